@@ -1,0 +1,2 @@
+# Installation and export (filled in by the packaging work).
+include(GNUInstallDirs)

@@ -1,0 +1,93 @@
+#include "estimator/identification_options.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace dwellfit {
+
+const char* ResidualKindName(ResidualKind kind) {
+  return kind == ResidualKind::kAlgebraic ? "algebraic" : "vertical";
+}
+
+bool ResidualKindFromName(const std::string& name, ResidualKind* kind) {
+  for (ResidualKind k : {ResidualKind::kAlgebraic, ResidualKind::kVertical}) {
+    if (name == ResidualKindName(k)) {
+      *kind = k;
+      return true;
+    }
+  }
+  return false;
+}
+
+const char* ErrorMeasureName(ErrorMeasure measure) {
+  return measure == ErrorMeasure::kAbsolute ? "absolute" : "relative";
+}
+
+bool ErrorMeasureFromName(const std::string& name, ErrorMeasure* measure) {
+  for (ErrorMeasure m : {ErrorMeasure::kAbsolute, ErrorMeasure::kRelative}) {
+    if (name == ErrorMeasureName(m)) {
+      *measure = m;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool SolverSettings::IsValid(std::string* error) const {
+  if (max_iterations < 1) {
+    *error = "solver.max_iterations must be at least 1";
+    return false;
+  }
+  if (!(function_tolerance >= 0) || !(gradient_tolerance >= 0) || !(parameter_tolerance >= 0)) {
+    *error = "solver tolerances must be non-negative numbers";
+    return false;
+  }
+  if (num_threads < 1) {
+    *error = "solver.num_threads must be at least 1";
+    return false;
+  }
+  return true;
+}
+
+bool JumpDetectionOptions::IsValid(std::string* error) const {
+  if (!(min_ratio > 1.0)) {
+    *error = "jump_detection.min_ratio must be greater than 1";
+    return false;
+  }
+  if (!(min_relative_amplitude >= 0.0 && min_relative_amplitude <= 1.0)) {
+    *error = "jump_detection.min_relative_amplitude must lie in [0, 1]";
+    return false;
+  }
+  return true;
+}
+
+bool IdentificationOptions::IsValid(std::string* error) const {
+  for (int i = 0; i < kNumParameters; ++i) {
+    if (!std::isfinite(initial[i])) {
+      *error = std::string("initial value of ") + ParameterName(i) + " is not a finite number";
+      return false;
+    }
+  }
+  for (int i : {kEtaE, kMu1, kMu2}) {
+    if (initial[i] < 0.0) {
+      *error = std::string("initial value of ") + ParameterName(i) +
+               " must be non-negative (it is bounded below by 0)";
+      return false;
+    }
+  }
+  if (!(initial[kEtaE] > 0.0)) {
+    *error = "initial value of eta_e must be positive";
+    return false;
+  }
+  if (!(initial[kOmega] > 0.0)) {
+    *error = "initial value of omega (natural frequency) must be positive";
+    return false;
+  }
+  if (stages.empty()) {
+    *error = "at least one fit stage is required";
+    return false;
+  }
+  return solver.IsValid(error);
+}
+
+}  // namespace dwellfit
