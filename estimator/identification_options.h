@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "residuals/model_parameters.h"
+#include "residuals/vertical_error_residual.h"
 
 namespace dwellfit {
 
@@ -19,11 +20,6 @@ enum class ResidualKind {
 const char* ResidualKindName(ResidualKind kind);
 bool ResidualKindFromName(const std::string& name, ResidualKind* kind);
 
-// How the vertical error is measured.
-enum class ErrorMeasure {
-  kAbsolute,  // a_i - a_model (the data's length unit)
-  kRelative,  // log(a_i) - log(a_model)
-};
 const char* ErrorMeasureName(ErrorMeasure measure);
 bool ErrorMeasureFromName(const std::string& name, ErrorMeasure* measure);
 

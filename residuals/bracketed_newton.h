@@ -27,7 +27,8 @@ double BracketedNewton(const Function& f, double lo, double hi, double x0) {
   // Orient the bracket so that f(x_neg) < 0 < f(x_pos).
   double x_neg = f_lo < 0.0 ? lo : hi;
   double x_pos = f_lo < 0.0 ? hi : lo;
-  double x = std::isfinite(x0) ? std::clamp(x0, std::min(lo, hi), std::max(lo, hi)) : 0.5 * (lo + hi);
+  double x =
+      std::isfinite(x0) ? std::clamp(x0, std::min(lo, hi), std::max(lo, hi)) : 0.5 * (lo + hi);
   double step_before_last = std::abs(hi - lo);
   double last_step = step_before_last;
   double value;

@@ -225,8 +225,8 @@ ResponseCoefficients<double> ScalarCoefficients(const ResponseCoefficients<T>& k
 }
 
 // The model's amplitude at one dwell (double precision convenience).
-inline StableRoot ModelAmplitude(const ParameterVector& p, double omega_drive_rad_s,
-                                 double a_base, Branch branch, double a_guess) {
+inline StableRoot ModelAmplitude(const ParameterVector& p, double omega_drive_rad_s, double a_base,
+                                 Branch branch, double a_guess) {
   const auto k = ResponseCoefficients<double>::FromParameters(p.data(), omega_drive_rad_s);
   StableRoot root = SolveStableRoot(k, a_base, branch, a_guess);
   if (root.status != RootStatus::kFailed) root.a = LiftRoot(k, a_base, root);

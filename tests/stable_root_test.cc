@@ -38,15 +38,11 @@ TEST(SolveStableRoot, FrequencySweepBranchesEndWhereTheChapterSays) {
   // Going up: the upper branch still exists at 42.2 Hz and is gone at 42.3 Hz.
   // (model.md quotes 42.0-42.1 Hz; a brute-force root count of its own G(a)
   // puts three roots at 42.2 Hz and one at 42.25 Hz.)
-  EXPECT_EQ(SolveStableRoot(At(42.2), a_base, Branch::kUpper, 4e-3).status,
-            RootStatus::kOnBranch);
-  EXPECT_EQ(SolveStableRoot(At(42.3), a_base, Branch::kUpper, 4e-3).status,
-            RootStatus::kBranchEnd);
+  EXPECT_EQ(SolveStableRoot(At(42.2), a_base, Branch::kUpper, 4e-3).status, RootStatus::kOnBranch);
+  EXPECT_EQ(SolveStableRoot(At(42.3), a_base, Branch::kUpper, 4e-3).status, RootStatus::kBranchEnd);
   // Coming down: the lower branch exists at 40.7 Hz and is gone at 40.6 Hz.
-  EXPECT_EQ(SolveStableRoot(At(40.7), a_base, Branch::kLower, 1e-3).status,
-            RootStatus::kOnBranch);
-  EXPECT_EQ(SolveStableRoot(At(40.6), a_base, Branch::kLower, 1e-3).status,
-            RootStatus::kBranchEnd);
+  EXPECT_EQ(SolveStableRoot(At(40.7), a_base, Branch::kLower, 1e-3).status, RootStatus::kOnBranch);
+  EXPECT_EQ(SolveStableRoot(At(40.6), a_base, Branch::kLower, 1e-3).status, RootStatus::kBranchEnd);
 }
 
 TEST(SolveStableRoot, ReturnsTheStableRootOfTheNamedBranchFromAnyGuess) {

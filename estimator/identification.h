@@ -1,0 +1,54 @@
+// Identification: the default multi-stage fit of the chapter's final
+// algorithm (section 3.2.4) on a set of fitted sweeps.
+//
+// Stages run in order on the same parameter block, each starting where the
+// previous ended. The default is [algebraic, vertical]: the algebraic residual
+// of eq. (3.11) is smooth and branch-free and so lands near the minimum from a
+// rough start; the vertical error, which respects branches and stability, then
+// converges from there.
+#ifndef DWELLFIT_ESTIMATOR_IDENTIFICATION_H_
+#define DWELLFIT_ESTIMATOR_IDENTIFICATION_H_
+
+#include <string>
+#include <vector>
+
+#include "ceres/problem.h"
+#include "ceres/solver.h"
+#include "estimator/identification_options.h"
+#include "estimator/sweep.h"
+
+namespace dwellfit {
+
+struct StageSummary {
+  ResidualKind residual = ResidualKind::kVertical;
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  int iterations = 0;
+  bool converged = false;      // the solver met a convergence test
+  std::string brief_report;    // ceres::Solver::Summary::BriefReport()
+  ParameterVector parameters;  // where the stage ended
+};
+
+struct IdentificationResult {
+  ParameterVector parameters;  // physical units, omega in rad/s
+  std::vector<StageSummary> stages;
+  int residual_blocks = 0;  // dwell points fitted
+  double final_cost = 0.0;  // of the last stage
+  int iterations = 0;       // over all stages
+  bool converged = false;   // the last stage converged
+};
+
+ceres::Solver::Options MakeSolverOptions(const SolverSettings& settings);
+
+// Solves a problem assembled by ProblemBuilder. Returns whether the solution is
+// usable (ceres::Solver::Summary::IsSolutionUsable).
+bool SolveProblem(const SolverSettings& settings, ceres::Problem* problem,
+                  ceres::Solver::Summary* summary);
+
+// Runs the configured stages on `fitted` from options.initial.
+IdentificationResult Identify(const std::vector<const Sweep*>& fitted,
+                              const IdentificationOptions& options);
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_ESTIMATOR_IDENTIFICATION_H_

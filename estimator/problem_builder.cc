@@ -1,0 +1,71 @@
+#include "estimator/problem_builder.h"
+
+#include <cmath>
+
+#include "estimator/scaled_subset_manifold.h"
+#include "glog/logging.h"
+#include "residuals/algebraic_residual.h"
+#include "residuals/vertical_error_residual.h"
+
+namespace dwellfit {
+
+bool ProblemBuilderOptions::IsValid(std::string* error) const {
+  if (scale) {
+    for (int i = 0; i < kNumParameters; ++i) {
+      if (!fixed[i] && !((*scale)[i] > 0.0 && std::isfinite((*scale)[i]))) {
+        *error = std::string("scale of ") + ParameterName(i) + " must be positive and finite";
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+ProblemBuilder::ProblemBuilder(const ProblemBuilderOptions& options) : options_(options) {
+  std::string error;
+  CHECK(options_.IsValid(&error)) << error;
+}
+
+ceres::CostFunction* ProblemBuilder::MakeResidual(const DwellPoint& point) const {
+  if (options_.residual == ResidualKind::kAlgebraic) {
+    return AlgebraicResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
+                                     1.0);
+  }
+  double weight = 1.0;
+  if (options_.residual_options.use_point_sigma && point.sigma) {
+    // sigma is the standard deviation of a; in relative error it becomes
+    // that of ln a, sigma / a.
+    weight = options_.residual_options.error == ErrorMeasure::kAbsolute
+                 ? 1.0 / *point.sigma
+                 : point.amplitude / *point.sigma;
+  }
+  return VerticalErrorResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
+                                       point.branch, options_.residual_options.error, weight);
+}
+
+int ProblemBuilder::AddSweep(const Sweep& sweep, double* parameters,
+                             ceres::Problem* problem) const {
+  for (const DwellPoint& point : sweep.points) {
+    problem->AddResidualBlock(MakeResidual(point), nullptr, parameters);
+  }
+  return static_cast<int>(sweep.points.size());
+}
+
+void ProblemBuilder::ConfigureParameters(double* parameters, ceres::Problem* problem) const {
+  CHECK(problem->HasParameterBlock(parameters)) << "add residuals before configuring";
+  for (int i : {kEtaE, kMu1, kMu2}) problem->SetParameterLowerBound(parameters, i, 0.0);
+  bool any_free = false;
+  for (bool f : options_.fixed) any_free = any_free || !f;
+  if (!any_free) {
+    problem->SetParameterBlockConstant(parameters);
+    return;
+  }
+  ParameterVector scale;
+  for (int i = 0; i < kNumParameters; ++i) {
+    scale[i] = options_.scale ? (*options_.scale)[i] : std::abs(parameters[i]);
+    if (!(scale[i] > 0.0)) scale[i] = 1.0;
+  }
+  problem->SetManifold(parameters, new ScaledSubsetManifold(scale, options_.fixed));
+}
+
+}  // namespace dwellfit

@@ -1,0 +1,63 @@
+// ProblemBuilder: assembles the identification problem on a ceres::Problem and
+// a parameter block that the caller owns, so a larger estimator can embed it.
+//
+// Mathematical formulation. With p = [eta_e, mu1, mu2, delta, alpha, omega]
+// (model_parameters.h) and the dwell points i of the chosen sweeps,
+//
+//   minimise over the free entries of p   (1/2) sum_i r_i(p)^2
+//   subject to                            eta_e, mu1, mu2 >= 0
+//
+// where r_i is either the algebraic residual of eq. (3.11)
+// (residuals/algebraic_residual.h) or the vertical error of section 3.2.4
+// (residuals/vertical_error_residual.h). Fixed parameters keep their value;
+// the free ones are stepped in units of their scale (ScaledSubsetManifold).
+#ifndef DWELLFIT_ESTIMATOR_PROBLEM_BUILDER_H_
+#define DWELLFIT_ESTIMATOR_PROBLEM_BUILDER_H_
+
+#include <array>
+#include <optional>
+#include <string>
+
+#include "ceres/problem.h"
+#include "estimator/identification_options.h"
+#include "estimator/sweep.h"
+#include "residuals/model_parameters.h"
+
+namespace dwellfit {
+
+struct ProblemBuilderOptions {
+  ResidualKind residual = ResidualKind::kVertical;
+  ResidualOptions residual_options;
+  std::array<bool, kNumParameters> fixed = {false, false, false, false, false, false};
+  // Typical magnitude of each parameter: one unit of solver step. Unset: the
+  // magnitude of the parameter's value when ConfigureParameters is called
+  // (1 where that value is 0).
+  std::optional<ParameterVector> scale;
+  bool IsValid(std::string* error) const;
+};
+
+class ProblemBuilder {
+ public:
+  explicit ProblemBuilder(const ProblemBuilderOptions& options);
+
+  // Adds one residual block per dwell of `sweep`, each reading the 6-double
+  // block `parameters` (owned by the caller, must outlive `problem`).
+  // Returns the number of residual blocks added.
+  int AddSweep(const Sweep& sweep, double* parameters, ceres::Problem* problem) const;
+
+  // Sets bounds (eta_e, mu1, mu2 >= 0), fixed parameters and scaling on the
+  // block. Call once, after the block has residuals in `problem`.
+  void ConfigureParameters(double* parameters, ceres::Problem* problem) const;
+
+  // The cost function of one dwell (owned by the caller; Ceres takes it).
+  ceres::CostFunction* MakeResidual(const DwellPoint& point) const;
+
+  const ProblemBuilderOptions& options() const { return options_; }
+
+ private:
+  ProblemBuilderOptions options_;
+};
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_ESTIMATOR_PROBLEM_BUILDER_H_
