@@ -47,6 +47,7 @@ IdentificationResult Identify(const std::vector<const Sweep*>& fitted,
       scale[i] = std::abs(options.initial[i]) > 0.0 ? std::abs(options.initial[i]) : 1.0;
     }
     builder_options.scale = scale;
+    builder_options.bound_damping = kind != ResidualKind::kAlgebraic;
     const ProblemBuilder builder(builder_options);
 
     ceres::Problem problem;
@@ -58,6 +59,9 @@ IdentificationResult Identify(const std::vector<const Sweep*>& fitted,
 
     ceres::Solver::Summary summary;
     SolveProblem(options.solver, &problem, &summary);
+    if (!builder_options.bound_damping && ReflectDampingIntoPhysicalRange(&result.parameters)) {
+      VLOG(1) << "reflected the " << ResidualKindName(kind) << " stage's damping";
+    }
     StageSummary stage;
     stage.residual = kind;
     stage.initial_cost = summary.initial_cost;

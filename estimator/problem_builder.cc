@@ -1,5 +1,6 @@
 #include "estimator/problem_builder.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "estimator/scaled_subset_manifold.h"
@@ -53,7 +54,10 @@ int ProblemBuilder::AddSweep(const Sweep& sweep, double* parameters,
 
 void ProblemBuilder::ConfigureParameters(double* parameters, ceres::Problem* problem) const {
   CHECK(problem->HasParameterBlock(parameters)) << "add residuals before configuring";
-  for (int i : {kEtaE, kMu1, kMu2}) problem->SetParameterLowerBound(parameters, i, 0.0);
+  problem->SetParameterLowerBound(parameters, kEtaE, 0.0);
+  if (options_.bound_damping) {
+    for (int i : {kMu1, kMu2}) problem->SetParameterLowerBound(parameters, i, 0.0);
+  }
   bool any_free = false;
   for (bool f : options_.fixed) any_free = any_free || !f;
   if (!any_free) {
@@ -66,6 +70,18 @@ void ProblemBuilder::ConfigureParameters(double* parameters, ceres::Problem* pro
     if (!(scale[i] > 0.0)) scale[i] = 1.0;
   }
   problem->SetManifold(parameters, new ScaledSubsetManifold(scale, options_.fixed));
+}
+
+bool ReflectDampingIntoPhysicalRange(ParameterVector* parameters) {
+  ParameterVector& p = *parameters;
+  const ParameterVector before = p;
+  p[kEtaE] = std::abs(p[kEtaE]);
+  if (p[kMu1] <= 0.0 && p[kMu2] <= 0.0) {
+    p[kMu1] = -p[kMu1];
+    p[kMu2] = -p[kMu2];
+  }
+  for (int i : {kMu1, kMu2}) p[i] = std::max(p[i], 0.0);
+  return p != before;
 }
 
 }  // namespace dwellfit

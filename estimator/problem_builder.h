@@ -33,6 +33,10 @@ struct ProblemBuilderOptions {
   // magnitude of the parameter's value when ConfigureParameters is called
   // (1 where that value is 0).
   std::optional<ParameterVector> scale;
+  // Bound mu1, mu2 >= 0 (eta_e is always bounded). The algebraic residual is
+  // invariant under (mu1, mu2) -> -(mu1, mu2), so a stage on it may run
+  // unbounded and reflect its result (ReflectDampingIntoPhysicalRange).
+  bool bound_damping = true;
   bool IsValid(std::string* error) const;
 };
 
@@ -45,8 +49,8 @@ class ProblemBuilder {
   // Returns the number of residual blocks added.
   int AddSweep(const Sweep& sweep, double* parameters, ceres::Problem* problem) const;
 
-  // Sets bounds (eta_e, mu1, mu2 >= 0), fixed parameters and scaling on the
-  // block. Call once, after the block has residuals in `problem`.
+  // Sets bounds (eta_e >= 0; mu1, mu2 >= 0 unless !bound_damping), fixed parameters and scaling on
+  // the block. Call once, after the block has residuals in `problem`.
   void ConfigureParameters(double* parameters, ceres::Problem* problem) const;
 
   // The cost function of one dwell (owned by the caller; Ceres takes it).
@@ -57,6 +61,13 @@ class ProblemBuilder {
  private:
   ProblemBuilderOptions options_;
 };
+
+// G(a) of eq. (3.11) depends on mu1, mu2 only through k1^2, k2^2 and k1 k2,
+// and on eta_e only through 1/eta_e^2. Maps a point fitted on G alone to its
+// physical twin: eta_e -> |eta_e|, (mu1, mu2) -> -(mu1, mu2) when neither is
+// positive; a damping left negative after that (mixed signs: no physical twin)
+// is set to 0. Returns whether anything changed.
+bool ReflectDampingIntoPhysicalRange(ParameterVector* parameters);
 
 }  // namespace dwellfit
 

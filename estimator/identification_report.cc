@@ -1,0 +1,172 @@
+#include "estimator/identification_report.h"
+
+#include <cstdio>
+#include <sstream>
+
+#include "estimator/output_files.h"
+#include "yaml-cpp/yaml.h"
+
+namespace dwellfit {
+
+IdentificationReport MakeIdentificationReport(const std::string& config_path,
+                                              const IdentificationOptions& options,
+                                              const IdentificationResult& result,
+                                              double omega_ref_rad_s,
+                                              const std::vector<const Sweep*>& fitted,
+                                              const std::vector<const Sweep*>& validation) {
+  IdentificationReport report;
+  report.config_path = config_path;
+  report.options = options;
+  report.result = result;
+  report.omega_ref_rad_s = omega_ref_rad_s > 0.0 ? omega_ref_rad_s : result.parameters[kOmega];
+  for (const Sweep* sweep : fitted) {
+    report.predictions.push_back(PredictSweep(result.parameters, *sweep, /*fitted=*/true));
+  }
+  for (const Sweep* sweep : validation) {
+    report.predictions.push_back(PredictSweep(result.parameters, *sweep, /*fitted=*/false));
+  }
+  return report;
+}
+
+namespace {
+
+const char* Role(const SweepPrediction& prediction) {
+  return prediction.fitted ? "fitted" : "validation";
+}
+
+// The control in the file's unit: Hz for frequencies, a_base as given.
+double ControlInFileUnit(const Sweep& sweep, double control) {
+  return sweep.kind == SweepKind::kFrequency ? RadPerSecondToHz(control) : control;
+}
+
+}  // namespace
+
+std::string ReportToYaml(const IdentificationReport& report) {
+  const IdentificationResult& result = report.result;
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap;
+  out << YAML::Key << "config" << YAML::Value << report.config_path;
+  out << YAML::Key << "parameters" << YAML::Value << YAML::BeginMap;
+  for (int i = 0; i < kNumParameters; ++i) {
+    out << YAML::Key << ParameterName(i) << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "value" << YAML::Value << result.parameters[i];
+    out << YAML::Key << "initial" << YAML::Value << report.options.initial[i];
+    out << YAML::Key << "fixed" << YAML::Value << report.options.fixed[i];
+    if (i == kOmega) out << YAML::Key << "unit" << YAML::Value << "rad/s";
+    out << YAML::EndMap;
+  }
+  out << YAML::EndMap;
+  out << YAML::Key << "natural_frequency_hz" << YAML::Value
+      << RadPerSecondToHz(result.parameters[kOmega]);
+  out << YAML::Key << "effective_nonlinearity" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "definition" << YAML::Value << "-(1/3)(2 delta Omega_ref^2 - 3 alpha)";
+  out << YAML::Key << "value" << YAML::Value
+      << EffectiveNonlinearity(result.parameters, report.omega_ref_rad_s);
+  out << YAML::Key << "omega_ref_rad_s" << YAML::Value << report.omega_ref_rad_s;
+  out << YAML::EndMap;
+  out << YAML::Key << "final_cost" << YAML::Value << result.final_cost;
+  out << YAML::Key << "iterations" << YAML::Value << result.iterations;
+  out << YAML::Key << "converged" << YAML::Value << result.converged;
+  out << YAML::Key << "fitted_points" << YAML::Value << result.residual_blocks;
+  out << YAML::Key << "stages" << YAML::Value << YAML::BeginSeq;
+  for (const StageSummary& stage : result.stages) {
+    out << YAML::BeginMap;
+    out << YAML::Key << "residual" << YAML::Value << ResidualKindName(stage.residual);
+    out << YAML::Key << "initial_cost" << YAML::Value << stage.initial_cost;
+    out << YAML::Key << "final_cost" << YAML::Value << stage.final_cost;
+    out << YAML::Key << "iterations" << YAML::Value << stage.iterations;
+    out << YAML::Key << "converged" << YAML::Value << stage.converged;
+    out << YAML::Key << "solver" << YAML::Value << stage.brief_report;
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::Key << "sweeps" << YAML::Value << YAML::BeginSeq;
+  for (const SweepPrediction& prediction : report.predictions) {
+    const Sweep& sweep = *prediction.sweep;
+    out << YAML::BeginMap;
+    out << YAML::Key << "name" << YAML::Value << sweep.Name();
+    out << YAML::Key << "role" << YAML::Value << Role(prediction);
+    out << YAML::Key << "kind" << YAML::Value << SweepKindName(sweep.kind);
+    out << YAML::Key << "points" << YAML::Value << sweep.points.size();
+    out << YAML::Key << "rms_error" << YAML::Value << prediction.rms_error;
+    out << YAML::Key << "relative_rms_error" << YAML::Value << prediction.relative_rms_error;
+    out << YAML::Key << "points_off_branch" << YAML::Value << prediction.points_off_branch;
+    out << YAML::Key << "measured_jumps" << YAML::Value << YAML::BeginSeq;
+    for (const JumpBracket& jump : sweep.jumps) {
+      out << YAML::Flow << YAML::BeginMap;
+      out << YAML::Key << "kind" << YAML::Value << JumpKindName(jump.kind);
+      out << YAML::Key << (sweep.kind == SweepKind::kFrequency ? "between_hz" : "between_a_base")
+          << YAML::Value << YAML::Flow << YAML::BeginSeq
+          << ControlInFileUnit(sweep, jump.control_before)
+          << ControlInFileUnit(sweep, jump.control_after) << YAML::EndSeq;
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+std::string ReportToPredictionsCsv(const IdentificationReport& report) {
+  std::ostringstream csv;
+  csv << "sweep,direction,role,freq_hz,a_base,a,a_model,branch,model_status\n";
+  for (const SweepPrediction& prediction : report.predictions) {
+    const Sweep& sweep = *prediction.sweep;
+    for (size_t i = 0; i < sweep.points.size(); ++i) {
+      const DwellPoint& point = sweep.points[i];
+      const StableRoot& model = prediction.model[i];
+      const char* status = model.status == RootStatus::kOnBranch    ? "on_branch"
+                           : model.status == RootStatus::kBranchEnd ? "branch_end"
+                                                                    : "failed";
+      csv << sweep.id << ',' << SweepDirectionName(sweep.direction) << ',' << Role(prediction)
+          << ',' << FormatDouble(RadPerSecondToHz(point.drive_frequency_rad_s)) << ','
+          << FormatDouble(point.a_base) << ',' << FormatDouble(point.amplitude) << ','
+          << FormatDouble(model.a) << ',' << BranchName(point.branch) << ',' << status << '\n';
+    }
+  }
+  return csv.str();
+}
+
+void PrintReport(const IdentificationReport& report, std::ostream& out) {
+  const IdentificationResult& result = report.result;
+  for (const StageSummary& stage : result.stages) {
+    out << ResidualKindName(stage.residual) << " stage: " << stage.brief_report << "\n";
+  }
+  char line[256];
+  out << "\n";
+  std::snprintf(line, sizeof(line), "%-8s %-24s %-24s %s\n", "param", "estimate", "initial",
+                "fixed");
+  out << line;
+  for (int i = 0; i < kNumParameters; ++i) {
+    std::snprintf(line, sizeof(line), "%-8s %-24.10g %-24.10g %s\n", ParameterName(i),
+                  result.parameters[i], report.options.initial[i],
+                  report.options.fixed[i] ? "yes" : "no");
+    out << line;
+  }
+  std::snprintf(line, sizeof(line),
+                "natural frequency %.8g Hz; effective nonlinearity %.8g at "
+                "Omega_ref %.6g rad/s\n",
+                RadPerSecondToHz(result.parameters[kOmega]),
+                EffectiveNonlinearity(result.parameters, report.omega_ref_rad_s),
+                report.omega_ref_rad_s);
+  out << line;
+  std::snprintf(line, sizeof(line), "final cost %.6g after %d iterations, %s\n\n",
+                result.final_cost, result.iterations,
+                result.converged ? "converged" : "NOT converged");
+  out << line;
+  std::snprintf(line, sizeof(line), "%-20s %-10s %6s %14s %14s %s\n", "sweep", "role", "points",
+                "rms_error", "relative_rms", "off_branch");
+  out << line;
+  for (const SweepPrediction& prediction : report.predictions) {
+    std::snprintf(line, sizeof(line), "%-20s %-10s %6zu %14.6g %14.6g %d\n",
+                  prediction.sweep->Name().c_str(), Role(prediction),
+                  prediction.sweep->points.size(), prediction.rms_error,
+                  prediction.relative_rms_error, prediction.points_off_branch);
+    out << line;
+  }
+}
+
+}  // namespace dwellfit

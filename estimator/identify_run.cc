@@ -1,0 +1,92 @@
+#include "estimator/identify_run.h"
+
+#include <cmath>
+#include <map>
+
+#include "estimator/input_error.h"
+#include "estimator/jump_detection.h"
+#include "estimator/output_files.h"
+#include "estimator/sweep_csv.h"
+#include "glog/logging.h"
+
+namespace dwellfit {
+
+std::vector<Sweep> LoadLabelledSweeps(const std::vector<std::string>& data_files,
+                                      const JumpDetectionOptions& jump_detection) {
+  std::vector<Sweep> sweeps;
+  std::map<std::string, std::string> file_of_sweep;
+  for (const std::string& file : data_files) {
+    LoadedSweeps loaded = LoadSweepsCsv(file);
+    for (Sweep& sweep : loaded.sweeps) {
+      const auto [it, inserted] = file_of_sweep.emplace(sweep.Name(), file);
+      if (!inserted) {
+        throw InputError(file, sweep.points.front().source_line, "sweep",
+                         "sweep '" + sweep.Name() + "' also appears in " + it->second +
+                             "; give the sweeps of different files different ids");
+      }
+      sweeps.push_back(std::move(sweep));
+    }
+  }
+  DetectJumps(jump_detection, &sweeps);
+  return sweeps;
+}
+
+std::vector<const Sweep*> SelectSweeps(const std::vector<Sweep>& sweeps,
+                                       const std::vector<SweepSelection>& selections,
+                                       const std::string& config_path, const std::string& field) {
+  for (const SweepSelection& selection : selections) {
+    bool found = false;
+    for (const Sweep& sweep : sweeps) found = found || selection.Selects(sweep);
+    if (!found) {
+      std::string available;
+      for (const Sweep& sweep : sweeps) available += (available.empty() ? "" : ", ") + sweep.Name();
+      throw InputError(
+          config_path, 0, field,
+          "sweep '" + selection.Name() + "' is not in the data; available: " + available);
+    }
+  }
+  std::vector<const Sweep*> selected;
+  for (const Sweep& sweep : sweeps) {
+    for (const SweepSelection& selection : selections) {
+      if (selection.Selects(sweep)) {
+        selected.push_back(&sweep);
+        break;
+      }
+    }
+  }
+  return selected;
+}
+
+std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::ostream& out) {
+  out << "# config in effect\n" << ConfigToYaml(config) << "\n";
+  auto outcome = std::make_unique<IdentifyOutcome>();
+  outcome->sweeps = LoadLabelledSweeps(config.data_files, config.jump_detection);
+  const std::vector<Sweep>& sweeps = outcome->sweeps;
+  const std::vector<const Sweep*> fitted =
+      SelectSweeps(sweeps, config.fit_sweeps, config.config_path, "fit");
+  const std::vector<const Sweep*> validation =
+      SelectSweeps(sweeps, config.validate_sweeps, config.config_path, "validate");
+  for (const Sweep* sweep : fitted) out << "fit      " << DescribeJumps(*sweep) << "\n";
+  for (const Sweep* sweep : validation) out << "validate " << DescribeJumps(*sweep) << "\n";
+  out << "\n";
+
+  const IdentificationResult result = Identify(fitted, config.identification);
+  for (double value : result.parameters) {
+    if (!std::isfinite(value)) {
+      throw InputError(config.config_path, 0, "initial_guess",
+                       "the solver returned no usable solution; start closer to the data "
+                       "(see config/README.md, initial_guess)");
+    }
+  }
+  outcome->report =
+      MakeIdentificationReport(config.config_path, config.identification, result,
+                               config.omega_ref_rad_s.value_or(0.0), fitted, validation);
+  const IdentificationReport& report = outcome->report;
+  PrintReport(report, out);
+  WriteFilesAtomically(config.output_dir, {{"result.yaml", ReportToYaml(report)},
+                                           {"predictions.csv", ReportToPredictionsCsv(report)}});
+  out << "\nwrote " << config.output_dir << "/result.yaml and predictions.csv\n";
+  return outcome;
+}
+
+}  // namespace dwellfit

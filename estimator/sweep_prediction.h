@@ -1,0 +1,33 @@
+// The model's amplitude beside every measured dwell of a sweep, and how far
+// the two are apart.
+//
+//   rms_error          = sqrt(mean_i (a_model_i - a_i)^2)        [data's unit]
+//   relative_rms_error = sqrt(mean_i ((a_model_i - a_i) / a_i)^2)
+//
+// a_model_i is the stable root on the branch point i was measured on (the
+// same root the vertical residual uses).
+#ifndef DWELLFIT_ESTIMATOR_SWEEP_PREDICTION_H_
+#define DWELLFIT_ESTIMATOR_SWEEP_PREDICTION_H_
+
+#include <vector>
+
+#include "estimator/sweep.h"
+#include "residuals/model_parameters.h"
+#include "residuals/stable_root.h"
+
+namespace dwellfit {
+
+struct SweepPrediction {
+  const Sweep* sweep = nullptr;
+  bool fitted = false;            // false: a validation sweep, only predicted
+  std::vector<StableRoot> model;  // one per point of sweep->points
+  double rms_error = 0.0;
+  double relative_rms_error = 0.0;
+  int points_off_branch = 0;  // points whose branch ends before their control
+};
+
+SweepPrediction PredictSweep(const ParameterVector& parameters, const Sweep& sweep, bool fitted);
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_ESTIMATOR_SWEEP_PREDICTION_H_
