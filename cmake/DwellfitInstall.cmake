@@ -1,2 +1,60 @@
-# Installation and export (filled in by the packaging work).
+# Installation and export.
+#
+#   <prefix>/include/dwellfit/{residuals,estimator,config}/*.h
+#   <prefix>/lib/libdwellfit.a
+#   <prefix>/lib/cmake/dwellfit/dwellfit{Config,ConfigVersion,Targets}.cmake
+#   <prefix>/bin/dwellfit-identify, dwellfit-simulate-dwell
+#
+# Outside code: find_package(dwellfit) and link dwellfit::dwellfit (the
+# estimator library) or dwellfit::residuals (the header-only functors). Headers
+# are included as "residuals/...", "estimator/...", "config/...".
 include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+set(DWELLFIT_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/dwellfit"
+    CACHE STRING "Where dwellfitConfig.cmake is installed, relative to the prefix")
+
+set_target_properties(dwellfit_residuals PROPERTIES EXPORT_NAME residuals)
+set_target_properties(dwellfit PROPERTIES EXPORT_NAME dwellfit)
+
+install(TARGETS dwellfit_residuals dwellfit
+  EXPORT dwellfitTargets
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+
+# Headers are globbed when `cmake --install` runs, so new ones need no edit here.
+foreach(header_dir residuals estimator config)
+  install(DIRECTORY ${PROJECT_SOURCE_DIR}/${header_dir}/
+    DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/dwellfit/${header_dir}
+    FILES_MATCHING PATTERN "*.h")
+endforeach()
+
+install(EXPORT dwellfitTargets
+  NAMESPACE dwellfit::
+  FILE dwellfitTargets.cmake
+  DESTINATION ${DWELLFIT_INSTALL_CMAKEDIR})
+
+configure_package_config_file(
+  ${PROJECT_SOURCE_DIR}/cmake/dwellfitConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/dwellfitConfig.cmake
+  INSTALL_DESTINATION ${DWELLFIT_INSTALL_CMAKEDIR})
+write_basic_package_version_file(
+  ${PROJECT_BINARY_DIR}/dwellfitConfigVersion.cmake
+  VERSION ${PROJECT_VERSION}
+  COMPATIBILITY SameMajorVersion)
+install(FILES
+  ${PROJECT_BINARY_DIR}/dwellfitConfig.cmake
+  ${PROJECT_BINARY_DIR}/dwellfitConfigVersion.cmake
+  DESTINATION ${DWELLFIT_INSTALL_CMAKEDIR})
+
+# The command-line tools keep their build names (build/tools/identify) but are
+# installed with a dwellfit- prefix: ImageMagick already installs `identify`.
+foreach(tool identify simulate_dwell)
+  if(TARGET ${tool})
+    string(REPLACE "_" "-" installed_name "dwellfit-${tool}")
+    install(PROGRAMS $<TARGET_FILE:${tool}>
+      DESTINATION ${CMAKE_INSTALL_BINDIR}
+      RENAME ${installed_name})
+  endif()
+endforeach()

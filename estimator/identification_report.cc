@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include "estimator/output_files.h"
+#include "estimator/sweep_csv_writer.h"
 #include "yaml-cpp/yaml.h"
 
 namespace dwellfit {
@@ -122,9 +122,9 @@ std::string ReportToPredictionsCsv(const IdentificationReport& report) {
                            : model.status == RootStatus::kBranchEnd ? "branch_end"
                                                                     : "failed";
       csv << sweep.id << ',' << SweepDirectionName(sweep.direction) << ',' << Role(prediction)
-          << ',' << FormatDouble(RadPerSecondToHz(point.drive_frequency_rad_s)) << ','
-          << FormatDouble(point.a_base) << ',' << FormatDouble(point.amplitude) << ','
-          << FormatDouble(model.a) << ',' << BranchName(point.branch) << ',' << status << '\n';
+          << ',' << FormatRoundTrip(RadPerSecondToHz(point.drive_frequency_rad_s)) << ','
+          << FormatRoundTrip(point.a_base) << ',' << FormatRoundTrip(point.amplitude) << ','
+          << FormatRoundTrip(model.a) << ',' << BranchName(point.branch) << ',' << status << '\n';
     }
   }
   return csv.str();

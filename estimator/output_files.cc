@@ -3,7 +3,6 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <charconv>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -11,12 +10,6 @@
 #include "estimator/input_error.h"
 
 namespace dwellfit {
-
-std::string FormatDouble(double value) {
-  char buffer[64];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  return std::string(buffer, result.ptr);
-}
 
 void WriteFilesAtomically(const std::string& directory,
                           const std::vector<std::pair<std::string, std::string>>& files) {

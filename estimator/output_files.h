@@ -16,9 +16,6 @@ namespace dwellfit {
 void WriteFilesAtomically(const std::string& directory,
                           const std::vector<std::pair<std::string, std::string>>& files);
 
-// Shortest text that reads back as the same double ("0.1", "9e+08").
-std::string FormatDouble(double value);
-
 }  // namespace dwellfit
 
 #endif  // DWELLFIT_ESTIMATOR_OUTPUT_FILES_H_

@@ -40,8 +40,8 @@ const char* JumpKindName(JumpKind kind);
 // control values (eq. 3.17 uses the bracket's centre and half-width).
 struct JumpBracket {
   JumpKind kind = JumpKind::kJumpDown;
-  int index_before = 0;           // index of the last dwell before the jump
-  double control_before = 0.0;    // rad/s (frequency sweep) or a_base (amplitude sweep)
+  int index_before = 0;         // index of the last dwell before the jump
+  double control_before = 0.0;  // rad/s (frequency sweep) or a_base (amplitude sweep)
   double control_after = 0.0;
   double amplitude_before = 0.0;  // measured a on either side
   double amplitude_after = 0.0;

@@ -1,0 +1,54 @@
+# CTest driver for `find_package_project` (cmake -P): installs the built
+# dwellfit into a fresh prefix, configures and builds the outside project
+# tests/find_package_project against it, and runs the program. Any failing
+# step fails the test with that step's name and output.
+#
+# Required -D variables:
+#   DWELLFIT_BINARY_DIR  the dwellfit build tree to install from
+#   PROJECT_SOURCE       tests/find_package_project
+#   WORK_DIR             build directory of the outside project (wiped first)
+#   PREFIX               install prefix (wiped first)
+# Optional: GENERATOR, CXX_COMPILER, BUILD_TYPE.
+cmake_minimum_required(VERSION 3.16)
+
+foreach(var DWELLFIT_BINARY_DIR PROJECT_SOURCE WORK_DIR PREFIX)
+  if(NOT ${var})
+    message(FATAL_ERROR "RunFindPackageProject: -D${var}=... is required")
+  endif()
+endforeach()
+if(NOT BUILD_TYPE)
+  set(BUILD_TYPE Release)
+endif()
+
+function(run_step name)
+  list(JOIN ARGN " " command_line)
+  message(STATUS "find_package_project: ${name}: ${command_line}")
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE result)
+  if(NOT result EQUAL 0)
+    message(FATAL_ERROR "find_package_project: step '${name}' failed (${result}): ${command_line}")
+  endif()
+endfunction()
+
+file(REMOVE_RECURSE "${PREFIX}" "${WORK_DIR}")
+
+run_step(install
+  "${CMAKE_COMMAND}" --install "${DWELLFIT_BINARY_DIR}" --prefix "${PREFIX}"
+  --config "${BUILD_TYPE}")
+
+set(configure_args -S "${PROJECT_SOURCE}" -B "${WORK_DIR}"
+  "-DCMAKE_PREFIX_PATH=${PREFIX}" "-DCMAKE_BUILD_TYPE=${BUILD_TYPE}")
+if(GENERATOR)
+  list(APPEND configure_args -G "${GENERATOR}")
+endif()
+if(CXX_COMPILER)
+  list(APPEND configure_args "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}")
+endif()
+run_step(configure "${CMAKE_COMMAND}" ${configure_args})
+run_step(build "${CMAKE_COMMAND}" --build "${WORK_DIR}" --config "${BUILD_TYPE}")
+
+find_program(program embed_dwellfit
+  PATHS "${WORK_DIR}" "${WORK_DIR}/${BUILD_TYPE}" NO_DEFAULT_PATH)
+if(NOT program)
+  message(FATAL_ERROR "find_package_project: the built program embed_dwellfit is missing in ${WORK_DIR}")
+endif()
+run_step(run "${program}")

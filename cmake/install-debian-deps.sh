@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages dwellfit needs to build, test, benchmark and
+# plot. Idempotent: when every package is already installed it only says so and
+# never calls apt-get (no network, under a second).
+#
+#   bash cmake/install-debian-deps.sh
+#
+# Runs as root, or through sudo when run as another user.
+set -euo pipefail
+
+packages=(
+  build-essential
+  make
+  cmake
+  pkg-config
+  libceres-dev
+  libeigen3-dev
+  libgoogle-glog-dev
+  libgflags-dev
+  libyaml-cpp-dev
+  libgtest-dev
+  libgmock-dev
+  libbenchmark-dev
+  libfccp-dev
+  libboost-dev
+  gnuplot-nox
+)
+
+is_installed() {
+  [[ "$(dpkg-query -W -f='${db:Status-Status}' "$1" 2>/dev/null || true)" == "installed" ]]
+}
+
+missing=()
+for package in "${packages[@]}"; do
+  if ! is_installed "${package}"; then
+    missing+=("${package}")
+  fi
+done
+
+if ((${#missing[@]} == 0)); then
+  echo "install-debian-deps: all ${#packages[@]} packages already installed; nothing to do."
+  exit 0
+fi
+
+if [[ "$(id -u)" -eq 0 ]]; then
+  sudo=()
+elif command -v sudo >/dev/null 2>&1; then
+  sudo=(sudo)
+else
+  echo "install-debian-deps: missing ${missing[*]}, and not root and no sudo: install them as root." >&2
+  exit 1
+fi
+
+echo "install-debian-deps: installing ${#missing[@]} missing package(s): ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+"${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update
+"${sudo[@]}" env DEBIAN_FRONTEND=noninteractive \
+  apt-get install -y --no-install-recommends "${missing[@]}"
+
+still_missing=()
+for package in "${missing[@]}"; do
+  if ! is_installed "${package}"; then
+    still_missing+=("${package}")
+  fi
+done
+if ((${#still_missing[@]} > 0)); then
+  echo "install-debian-deps: still not installed: ${still_missing[*]}" >&2
+  exit 1
+fi
+echo "install-debian-deps: done."

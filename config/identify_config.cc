@@ -1,0 +1,354 @@
+#include "config/identify_config.h"
+
+#include <array>
+#include <filesystem>
+#include <system_error>
+
+#include "config/config_source.h"
+#include "config/strict_yaml.h"
+
+namespace dwellfit {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct PlacedSelection {
+  SweepSelection selection;
+  ConfigValue value;
+};
+
+// How a relative path in `value` is resolved: from the config file's
+// directory, or from the working directory when an override gave it.
+fs::path ResolvePath(const std::string& text, const ConfigValue& value, const ConfigSource& source,
+                     const fs::path& config_dir) {
+  fs::path path(text);
+  if (path.is_relative()) {
+    path = (source.OverrideFor(value.path) != nullptr ? fs::current_path() : config_dir) / path;
+  }
+  return path.lexically_normal();
+}
+
+std::string RelativeToWhat(const ConfigValue& value, const ConfigSource& source) {
+  return source.OverrideFor(value.path) != nullptr
+             ? "a relative path given on the command line is relative to the working directory"
+             : "a relative path in the config is relative to the config file's directory";
+}
+
+std::vector<std::string> ReadDataFiles(const ConfigValue& value, const ConfigSource& source,
+                                       const fs::path& config_dir) {
+  const std::vector<ConfigValue> entries = ReadList(value, source);
+  if (entries.empty()) {
+    throw source.Error(value.path, value.mark,
+                       "lists no data file; give a CSV path or a list of paths");
+  }
+  std::vector<std::string> files;
+  std::vector<ConfigValue> places;
+  for (const ConfigValue& entry : entries) {
+    const std::string text = ReadNonEmptyString(entry, source);
+    const std::string resolved = ResolvePath(text, entry, source, config_dir).string();
+    std::error_code error;
+    if (!fs::is_regular_file(resolved, error)) {
+      throw source.Error(entry.path, entry.mark,
+                         "data file '" + text + "' not found at " + resolved + " (" +
+                             RelativeToWhat(entry, source) + ")");
+    }
+    for (std::size_t i = 0; i < files.size(); ++i) {
+      if (files[i] == resolved) {
+        throw source.Error(entry.path, entry.mark,
+                           "data file " + resolved + " is listed twice (first at " +
+                               source.Where(places[i].path, places[i].mark) +
+                               "); its sweeps would be counted twice, keep one");
+      }
+    }
+    files.push_back(resolved);
+    places.push_back(entry);
+  }
+  return files;
+}
+
+// The sweeps of `fit` or `validate`; none may be selected twice.
+std::vector<PlacedSelection> ReadSweepSelections(const ConfigValue& value,
+                                                 const ConfigSource& source) {
+  std::vector<PlacedSelection> placed;
+  for (const ConfigValue& entry : ReadList(value, source)) {
+    SweepSelection selection;
+    std::string error;
+    if (!ParseSweepSelection(ReadNonEmptyString(entry, source), &selection, &error)) {
+      throw source.Error(entry.path, entry.mark, error);
+    }
+    for (const PlacedSelection& earlier : placed) {
+      if (earlier.selection.Overlaps(selection)) {
+        const std::string first =
+            " (first at " + source.Where(earlier.value.path, earlier.value.mark) + ")";
+        throw source.Error(
+            entry.path, entry.mark,
+            earlier.selection.Name() == selection.Name()
+                ? "sweep '" + selection.Name() + "' is listed twice" + first + "; keep one"
+                : "sweep '" + selection.Name() + "' overlaps '" + earlier.selection.Name() + "'" +
+                      first + "; a sweep id alone selects both directions, so list either '" +
+                      selection.sweep_id + "' or its directions");
+      }
+    }
+    placed.push_back(PlacedSelection{selection, entry});
+  }
+  return placed;
+}
+
+std::vector<SweepSelection> Selections(const std::vector<PlacedSelection>& placed) {
+  std::vector<SweepSelection> selections;
+  for (const PlacedSelection& p : placed) selections.push_back(p.selection);
+  return selections;
+}
+
+void CheckNoSweepFittedAndValidated(const std::vector<PlacedSelection>& fit,
+                                    const std::vector<PlacedSelection>& validate,
+                                    const ConfigSource& source) {
+  for (const PlacedSelection& validated : validate) {
+    for (const PlacedSelection& fitted : fit) {
+      if (fitted.selection.Overlaps(validated.selection)) {
+        throw source.Error(validated.value.path, validated.value.mark,
+                           "sweep '" + validated.selection.Name() + "' is also fitted ('" +
+                               fitted.selection.Name() + "' in 'fit' at " +
+                               source.Where(fitted.value.path, fitted.value.mark) +
+                               "); a validation sweep must not be fitted, remove it from one "
+                               "of the lists");
+      }
+    }
+  }
+}
+
+// The initial_guess block: every parameter, in physical units, omega in Hz.
+ParameterVector ReadInitialGuess(const ConfigValue& value, const ConfigSource& source) {
+  struct Key {
+    ParameterIndex index;
+    const char* name;
+    const char* meaning;
+  };
+  const std::array<Key, kNumParameters> keys = {{
+      {kEtaE, "eta_e", "forcing effectiveness, > 0"},
+      {kMu1, "mu1", "linear damping [1/s], >= 0"},
+      {kMu2, "mu2", "quadratic damping, >= 0"},
+      {kDelta, "delta", "nonlinear inertia"},
+      {kAlpha, "alpha", "cubic stiffness"},
+      {kOmega, "omega_hz", "linear natural frequency [Hz], > 0"},
+  }};
+  std::vector<std::string> names;
+  for (const Key& key : keys) names.push_back(key.name);
+  const StrictMap block(value, source, names);
+
+  ParameterVector initial{};
+  for (const Key& key : keys) {
+    const ConfigValue entry =
+        block.Required(key.name, std::string("give its initial guess (") + key.meaning + ")");
+    const double number = ReadFiniteDouble(entry, source);
+    const bool must_be_positive = key.index == kEtaE || key.index == kOmega;
+    const bool must_be_non_negative = key.index == kMu1 || key.index == kMu2;
+    if (must_be_positive && !(number > 0.0)) {
+      throw source.Error(entry.path, entry.mark,
+                         "the initial guess must be positive, got " + entry.node.Scalar());
+    }
+    if (must_be_non_negative && number < 0.0) {
+      throw source.Error(entry.path, entry.mark,
+                         "the initial guess must be non-negative (the parameter is bounded "
+                         "below by 0), got " +
+                             entry.node.Scalar());
+    }
+    initial[key.index] = key.index == kOmega ? HzToRadPerSecond(number) : number;
+  }
+  return initial;
+}
+
+std::array<bool, kNumParameters> ReadFixed(const ConfigValue& value, const ConfigSource& source) {
+  const std::vector<std::string> allowed(kParameterNames.begin(), kParameterNames.end());
+  std::array<bool, kNumParameters> fixed{};
+  for (const ConfigValue& entry : ReadList(value, source)) {
+    const std::string name = ReadNonEmptyString(entry, source);
+    ParameterIndex index;
+    if (!ParameterIndexFromName(name, &index)) {
+      const std::string hint =
+          name == "omega_hz" ? " (the parameter is called 'omega')" : DidYouMean(name, allowed);
+      throw source.Error(
+          entry.path, entry.mark,
+          "unknown parameter '" + name + "'" + hint + "; allowed: " + JoinNames(allowed));
+    }
+    if (fixed[index]) {
+      throw source.Error(entry.path, entry.mark,
+                         "parameter '" + name + "' is listed twice; keep one");
+    }
+    fixed[index] = true;
+  }
+  return fixed;
+}
+
+std::vector<ResidualKind> ReadStages(const ConfigValue& value, const ConfigSource& source) {
+  const std::vector<std::string> allowed = {ResidualKindName(ResidualKind::kAlgebraic),
+                                            ResidualKindName(ResidualKind::kVertical)};
+  std::vector<ResidualKind> stages;
+  for (const ConfigValue& entry : ReadList(value, source)) {
+    const std::string name = ReadNonEmptyString(entry, source);
+    ResidualKind kind;
+    if (!ResidualKindFromName(name, &kind)) {
+      throw source.Error(entry.path, entry.mark,
+                         "unknown stage '" + name + "'" + DidYouMean(name, allowed) +
+                             "; allowed: " + JoinNames(allowed));
+    }
+    stages.push_back(kind);
+  }
+  if (stages.empty()) {
+    throw source.Error(value.path, value.mark,
+                       "lists no stage; give at least one of " + JoinNames(allowed) +
+                           ", or remove the key for the default [algebraic, vertical]");
+  }
+  return stages;
+}
+
+ResidualOptions ReadResidual(const ConfigValue& value, const ConfigSource& source) {
+  const StrictMap block(value, source, {"error", "use_point_sigma"});
+  ResidualOptions residual;
+  if (const auto error = block.Optional("error")) {
+    const std::string name = ReadNonEmptyString(*error, source);
+    if (!ErrorMeasureFromName(name, &residual.error)) {
+      const std::vector<std::string> allowed = {ErrorMeasureName(ErrorMeasure::kAbsolute),
+                                                ErrorMeasureName(ErrorMeasure::kRelative)};
+      throw source.Error(error->path, error->mark,
+                         "unknown error measure '" + name + "'" + DidYouMean(name, allowed) +
+                             "; allowed: " + JoinNames(allowed));
+    }
+  }
+  if (const auto use_point_sigma = block.Optional("use_point_sigma")) {
+    residual.use_point_sigma = ReadBool(*use_point_sigma, source);
+  }
+  return residual;
+}
+
+SolverSettings ReadSolver(const ConfigValue& value, const ConfigSource& source) {
+  const StrictMap block(value, source,
+                        {"max_iterations", "function_tolerance", "gradient_tolerance",
+                         "parameter_tolerance", "num_threads"});
+  SolverSettings solver;
+  if (const auto v = block.Optional("max_iterations")) solver.max_iterations = ReadInt(*v, source);
+  if (const auto v = block.Optional("function_tolerance")) {
+    solver.function_tolerance = ReadFiniteDouble(*v, source);
+  }
+  if (const auto v = block.Optional("gradient_tolerance")) {
+    solver.gradient_tolerance = ReadFiniteDouble(*v, source);
+  }
+  if (const auto v = block.Optional("parameter_tolerance")) {
+    solver.parameter_tolerance = ReadFiniteDouble(*v, source);
+  }
+  if (const auto v = block.Optional("num_threads")) solver.num_threads = ReadInt(*v, source);
+  return solver;
+}
+
+JumpDetectionOptions ReadJumpDetection(const ConfigValue& value, const ConfigSource& source) {
+  const StrictMap block(value, source, {"min_ratio", "min_relative_amplitude"});
+  JumpDetectionOptions jump_detection;
+  if (const auto v = block.Optional("min_ratio")) {
+    jump_detection.min_ratio = ReadFiniteDouble(*v, source);
+  }
+  if (const auto v = block.Optional("min_relative_amplitude")) {
+    jump_detection.min_relative_amplitude = ReadFiniteDouble(*v, source);
+  }
+  return jump_detection;
+}
+
+// Throws the `IsValid` message of an options struct read from `block`, at the
+// block's line, naming the overrides that changed values inside it.
+void ThrowInvalidBlock(const ConfigValue& block, const ConfigSource& source,
+                       const std::string& message) {
+  std::string set_by;
+  for (const ConfigOverride* applied : source.OverridesWithin(block.path)) {
+    set_by += (set_by.empty() ? "" : ", ") + DescribeOverride(*applied);
+  }
+  std::string what = message;
+  if (!set_by.empty()) what += " (values set on the command line: " + set_by + ")";
+  throw source.Error(block.path, block.mark, what);
+}
+
+ConfigValue OrAbsent(const std::optional<ConfigValue>& value, const std::string& path) {
+  return value.has_value() ? *value : ConfigValue{YAML::Node(), path, YAML::Mark::null_mark()};
+}
+
+IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& config_dir) {
+  const StrictMap top(
+      DocumentValue(source), source,
+      {"data", "fit", "validate", "initial_guess", "fixed", "stages", "residual", "solver",
+       "jump_detection", "effective_nonlinearity_reference_hz", "output_dir"});
+  IdentifyConfig config;
+  config.data_files =
+      ReadDataFiles(top.Required("data", "give the CSV file with the sweeps (or a list of files)"),
+                    source, config_dir);
+
+  const ConfigValue fit_value =
+      top.Required("fit", "list the sweep ids to fit, e.g. fit: [F0.01, A41.5/up]");
+  const std::vector<PlacedSelection> fit = ReadSweepSelections(fit_value, source);
+  if (fit.empty()) {
+    throw source.Error(fit_value.path, fit_value.mark,
+                       "lists no sweep; give at least one sweep id to fit");
+  }
+  std::vector<PlacedSelection> validate;
+  if (const auto value = top.Optional("validate")) validate = ReadSweepSelections(*value, source);
+  CheckNoSweepFittedAndValidated(fit, validate, source);
+  config.fit_sweeps = Selections(fit);
+  config.validate_sweeps = Selections(validate);
+
+  IdentificationOptions& identification = config.identification;
+  const ConfigValue initial_guess =
+      top.Required("initial_guess", "give eta_e, mu1, mu2, delta, alpha and omega_hz in a block");
+  identification.initial = ReadInitialGuess(initial_guess, source);
+  if (const auto value = top.Optional("fixed")) identification.fixed = ReadFixed(*value, source);
+  if (const auto value = top.Optional("stages")) identification.stages = ReadStages(*value, source);
+  if (const auto value = top.Optional("residual")) {
+    identification.residual = ReadResidual(*value, source);
+  }
+  const ConfigValue solver = OrAbsent(top.Optional("solver"), "solver");
+  if (solver.node.IsDefined()) identification.solver = ReadSolver(solver, source);
+  std::string message;
+  if (!identification.solver.IsValid(&message)) ThrowInvalidBlock(solver, source, message);
+  if (!identification.IsValid(&message)) ThrowInvalidBlock(initial_guess, source, message);
+
+  const ConfigValue jump_detection = OrAbsent(top.Optional("jump_detection"), "jump_detection");
+  if (jump_detection.node.IsDefined()) {
+    config.jump_detection = ReadJumpDetection(jump_detection, source);
+  }
+  if (!config.jump_detection.IsValid(&message)) {
+    ThrowInvalidBlock(jump_detection, source, message);
+  }
+
+  if (const auto value = top.Optional("effective_nonlinearity_reference_hz")) {
+    const double hz = ReadFiniteDouble(*value, source);
+    if (!(hz > 0.0)) {
+      throw source.Error(value->path, value->mark,
+                         "must be a positive frequency in Hz, got " + value->node.Scalar() +
+                             "; remove the key to use the identified natural frequency");
+    }
+    config.omega_ref_rad_s = HzToRadPerSecond(hz);
+  }
+
+  const ConfigValue output_dir =
+      top.Required("output_dir", "give the directory for the results, e.g. output_dir: out");
+  config.output_dir =
+      ResolvePath(ReadNonEmptyString(output_dir, source), output_dir, source, config_dir).string();
+  return config;
+}
+
+}  // namespace
+
+IdentifyConfig LoadIdentifyConfig(const std::string& path,
+                                  const std::vector<ConfigOverride>& overrides) {
+  ConfigSource source = ConfigSource::Load(path);
+  source.Apply(overrides);
+  const fs::path config_path = fs::absolute(path).lexically_normal();
+  IdentifyConfig config;
+  try {
+    config = ReadIdentifyConfig(source, config_path.parent_path());
+  } catch (const YAML::Exception& e) {
+    // The readers check types before converting; this is a safety net.
+    throw InputError(path, e.mark.is_null() ? 0 : e.mark.line + 1, "", e.what());
+  }
+  config.config_path = config_path.string();
+  config.overrides = overrides;
+  return config;
+}
+
+}  // namespace dwellfit

@@ -1,0 +1,55 @@
+// The configuration of one `identify` run, read from a YAML file (schema and
+// every key documented in config/README.md) plus command-line overrides.
+//
+// Loading is strict: an unknown or repeated key, a value of the wrong type, a
+// missing required key or an invalid value throws InputError naming the file,
+// the 1-based line and the key path, or the flag of the override that set it.
+#ifndef DWELLFIT_CONFIG_IDENTIFY_CONFIG_H_
+#define DWELLFIT_CONFIG_IDENTIFY_CONFIG_H_
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "config/config_override.h"
+#include "config/sweep_selection.h"
+#include "estimator/identification_options.h"
+
+namespace dwellfit {
+
+struct IdentifyConfig {
+  // The config file, absolute.
+  std::string config_path;
+  // Data files, absolute: resolved relative to the config file's directory
+  // (relative to the working directory when an override gave them). Each exists.
+  std::vector<std::string> data_files;
+  // Sweeps fitted; non-empty, no sweep selected twice.
+  std::vector<SweepSelection> fit_sweeps;
+  // Sweeps only predicted and scored; none of them is also fitted.
+  std::vector<SweepSelection> validate_sweeps;
+  // Initial guesses (physical units, omega in rad/s), fixed parameters, fit
+  // stages, residual and solver settings. IsValid() holds.
+  IdentificationOptions identification;
+  JumpDetectionOptions jump_detection;
+  // Omega_ref [rad/s] of the effective nonlinearity alpha - (2/3) delta
+  // Omega_ref^2; unset: the identified omega.
+  std::optional<double> omega_ref_rad_s;
+  // Where results go, absolute (resolved like data_files); may not exist yet.
+  std::string output_dir;
+  // The overrides applied on top of the file, in order.
+  std::vector<ConfigOverride> overrides;
+};
+
+// Reads, overrides and validates the config at `path`. `overrides` are applied
+// to the YAML tree before validation, so they pass the same checks.
+IdentifyConfig LoadIdentifyConfig(const std::string& path,
+                                  const std::vector<ConfigOverride>& overrides = {});
+
+// The config in effect as YAML text that LoadIdentifyConfig accepts again,
+// with comments naming the source file and the overrides (for printing and
+// for result.yaml provenance). Paths are absolute; omega is in Hz.
+std::string ConfigToYaml(const IdentifyConfig& config);
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_CONFIG_IDENTIFY_CONFIG_H_

@@ -1,0 +1,104 @@
+// ConfigToYaml: the config in effect, in the schema LoadIdentifyConfig reads.
+#include <charconv>
+#include <string>
+
+#include "config/identify_config.h"
+#include "yaml-cpp/yaml.h"
+
+namespace dwellfit {
+namespace {
+
+// The shortest text that reads back as exactly `value`.
+std::string ExactNumber(double value) {
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  return std::string(buffer, result.ptr);
+}
+
+// 15 significant digits: recovers the decimal a person typed from a value
+// that went through a unit conversion (Hz -> rad/s -> Hz).
+std::string ConvertedNumber(double value) {
+  char buffer[64];
+  const auto result =
+      std::to_chars(buffer, buffer + sizeof(buffer), value, std::chars_format::general, 15);
+  return std::string(buffer, result.ptr);
+}
+
+void EmitSelections(YAML::Emitter& out, const char* key,
+                    const std::vector<SweepSelection>& selections) {
+  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (const SweepSelection& selection : selections) out << selection.Name();
+  out << YAML::EndSeq;
+}
+
+}  // namespace
+
+std::string ConfigToYaml(const IdentifyConfig& config) {
+  const IdentificationOptions& identification = config.identification;
+  YAML::Emitter out;
+  std::string header = "Configuration in effect, loaded from " + config.config_path;
+  for (const ConfigOverride& applied : config.overrides) {
+    header += "\noverride: " + DescribeOverride(applied);
+  }
+  out << YAML::Comment(header) << YAML::Newline;
+  out << YAML::BeginMap;
+
+  out << YAML::Key << "data" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (const std::string& file : config.data_files) out << file;
+  out << YAML::EndSeq;
+  EmitSelections(out, "fit", config.fit_sweeps);
+  EmitSelections(out, "validate", config.validate_sweeps);
+
+  out << YAML::Key << "initial_guess" << YAML::Value << YAML::BeginMap;
+  for (int i = 0; i < kNumParameters; ++i) {
+    if (i == kOmega) {
+      out << YAML::Key << "omega_hz" << YAML::Value
+          << ConvertedNumber(RadPerSecondToHz(identification.initial[i]))
+          << YAML::Comment(ExactNumber(identification.initial[i]) + " rad/s");
+    } else {
+      out << YAML::Key << ParameterName(i) << YAML::Value << ExactNumber(identification.initial[i]);
+    }
+  }
+  out << YAML::EndMap;
+
+  out << YAML::Key << "fixed" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (int i = 0; i < kNumParameters; ++i) {
+    if (identification.fixed[i]) out << ParameterName(i);
+  }
+  out << YAML::EndSeq;
+  out << YAML::Key << "stages" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (ResidualKind stage : identification.stages) out << ResidualKindName(stage);
+  out << YAML::EndSeq;
+
+  out << YAML::Key << "residual" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "error" << YAML::Value << ErrorMeasureName(identification.residual.error);
+  out << YAML::Key << "use_point_sigma" << YAML::Value << identification.residual.use_point_sigma;
+  out << YAML::EndMap;
+
+  const SolverSettings& solver = identification.solver;
+  out << YAML::Key << "solver" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "max_iterations" << YAML::Value << solver.max_iterations;
+  out << YAML::Key << "function_tolerance" << YAML::Value << ExactNumber(solver.function_tolerance);
+  out << YAML::Key << "gradient_tolerance" << YAML::Value << ExactNumber(solver.gradient_tolerance);
+  out << YAML::Key << "parameter_tolerance" << YAML::Value
+      << ExactNumber(solver.parameter_tolerance);
+  out << YAML::Key << "num_threads" << YAML::Value << solver.num_threads;
+  out << YAML::EndMap;
+
+  out << YAML::Key << "jump_detection" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "min_ratio" << YAML::Value << ExactNumber(config.jump_detection.min_ratio);
+  out << YAML::Key << "min_relative_amplitude" << YAML::Value
+      << ExactNumber(config.jump_detection.min_relative_amplitude);
+  out << YAML::EndMap;
+
+  if (config.omega_ref_rad_s.has_value()) {
+    out << YAML::Key << "effective_nonlinearity_reference_hz" << YAML::Value
+        << ConvertedNumber(RadPerSecondToHz(*config.omega_ref_rad_s))
+        << YAML::Comment(ExactNumber(*config.omega_ref_rad_s) + " rad/s");
+  }  // unset: the identified omega (the key's default)
+  out << YAML::Key << "output_dir" << YAML::Value << config.output_dir;
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+}  // namespace dwellfit

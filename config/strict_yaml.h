@@ -1,0 +1,69 @@
+// Strict reading of a config's YAML tree: every key of a block must be one of
+// the keys the block allows and may appear once; every value must have the
+// type asked for. Every error goes through ConfigSource::Error, so it names
+// the file, the 1-based line and the key path (or the overriding flag).
+#ifndef DWELLFIT_CONFIG_STRICT_YAML_H_
+#define DWELLFIT_CONFIG_STRICT_YAML_H_
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "config/config_source.h"
+#include "yaml-cpp/yaml.h"
+
+namespace dwellfit {
+
+// One value of the config and where it is.
+struct ConfigValue {
+  YAML::Node node;
+  std::string path;  // "solver.max_iterations"; "" for the whole document
+  YAML::Mark mark;   // the key's position (the entry's for list entries)
+};
+
+// The whole document of `source`, as the value to read the top-level block from.
+ConfigValue DocumentValue(const ConfigSource& source);
+
+// A block of keys read strictly. The constructor throws InputError when the
+// value is not a block, a key repeats, or a key is not in `allowed_keys` (the
+// message lists the allowed keys and suggests the nearest one). A block with
+// no value (`solver:` alone) counts as empty.
+class StrictMap {
+ public:
+  StrictMap(const ConfigValue& block, const ConfigSource& source,
+            std::vector<std::string> allowed_keys);
+
+  std::optional<ConfigValue> Optional(const std::string& key) const;
+  // Throws InputError "missing required key" ending with `hint` (what to add).
+  ConfigValue Required(const std::string& key, const std::string& hint) const;
+
+  const ConfigValue& block() const { return block_; }
+
+ private:
+  std::string ChildPath(const std::string& key) const;
+
+  ConfigValue block_;
+  const ConfigSource& source_;
+  std::vector<std::string> allowed_keys_;
+  std::map<std::string, ConfigValue> entries_;
+};
+
+// Typed values; each throws InputError on a value of the wrong type.
+double ReadFiniteDouble(const ConfigValue& value, const ConfigSource& source);
+int ReadInt(const ConfigValue& value, const ConfigSource& source);
+bool ReadBool(const ConfigValue& value, const ConfigSource& source);
+std::string ReadNonEmptyString(const ConfigValue& value, const ConfigSource& source);
+// The entries of a list; a single value counts as a one-entry list. Entries
+// keep the list's path and carry their own position.
+std::vector<ConfigValue> ReadList(const ConfigValue& value, const ConfigSource& source);
+
+// "a, b, c".
+std::string JoinNames(const std::vector<std::string>& names);
+// " (did you mean 'max_iterations'?)" when `word` is a likely typo of one of
+// `candidates`, else "".
+std::string DidYouMean(const std::string& word, const std::vector<std::string>& candidates);
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_CONFIG_STRICT_YAML_H_
