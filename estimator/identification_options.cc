@@ -61,6 +61,59 @@ bool JumpDetectionOptions::IsValid(std::string* error) const {
   return true;
 }
 
+const char* JumpTargetName(JumpTarget target) {
+  switch (target) {
+    case JumpTarget::kFrequencyJumpUp:
+      return "frequency_jump_up";
+    case JumpTarget::kFrequencyJumpDown:
+      return "frequency_jump_down";
+    case JumpTarget::kAmplitudeJumpUp:
+      return "amplitude_jump_up";
+    case JumpTarget::kAmplitudeJumpDown:
+      return "amplitude_jump_down";
+  }
+  return "frequency_jump_down";
+}
+
+bool JumpTargetFromName(const std::string& name, JumpTarget* target) {
+  for (JumpTarget t : {JumpTarget::kFrequencyJumpUp, JumpTarget::kFrequencyJumpDown,
+                       JumpTarget::kAmplitudeJumpUp, JumpTarget::kAmplitudeJumpDown}) {
+    if (name == JumpTargetName(t)) {
+      *target = t;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool BifurcationRangeOptions::IsValid(std::string* error) const {
+  if (exponent < 2 || exponent % 2 != 0) {
+    *error = "penalties.bifurcation_range.exponent must be an even integer >= 2";
+    return false;
+  }
+  if (!(weight >= 0.0) || !std::isfinite(weight)) {
+    *error = "penalties.bifurcation_range.weight must be a non-negative number";
+    return false;
+  }
+  return true;
+}
+
+bool BranchStabilityOptions::IsValid(std::string* error) const {
+  if (!(lambda > 0.0) || !std::isfinite(lambda)) {
+    *error = "penalties.branch_stability.lambda must be a positive number";
+    return false;
+  }
+  if (!(weight >= 0.0) || !std::isfinite(weight)) {
+    *error = "penalties.branch_stability.weight must be a non-negative number";
+    return false;
+  }
+  return true;
+}
+
+bool PenaltyOptions::IsValid(std::string* error) const {
+  return bifurcation_range.IsValid(error) && branch_stability.IsValid(error);
+}
+
 bool IdentificationOptions::IsValid(std::string* error) const {
   for (int i = 0; i < kNumParameters; ++i) {
     if (!std::isfinite(initial[i])) {
@@ -87,7 +140,7 @@ bool IdentificationOptions::IsValid(std::string* error) const {
     *error = "at least one fit stage is required";
     return false;
   }
-  return solver.IsValid(error);
+  return penalties.IsValid(error) && solver.IsValid(error);
 }
 
 }  // namespace dwellfit

@@ -51,6 +51,50 @@ struct JumpDetectionOptions {
   bool IsValid(std::string* error) const;
 };
 
+// The jumps a bifurcation-range penalty can enforce: the sweep kind and
+// which fold (jump-up: the lower branch ends; jump-down: the upper one ends).
+enum class JumpTarget {
+  kFrequencyJumpUp,
+  kFrequencyJumpDown,
+  kAmplitudeJumpUp,
+  kAmplitudeJumpDown,
+};
+const char* JumpTargetName(JumpTarget target);  // "frequency_jump_down", ...
+bool JumpTargetFromName(const std::string& name, JumpTarget* target);
+
+// Eq. (3.17): each enforced measured jump adds the cost
+//   weight ((c_model - c_centre) / c_halfwidth)^exponent
+// where c is the jump's control (Omega [rad/s] or a_base) and c_model the
+// model's fold for that bracket.
+struct BifurcationRangeOptions {
+  bool enabled = false;
+  int exponent = 10;  // n of eq. (3.17): even, >= 2
+  double weight = 1.0;
+  // The chapter enforces the frequency sweep's jump-down and the amplitude
+  // sweep's jump-up.
+  std::vector<JumpTarget> enforce = {JumpTarget::kFrequencyJumpDown,
+                                     JumpTarget::kAmplitudeJumpUp};
+  bool IsValid(std::string* error) const;
+};
+
+// Eq. (3.19): each dwell measured on the upper branch adds the cost
+//   weight exp(Lambda (a_fold - a_i)),
+// a_fold the amplitude where the upper branch ends at the dwell's frequency
+// (mirror for the lower branch: weight exp(Lambda (a_i - a_fold))), with
+// Lambda = lambda / (largest measured amplitude of the sweep).
+struct BranchStabilityOptions {
+  bool enabled = false;
+  double lambda = 50.0;  // dimensionless: Lambda times the sweep's amplitude scale
+  double weight = 1.0;
+  bool IsValid(std::string* error) const;
+};
+
+struct PenaltyOptions {
+  BifurcationRangeOptions bifurcation_range;
+  BranchStabilityOptions branch_stability;
+  bool IsValid(std::string* error) const;
+};
+
 struct IdentificationOptions {
   // Starting point, ParameterIndex order, physical units (omega in rad/s).
   ParameterVector initial = {0, 0, 0, 0, 0, 0};
@@ -59,6 +103,8 @@ struct IdentificationOptions {
   // Fit stages run in order, each starting where the previous one ended.
   std::vector<ResidualKind> stages = {ResidualKind::kAlgebraic, ResidualKind::kVertical};
   ResidualOptions residual;
+  // Soft constraints added to every vertical-error stage.
+  PenaltyOptions penalties;
   SolverSettings solver;
   bool IsValid(std::string* error) const;
 };
