@@ -2,10 +2,13 @@
 // algorithm (section 3.2.4) on a set of fitted sweeps.
 //
 // Stages run in order on the same parameter block, each starting where the
-// previous ended. The default is [algebraic, vertical]: the algebraic residual
-// of eq. (3.11) is smooth and branch-free and so lands near the minimum from a
-// rough start; the vertical error, which respects branches and stability, then
-// converges from there.
+// previous ended. Enabled penalties join every vertical stage, their weights
+// in units of the data's mean squared residual at the stage's start: inside a
+// bracket a penalty costs about as much as one dwell's misfit, outside it
+// grows as u^n or exponentially, so it constrains without overriding what the
+// data determine (on exact data it vanishes). The default is [algebraic, vertical]: the algebraic
+// residual of eq. (3.11) is smooth and branch-free and so lands near the minimum from a rough
+// start; the vertical error, which respects branches and stability, then converges from there.
 #ifndef DWELLFIT_ESTIMATOR_IDENTIFICATION_H_
 #define DWELLFIT_ESTIMATOR_IDENTIFICATION_H_
 
@@ -23,6 +26,12 @@ struct StageSummary {
   ResidualKind residual = ResidualKind::kVertical;
   double initial_cost = 0.0;
   double final_cost = 0.0;
+  double final_data_cost = 0.0;  // final_cost less the penalties
+  // Penalty weights multiply this: the mean squared data residual where the
+  // stage started (0 when the stage had no penalties).
+  double penalty_unit = 0.0;
+  int penalty_exponent = 0;  // n of eq. (3.17) in this stage (0: none)
+  int residual_blocks = 0;   // dwell points fitted
   int iterations = 0;
   bool converged = false;      // the solver met a convergence test
   std::string brief_report;    // ceres::Solver::Summary::BriefReport()

@@ -50,12 +50,20 @@ bool SolverSettings::IsValid(std::string* error) const {
 }
 
 bool JumpDetectionOptions::IsValid(std::string* error) const {
-  if (!(min_ratio > 1.0)) {
+  if (!(min_ratio > 1.0) || !std::isfinite(min_ratio)) {
     *error = "jump_detection.min_ratio must be greater than 1";
     return false;
   }
   if (!(min_relative_amplitude >= 0.0 && min_relative_amplitude <= 1.0)) {
     *error = "jump_detection.min_relative_amplitude must lie in [0, 1]";
+    return false;
+  }
+  if (!(noise_multiple >= 0.0) || !std::isfinite(noise_multiple)) {
+    *error = "jump_detection.noise_multiple must be a non-negative number (0: no noise test)";
+    return false;
+  }
+  if (min_candidate_steps < 1) {
+    *error = "jump_detection.min_candidate_steps must be at least 1";
     return false;
   }
   return true;

@@ -40,14 +40,22 @@ struct SolverSettings {
   bool IsValid(std::string* error) const;
 };
 
-// Jump detection in measured sweeps (issue: brackets and branch labels).
+// Jump detection in measured sweeps (estimator/jump_detection.h has the test
+// and the numbers behind these defaults).
 struct JumpDetectionOptions {
-  // A jump is a step between consecutive dwells whose amplitude ratio exceeds
-  // this (either way).
-  double min_ratio = 2.0;
-  // ... and whose larger side exceeds this fraction of the sweep's largest
-  // amplitude (ignores hops in the noise floor far from resonance).
+  // A jump's step between consecutive dwells must change the amplitude by
+  // more than this ratio, either way (in an amplitude sweep: beyond the
+  // sweep's power-law trend in a_base) ...
+  double min_ratio = 1.07;
+  // ... its larger side must reach this fraction of the sweep's largest
+  // amplitude (ignores hops in the noise floor far from resonance) ...
   double min_relative_amplitude = 0.2;
+  // ... and its log ratio must exceed this many robust standard deviations
+  // of the sweep's steps (0: no noise test).
+  double noise_multiple = 6.0;
+  // Sweeps with fewer candidate steps (above the amplitude gate) get no
+  // detected jump: too few steps to tell a jump from noise.
+  int min_candidate_steps = 5;
   bool IsValid(std::string* error) const;
 };
 
@@ -63,7 +71,8 @@ const char* JumpTargetName(JumpTarget target);  // "frequency_jump_down", ...
 bool JumpTargetFromName(const std::string& name, JumpTarget* target);
 
 // Eq. (3.17): each enforced measured jump adds the cost
-//   weight ((c_model - c_centre) / c_halfwidth)^exponent
+//   weight s^2 ((c_model - c_centre) / c_halfwidth)^exponent
+// (s^2: the data's mean squared residual where the fit stage starts)
 // where c is the jump's control (Omega [rad/s] or a_base) and c_model the
 // model's fold for that bracket.
 struct BifurcationRangeOptions {
@@ -72,13 +81,12 @@ struct BifurcationRangeOptions {
   double weight = 1.0;
   // The chapter enforces the frequency sweep's jump-down and the amplitude
   // sweep's jump-up.
-  std::vector<JumpTarget> enforce = {JumpTarget::kFrequencyJumpDown,
-                                     JumpTarget::kAmplitudeJumpUp};
+  std::vector<JumpTarget> enforce = {JumpTarget::kFrequencyJumpDown, JumpTarget::kAmplitudeJumpUp};
   bool IsValid(std::string* error) const;
 };
 
 // Eq. (3.19): each dwell measured on the upper branch adds the cost
-//   weight exp(Lambda (a_fold - a_i)),
+//   weight s^2 exp(Lambda (a_fold - a_i)),
 // a_fold the amplitude where the upper branch ends at the dwell's frequency
 // (mirror for the lower branch: weight exp(Lambda (a_i - a_fold))), with
 // Lambda = lambda / (largest measured amplitude of the sweep).

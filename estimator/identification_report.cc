@@ -75,6 +75,11 @@ std::string ReportToYaml(const IdentificationReport& report) {
     out << YAML::Key << "residual" << YAML::Value << ResidualKindName(stage.residual);
     out << YAML::Key << "initial_cost" << YAML::Value << stage.initial_cost;
     out << YAML::Key << "final_cost" << YAML::Value << stage.final_cost;
+    out << YAML::Key << "final_data_cost" << YAML::Value << stage.final_data_cost;
+    if (stage.penalty_unit > 0.0) {
+      out << YAML::Key << "penalty_unit" << YAML::Value << stage.penalty_unit;
+      out << YAML::Key << "penalty_exponent" << YAML::Value << stage.penalty_exponent;
+    }
     out << YAML::Key << "iterations" << YAML::Value << stage.iterations;
     out << YAML::Key << "converged" << YAML::Value << stage.converged;
     out << YAML::Key << "solver" << YAML::Value << stage.brief_report;
@@ -92,14 +97,25 @@ std::string ReportToYaml(const IdentificationReport& report) {
     out << YAML::Key << "rms_error" << YAML::Value << prediction.rms_error;
     out << YAML::Key << "relative_rms_error" << YAML::Value << prediction.relative_rms_error;
     out << YAML::Key << "points_off_branch" << YAML::Value << prediction.points_off_branch;
-    out << YAML::Key << "measured_jumps" << YAML::Value << YAML::BeginSeq;
-    for (const JumpBracket& jump : sweep.jumps) {
+    // Measured jump brackets beside the model's jumps (Hz or a_base).
+    out << YAML::Key << "jumps" << YAML::Value << YAML::BeginSeq;
+    const bool frequency = sweep.kind == SweepKind::kFrequency;
+    for (const PredictedJump& jump : prediction.jumps) {
       out << YAML::Flow << YAML::BeginMap;
       out << YAML::Key << "kind" << YAML::Value << JumpKindName(jump.kind);
-      out << YAML::Key << (sweep.kind == SweepKind::kFrequency ? "between_hz" : "between_a_base")
-          << YAML::Value << YAML::Flow << YAML::BeginSeq
-          << ControlInFileUnit(sweep, jump.control_before)
-          << ControlInFileUnit(sweep, jump.control_after) << YAML::EndSeq;
+      if (jump.measured) {
+        out << YAML::Key << (frequency ? "measured_between_hz" : "measured_between_a_base")
+            << YAML::Value << YAML::Flow << YAML::BeginSeq
+            << ControlInFileUnit(sweep, jump.bracket.control_before)
+            << ControlInFileUnit(sweep, jump.bracket.control_after) << YAML::EndSeq;
+      }
+      out << YAML::Key << (frequency ? "model_hz" : "model_a_base") << YAML::Value;
+      if (jump.exists) {
+        out << ControlInFileUnit(sweep, jump.control);
+      } else {
+        out << YAML::Null;
+      }
+      if (jump.measured) out << YAML::Key << "inside" << YAML::Value << jump.inside;
       out << YAML::EndMap;
     }
     out << YAML::EndSeq;
@@ -133,7 +149,9 @@ std::string ReportToPredictionsCsv(const IdentificationReport& report) {
 void PrintReport(const IdentificationReport& report, std::ostream& out) {
   const IdentificationResult& result = report.result;
   for (const StageSummary& stage : result.stages) {
-    out << ResidualKindName(stage.residual) << " stage: " << stage.brief_report << "\n";
+    out << ResidualKindName(stage.residual);
+    if (stage.penalty_unit > 0.0) out << " + penalties (exponent " << stage.penalty_exponent << ")";
+    out << " stage: " << stage.brief_report << "\n";
   }
   char line[256];
   out << "\n";
@@ -166,6 +184,29 @@ void PrintReport(const IdentificationReport& report, std::ostream& out) {
                   prediction.sweep->points.size(), prediction.rms_error,
                   prediction.relative_rms_error, prediction.points_off_branch);
     out << line;
+  }
+  out << "\njumps (measured bracket -> model)\n";
+  for (const SweepPrediction& prediction : report.predictions) {
+    const Sweep& sweep = *prediction.sweep;
+    const char* unit = sweep.kind == SweepKind::kFrequency ? " Hz" : "";
+    for (const PredictedJump& jump : prediction.jumps) {
+      std::string measured = "not measured";
+      if (jump.measured) {
+        std::snprintf(line, sizeof(line), "%.6g..%.6g%s",
+                      ControlInFileUnit(sweep, jump.bracket.control_before),
+                      ControlInFileUnit(sweep, jump.bracket.control_after), unit);
+        measured = line;
+      }
+      std::string model = "no fold";
+      if (jump.exists) {
+        std::snprintf(line, sizeof(line), "%.6g%s%s", ControlInFileUnit(sweep, jump.control), unit,
+                      jump.measured ? (jump.inside ? " (inside)" : " (outside)") : "");
+        model = line;
+      }
+      std::snprintf(line, sizeof(line), "%-20s %-10s %-30s %s\n", sweep.Name().c_str(),
+                    JumpKindName(jump.kind), measured.c_str(), model.c_str());
+      out << line;
+    }
   }
 }
 

@@ -6,6 +6,8 @@
 #include "estimator/scaled_subset_manifold.h"
 #include "glog/logging.h"
 #include "residuals/algebraic_residual.h"
+#include "residuals/bifurcation_range_penalty.h"
+#include "residuals/branch_stability_penalty.h"
 #include "residuals/vertical_error_residual.h"
 
 namespace dwellfit {
@@ -50,6 +52,59 @@ int ProblemBuilder::AddSweep(const Sweep& sweep, double* parameters,
     problem->AddResidualBlock(MakeResidual(point), nullptr, parameters);
   }
   return static_cast<int>(sweep.points.size());
+}
+
+JumpTarget TargetOf(const Sweep& sweep, const JumpBracket& jump) {
+  const bool up = jump.kind == JumpKind::kJumpUp;
+  if (sweep.kind == SweepKind::kFrequency) {
+    return up ? JumpTarget::kFrequencyJumpUp : JumpTarget::kFrequencyJumpDown;
+  }
+  return up ? JumpTarget::kAmplitudeJumpUp : JumpTarget::kAmplitudeJumpDown;
+}
+
+ceres::CostFunction* MakeBifurcationRangePenalty(const Sweep& sweep, const JumpBracket& jump,
+                                                 const BifurcationRangeOptions& options) {
+  const DwellPoint& before = sweep.points[jump.index_before];
+  const bool frequency = sweep.kind == SweepKind::kFrequency;
+  // A jump-up ends the lower branch, a jump-down the upper one; the dwell
+  // before the jump sits on the branch that ends.
+  return BifurcationRangePenalty::Create(
+      frequency ? ControlKind::kDriveFrequency : ControlKind::kBaseLevel,
+      jump.kind == JumpKind::kJumpUp ? FoldKind::kLowerBranchEnd : FoldKind::kUpperBranchEnd,
+      frequency ? before.a_base : before.drive_frequency_rad_s, jump.control_before,
+      jump.control_after, jump.amplitude_before, options.exponent, options.weight);
+}
+
+int ProblemBuilder::AddPenalties(const Sweep& sweep, double* parameters,
+                                 ceres::Problem* problem) const {
+  int blocks = 0;
+  const BifurcationRangeOptions& range = options_.penalties.bifurcation_range;
+  if (range.enabled) {
+    for (const JumpBracket& jump : sweep.jumps) {
+      const JumpTarget target = TargetOf(sweep, jump);
+      if (std::find(range.enforce.begin(), range.enforce.end(), target) == range.enforce.end()) {
+        continue;
+      }
+      problem->AddResidualBlock(MakeBifurcationRangePenalty(sweep, jump, range), nullptr,
+                                parameters);
+      ++blocks;
+    }
+  }
+  const BranchStabilityOptions& stability = options_.penalties.branch_stability;
+  if (stability.enabled && !sweep.points.empty()) {
+    double largest = 0.0;
+    for (const DwellPoint& point : sweep.points) largest = std::max(largest, point.amplitude);
+    const double lambda = stability.lambda / largest;  // [1/amplitude]
+    for (const DwellPoint& point : sweep.points) {
+      if (point.branch == Branch::kOnly) continue;
+      problem->AddResidualBlock(
+          BranchStabilityPenalty::Create(point.drive_frequency_rad_s, point.amplitude, point.branch,
+                                         lambda, stability.weight),
+          nullptr, parameters);
+      ++blocks;
+    }
+  }
+  return blocks;
 }
 
 void ProblemBuilder::ConfigureParameters(double* parameters, ceres::Problem* problem) const {

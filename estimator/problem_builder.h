@@ -37,6 +37,8 @@ struct ProblemBuilderOptions {
   // invariant under (mu1, mu2) -> -(mu1, mu2), so a stage on it may run
   // unbounded and reflect its result (ReflectDampingIntoPhysicalRange).
   bool bound_damping = true;
+  // Soft constraints of eqs. (3.17) and (3.19); AddPenalties adds them.
+  PenaltyOptions penalties;
   bool IsValid(std::string* error) const;
 };
 
@@ -48,6 +50,11 @@ class ProblemBuilder {
   // block `parameters` (owned by the caller, must outlive `problem`).
   // Returns the number of residual blocks added.
   int AddSweep(const Sweep& sweep, double* parameters, ceres::Problem* problem) const;
+
+  // Adds the enabled penalties for `sweep`: one BifurcationRangePenalty per
+  // measured jump whose target is enforced, one BranchStabilityPenalty per
+  // dwell labelled lower or upper. Returns the number of blocks added.
+  int AddPenalties(const Sweep& sweep, double* parameters, ceres::Problem* problem) const;
 
   // Sets bounds (eta_e >= 0; mu1, mu2 >= 0 unless !bound_damping), fixed parameters and scaling on
   // the block. Call once, after the block has residuals in `problem`.
@@ -68,6 +75,14 @@ class ProblemBuilder {
 // positive; a damping left negative after that (mixed signs: no physical twin)
 // is set to 0. Returns whether anything changed.
 bool ReflectDampingIntoPhysicalRange(ParameterVector* parameters);
+
+// Which enforceable target a measured jump of `sweep` is.
+JumpTarget TargetOf(const Sweep& sweep, const JumpBracket& jump);
+
+// The bifurcation-range penalty of one measured jump (eq. 3.17), owned by the
+// caller; Ceres takes it.
+ceres::CostFunction* MakeBifurcationRangePenalty(const Sweep& sweep, const JumpBracket& jump,
+                                                 const BifurcationRangeOptions& options);
 
 }  // namespace dwellfit
 

@@ -11,9 +11,12 @@
 #ifndef DWELLFIT_RESIDUALS_ALGEBRAIC_RESIDUAL_H_
 #define DWELLFIT_RESIDUALS_ALGEBRAIC_RESIDUAL_H_
 
+#include <cmath>
+
 #include "ceres/autodiff_cost_function.h"
 #include "residuals/model_parameters.h"
 #include "residuals/response_model.h"
+#include "residuals/stable_root.h"
 
 namespace dwellfit {
 
@@ -29,7 +32,8 @@ class AlgebraicResidual {
   bool operator()(const T* const parameters, T* residual) const {
     const auto k = ResponseCoefficients<T>::FromParameters(parameters, drive_frequency_rad_s_);
     residual[0] = weight_ * (k.G(T(a_measured_)) - a_base_squared_) / a_base_squared_;
-    return true;
+    // Undefined evaluation: a trial step where G overflows (eta_e -> 0).
+    return std::isfinite(ScalarPart(residual[0]));
   }
 
   static ceres::CostFunction* Create(double drive_frequency_rad_s, double a_base, double a_measured,

@@ -63,7 +63,8 @@ class VerticalErrorResidual {
       if (!(ScalarPart(a_model) > 0.0)) return false;  // log undefined
       residual[0] = weight_ * (std::log(a_measured_) - log(a_model));
     }
-    return true;
+    // Undefined evaluation: a root that overflowed at an extreme trial step.
+    return std::isfinite(ScalarPart(residual[0]));
   }
 
   static ceres::CostFunction* Create(double drive_frequency_rad_s, double a_base, double a_measured,

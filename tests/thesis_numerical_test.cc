@@ -67,6 +67,30 @@ TEST_F(ThesisNumerical, BothStartsRecoverTheTruthAndPredictTheValidationSweeps) 
   }
 }
 
+TEST_F(ThesisNumerical,
+       WithPenaltiesEveryFittedJumpIsInsideItsBracketAndEstimatesWithinOnePercent) {
+  for (const std::vector<double>& factors : {std::vector<double>{1.3, 0.7, 1.3, 0.7, 1.3},
+                                             std::vector<double>{0.7, 1.3, 0.7, 1.3, 0.7}}) {
+    IdentificationOptions options = StartAt(factors);
+    options.penalties.bifurcation_range.enabled = true;
+    options.penalties.branch_stability.enabled = true;
+    const IdentificationResult result = Identify(fitted_, options);
+    EXPECT_TRUE(result.converged);
+    for (int i = 0; i < 5; ++i) {
+      EXPECT_NEAR(result.parameters[i] / kTruth[i], 1.0, 0.01) << ParameterName(i);
+    }
+    int jumps = 0;
+    for (const Sweep* sweep : fitted_) {
+      for (const PredictedJump& jump : PredictJumps(result.parameters, *sweep)) {
+        ASSERT_TRUE(jump.measured);
+        EXPECT_TRUE(jump.inside) << sweep->Name() << " " << JumpKindName(jump.kind);
+        ++jumps;
+      }
+    }
+    EXPECT_EQ(jumps, 4);
+  }
+}
+
 TEST_F(ThesisNumerical, VerticalErrorAloneFromTheFirstStartEndsAtAWrongMinimum) {
   // Why the default runs the algebraic stage first: without it, the damping
   // collapses (the observation, kept as a regression guard).
