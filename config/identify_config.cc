@@ -1,8 +1,11 @@
 #include "config/identify_config.h"
 
+#include <algorithm>
 #include <array>
 #include <filesystem>
+#include <optional>
 #include <system_error>
+#include <utility>
 
 #include "config/config_source.h"
 #include "config/strict_yaml.h"
@@ -203,7 +206,7 @@ std::vector<ResidualKind> ReadStages(const ConfigValue& value, const ConfigSourc
 }
 
 ResidualOptions ReadResidual(const ConfigValue& value, const ConfigSource& source) {
-  const StrictMap block(value, source, {"error", "use_point_sigma"});
+  const StrictMap block(value, source, {"error", "use_point_sigma", "amplitude_floor"});
   ResidualOptions residual;
   if (const auto error = block.Optional("error")) {
     const std::string name = ReadNonEmptyString(*error, source);
@@ -218,13 +221,20 @@ ResidualOptions ReadResidual(const ConfigValue& value, const ConfigSource& sourc
   if (const auto use_point_sigma = block.Optional("use_point_sigma")) {
     residual.use_point_sigma = ReadBool(*use_point_sigma, source);
   }
+  if (const auto floor = block.Optional("amplitude_floor")) {
+    residual.amplitude_floor = ReadFiniteDouble(*floor, source);
+    if (residual.amplitude_floor < 0.0) {
+      throw source.Error(floor->path, floor->mark,
+                         "must be >= 0 (the noise floor of the measured amplitude, in its unit)");
+    }
+  }
   return residual;
 }
 
 SolverSettings ReadSolver(const ConfigValue& value, const ConfigSource& source) {
   const StrictMap block(value, source,
                         {"max_iterations", "function_tolerance", "gradient_tolerance",
-                         "parameter_tolerance", "num_threads"});
+                         "parameter_tolerance", "num_threads", "nonmonotonic_steps"});
   SolverSettings solver;
   if (const auto v = block.Optional("max_iterations")) solver.max_iterations = ReadInt(*v, source);
   if (const auto v = block.Optional("function_tolerance")) {
@@ -236,12 +246,17 @@ SolverSettings ReadSolver(const ConfigValue& value, const ConfigSource& source) 
   if (const auto v = block.Optional("parameter_tolerance")) {
     solver.parameter_tolerance = ReadFiniteDouble(*v, source);
   }
+  if (const auto v = block.Optional("nonmonotonic_steps")) {
+    solver.nonmonotonic_steps = ReadBool(*v, source);
+  }
   if (const auto v = block.Optional("num_threads")) solver.num_threads = ReadInt(*v, source);
   return solver;
 }
 
 JumpDetectionOptions ReadJumpDetection(const ConfigValue& value, const ConfigSource& source) {
-  const StrictMap block(value, source, {"min_ratio", "min_relative_amplitude"});
+  const StrictMap block(
+      value, source,
+      {"min_ratio", "min_relative_amplitude", "noise_multiple", "min_candidate_steps"});
   JumpDetectionOptions jump_detection;
   if (const auto v = block.Optional("min_ratio")) {
     jump_detection.min_ratio = ReadFiniteDouble(*v, source);
@@ -249,7 +264,188 @@ JumpDetectionOptions ReadJumpDetection(const ConfigValue& value, const ConfigSou
   if (const auto v = block.Optional("min_relative_amplitude")) {
     jump_detection.min_relative_amplitude = ReadFiniteDouble(*v, source);
   }
+  if (const auto v = block.Optional("noise_multiple")) {
+    jump_detection.noise_multiple = ReadFiniteDouble(*v, source);
+  }
+  if (const auto v = block.Optional("min_candidate_steps")) {
+    jump_detection.min_candidate_steps = ReadInt(*v, source);
+  }
   return jump_detection;
+}
+
+// One jump override's bracket: two positive, different numbers.
+std::pair<double, double> ReadBracket(const ConfigValue& value, const ConfigSource& source) {
+  const std::vector<ConfigValue> ends = ReadList(value, source);
+  if (ends.size() != 2 || !value.node.IsSequence()) {
+    throw source.Error(value.path, value.mark,
+                       "expected two values, [before, after] in measurement order, got " +
+                           std::to_string(value.node.IsSequence() ? ends.size() : 1));
+  }
+  const double before = ReadFiniteDouble(ends[0], source);
+  const double after = ReadFiniteDouble(ends[1], source);
+  if (!(before > 0.0) || !(after > 0.0)) {
+    throw source.Error(value.path, value.mark, "the bracket's values must be positive");
+  }
+  if (before == after) {
+    throw source.Error(value.path, value.mark,
+                       "the bracket's two values are equal; give the controls of the last dwell "
+                       "before the jump and the first after it");
+  }
+  return {before, after};
+}
+
+// The last key of a key path: "between_hz" of "jumps[0].between_hz".
+std::string LastKey(const std::string& path) { return path.substr(path.rfind('.') + 1); }
+
+// The `sweep` of a jump entry: one direction of one sweep.
+std::string ReadJumpSweep(const StrictMap& block, const ConfigSource& source) {
+  const ConfigValue sweep =
+      block.Required("sweep", "name the sweep and one direction, e.g. sweep: L0.060g/down");
+  SweepSelection selection;
+  std::string error;
+  if (!ParseSweepSelection(ReadNonEmptyString(sweep, source), &selection, &error)) {
+    throw source.Error(sweep.path, sweep.mark, error);
+  }
+  if (!selection.direction.has_value()) {
+    const std::string& id = selection.sweep_id;
+    throw source.Error(sweep.path, sweep.mark,
+                       "'" + id + "' names both directions; a jump belongs to one: write '" + id +
+                           "/up' or '" + id + "/down'");
+  }
+  return selection.Name();
+}
+
+JumpKind ReadJumpKind(const ConfigValue& value, const ConfigSource& source) {
+  const std::string name = ReadNonEmptyString(value, source);
+  for (JumpKind kind : {JumpKind::kJumpUp, JumpKind::kJumpDown}) {
+    if (name == JumpKindName(kind)) return kind;
+  }
+  const std::vector<std::string> allowed = {JumpKindName(JumpKind::kJumpUp),
+                                            JumpKindName(JumpKind::kJumpDown)};
+  throw source.Error(value.path, value.mark,
+                     "unknown jump kind '" + name + "'" + DidYouMean(name, allowed) +
+                         "; allowed: " + JoinNames(allowed));
+}
+
+// One entry of `jumps`: a sweep and exactly one of between_hz, between_a_base
+// (each with a kind) or none: true.
+JumpOverride ReadJumpOverride(const ConfigValue& entry, const ConfigSource& source) {
+  const StrictMap block(entry, source, {"sweep", "kind", "between_hz", "between_a_base", "none"});
+  JumpOverride jump;
+  jump.field = entry.path;
+  const bool from_file = source.OverrideFor(entry.path) == nullptr && !entry.mark.is_null();
+  jump.line = from_file ? entry.mark.line + 1 : 0;
+  jump.sweep = ReadJumpSweep(block, source);
+
+  std::optional<ConfigValue> statement;
+  for (const char* key : {"between_hz", "between_a_base", "none"}) {
+    const std::optional<ConfigValue> value = block.Optional(key);
+    if (!value.has_value()) continue;
+    if (statement.has_value()) {
+      throw source.Error(value->path, value->mark,
+                         "give exactly one of between_hz, between_a_base and none (this entry "
+                         "also has '" +
+                             LastKey(statement->path) + "')");
+    }
+    statement = value;
+  }
+  if (!statement.has_value()) {
+    throw source.Error(entry.path, entry.mark,
+                       "give exactly one of between_hz: [before, after] (frequency sweep), "
+                       "between_a_base: [before, after] (amplitude sweep) or none: true");
+  }
+  const std::optional<ConfigValue> kind = block.Optional("kind");
+  const std::string key = LastKey(statement->path);
+  if (key == "none") {
+    if (!ReadBool(*statement, source)) {
+      throw source.Error(statement->path, statement->mark,
+                         "none: false states nothing; write none: true for a sweep without a "
+                         "jump, or give kind and between_hz (or between_a_base)");
+    }
+    if (kind.has_value()) {
+      throw source.Error(kind->path, kind->mark,
+                         "a sweep with none: true has no jump, so no kind; remove one of them");
+    }
+    jump.none = true;
+    return jump;
+  }
+
+  if (!kind.has_value()) {
+    throw source.Error(
+        entry.path + ".kind", entry.mark,
+        "missing required key 'kind' in '" + entry.path + "'; give jump_up or jump_down");
+  }
+  jump.kind = ReadJumpKind(*kind, source);
+  const auto [before, after] = ReadBracket(*statement, source);
+  const bool frequency = key == "between_hz";
+  jump.control = frequency ? SweepKind::kFrequency : SweepKind::kAmplitude;
+  jump.control_before = frequency ? HzToRadPerSecond(before) : before;
+  jump.control_after = frequency ? HzToRadPerSecond(after) : after;
+  return jump;
+}
+
+// The `jumps` list: at most one entry per sweep.
+std::vector<JumpOverride> ReadJumpOverrides(const ConfigValue& value, const ConfigSource& source) {
+  std::vector<JumpOverride> jumps;
+  std::vector<ConfigValue> places;
+  const std::vector<ConfigValue> entries = ReadList(value, source);
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const ConfigValue entry{entries[i].node, value.path + "[" + std::to_string(i) + "]",
+                            entries[i].mark};
+    JumpOverride jump = ReadJumpOverride(entry, source);
+    for (std::size_t j = 0; j < jumps.size(); ++j) {
+      if (jumps[j].sweep == jump.sweep) {
+        throw source.Error(entry.path, entry.mark,
+                           "sweep '" + jump.sweep + "' has a jump entry already (at " +
+                               source.Where(places[j].path, places[j].mark) + "); keep one");
+      }
+    }
+    jumps.push_back(jump);
+    places.push_back(entry);
+  }
+  return jumps;
+}
+
+std::vector<JumpTarget> ReadJumpTargets(const ConfigValue& value, const ConfigSource& source) {
+  std::vector<std::string> allowed;
+  for (JumpTarget target : {JumpTarget::kFrequencyJumpUp, JumpTarget::kFrequencyJumpDown,
+                            JumpTarget::kAmplitudeJumpUp, JumpTarget::kAmplitudeJumpDown}) {
+    allowed.push_back(JumpTargetName(target));
+  }
+  std::vector<JumpTarget> targets;
+  for (const ConfigValue& entry : ReadList(value, source)) {
+    const std::string name = ReadNonEmptyString(entry, source);
+    JumpTarget target;
+    if (!JumpTargetFromName(name, &target)) {
+      throw source.Error(entry.path, entry.mark,
+                         "unknown jump '" + name + "'" + DidYouMean(name, allowed) +
+                             "; allowed: " + JoinNames(allowed));
+    }
+    if (std::find(targets.begin(), targets.end(), target) != targets.end()) {
+      throw source.Error(entry.path, entry.mark, "jump '" + name + "' is listed twice; keep one");
+    }
+    targets.push_back(target);
+  }
+  return targets;
+}
+
+BifurcationRangeOptions ReadBifurcationRange(const ConfigValue& value, const ConfigSource& source) {
+  const StrictMap block(value, source, {"enabled", "exponent", "weight", "enforce"});
+  BifurcationRangeOptions range;
+  if (const auto v = block.Optional("enabled")) range.enabled = ReadBool(*v, source);
+  if (const auto v = block.Optional("exponent")) range.exponent = ReadInt(*v, source);
+  if (const auto v = block.Optional("weight")) range.weight = ReadFiniteDouble(*v, source);
+  if (const auto v = block.Optional("enforce")) range.enforce = ReadJumpTargets(*v, source);
+  return range;
+}
+
+BranchStabilityOptions ReadBranchStability(const ConfigValue& value, const ConfigSource& source) {
+  const StrictMap block(value, source, {"enabled", "lambda", "weight"});
+  BranchStabilityOptions stability;
+  if (const auto v = block.Optional("enabled")) stability.enabled = ReadBool(*v, source);
+  if (const auto v = block.Optional("lambda")) stability.lambda = ReadFiniteDouble(*v, source);
+  if (const auto v = block.Optional("weight")) stability.weight = ReadFiniteDouble(*v, source);
+  return stability;
 }
 
 // Throws the `IsValid` message of an options struct read from `block`, at the
@@ -269,11 +465,33 @@ ConfigValue OrAbsent(const std::optional<ConfigValue>& value, const std::string&
   return value.has_value() ? *value : ConfigValue{YAML::Node(), path, YAML::Mark::null_mark()};
 }
 
+// The `penalties` block; each sub-block's IsValid is reported at its line.
+PenaltyOptions ReadPenalties(const ConfigValue& value, const ConfigSource& source) {
+  const StrictMap block(value, source, {"bifurcation_range", "branch_stability"});
+  PenaltyOptions penalties;
+  std::string message;
+  const ConfigValue range =
+      OrAbsent(block.Optional("bifurcation_range"), value.path + ".bifurcation_range");
+  if (range.node.IsDefined()) penalties.bifurcation_range = ReadBifurcationRange(range, source);
+  if (!penalties.bifurcation_range.IsValid(&message)) {
+    ThrowInvalidBlock(range.node.IsDefined() ? range : value, source, message);
+  }
+  const ConfigValue stability =
+      OrAbsent(block.Optional("branch_stability"), value.path + ".branch_stability");
+  if (stability.node.IsDefined()) {
+    penalties.branch_stability = ReadBranchStability(stability, source);
+  }
+  if (!penalties.branch_stability.IsValid(&message)) {
+    ThrowInvalidBlock(stability.node.IsDefined() ? stability : value, source, message);
+  }
+  return penalties;
+}
+
 IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& config_dir) {
-  const StrictMap top(
-      DocumentValue(source), source,
-      {"data", "fit", "validate", "initial_guess", "fixed", "stages", "residual", "solver",
-       "jump_detection", "effective_nonlinearity_reference_hz", "output_dir"});
+  const StrictMap top(DocumentValue(source), source,
+                      {"data", "fit", "validate", "initial_guess", "fixed", "stages", "residual",
+                       "solver", "penalties", "jump_detection", "jumps",
+                       "effective_nonlinearity_reference_hz", "output_dir"});
   IdentifyConfig config;
   config.data_files =
       ReadDataFiles(top.Required("data", "give the CSV file with the sweeps (or a list of files)"),
@@ -305,6 +523,9 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
   if (solver.node.IsDefined()) identification.solver = ReadSolver(solver, source);
   std::string message;
   if (!identification.solver.IsValid(&message)) ThrowInvalidBlock(solver, source, message);
+  if (const auto value = top.Optional("penalties")) {
+    identification.penalties = ReadPenalties(*value, source);
+  }
   if (!identification.IsValid(&message)) ThrowInvalidBlock(initial_guess, source, message);
 
   const ConfigValue jump_detection = OrAbsent(top.Optional("jump_detection"), "jump_detection");
@@ -313,6 +534,9 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
   }
   if (!config.jump_detection.IsValid(&message)) {
     ThrowInvalidBlock(jump_detection, source, message);
+  }
+  if (const auto value = top.Optional("jumps")) {
+    config.jump_overrides = ReadJumpOverrides(*value, source);
   }
 
   if (const auto value = top.Optional("effective_nonlinearity_reference_hz")) {

@@ -14,6 +14,7 @@
 #include "config/config_override.h"
 #include "config/sweep_selection.h"
 #include "estimator/identification_options.h"
+#include "estimator/jump_detection.h"
 
 namespace dwellfit {
 
@@ -28,9 +29,13 @@ struct IdentifyConfig {
   // Sweeps only predicted and scored; none of them is also fitted.
   std::vector<SweepSelection> validate_sweeps;
   // Initial guesses (physical units, omega in rad/s), fixed parameters, fit
-  // stages, residual and solver settings. IsValid() holds.
+  // stages, residual, penalty and solver settings. IsValid() holds.
   IdentificationOptions identification;
   JumpDetectionOptions jump_detection;
+  // Jumps stated per sweep (`jumps:`), applied after detection
+  // (ApplyJumpOverrides); frequencies in rad/s, one entry per sweep at most.
+  // Whether each names a sweep of the data is checked when the data is read.
+  std::vector<JumpOverride> jump_overrides;
   // Omega_ref [rad/s] of the effective nonlinearity alpha - (2/3) delta
   // Omega_ref^2; unset: the identified omega.
   std::optional<double> omega_ref_rad_s;

@@ -1,6 +1,7 @@
 // ConfigToYaml: the config in effect, in the schema LoadIdentifyConfig reads.
 #include <charconv>
 #include <string>
+#include <vector>
 
 #include "config/identify_config.h"
 #include "yaml-cpp/yaml.h"
@@ -28,6 +29,61 @@ void EmitSelections(YAML::Emitter& out, const char* key,
                     const std::vector<SweepSelection>& selections) {
   out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
   for (const SweepSelection& selection : selections) out << selection.Name();
+  out << YAML::EndSeq;
+}
+
+void EmitPenalties(YAML::Emitter& out, const PenaltyOptions& penalties) {
+  const BifurcationRangeOptions& range = penalties.bifurcation_range;
+  out << YAML::Key << "penalties" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "bifurcation_range" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "enabled" << YAML::Value << range.enabled;
+  out << YAML::Key << "exponent" << YAML::Value << range.exponent;
+  out << YAML::Key << "weight" << YAML::Value << ExactNumber(range.weight);
+  out << YAML::Key << "enforce" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (JumpTarget target : range.enforce) out << JumpTargetName(target);
+  out << YAML::EndSeq;
+  out << YAML::EndMap;
+  const BranchStabilityOptions& stability = penalties.branch_stability;
+  out << YAML::Key << "branch_stability" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "enabled" << YAML::Value << stability.enabled;
+  out << YAML::Key << "lambda" << YAML::Value << ExactNumber(stability.lambda);
+  out << YAML::Key << "weight" << YAML::Value << ExactNumber(stability.weight);
+  out << YAML::EndMap;
+  out << YAML::EndMap;
+}
+
+// Brackets in the config's units: Hz (with rad/s as a comment) or a_base.
+void EmitJumpOverrides(YAML::Emitter& out, const std::vector<JumpOverride>& jumps) {
+  out << YAML::Key << "jumps" << YAML::Value;
+  if (jumps.empty()) {
+    out << YAML::Flow << YAML::BeginSeq << YAML::EndSeq;
+    return;
+  }
+  out << YAML::BeginSeq;
+  for (const JumpOverride& jump : jumps) {
+    out << YAML::BeginMap;
+    out << YAML::Key << "sweep" << YAML::Value << jump.sweep;
+    if (jump.none) {
+      out << YAML::Key << "none" << YAML::Value << true;
+    } else {
+      out << YAML::Key << "kind" << YAML::Value << JumpKindName(jump.kind);
+      const bool frequency = jump.control == SweepKind::kFrequency;
+      out << YAML::Key << (frequency ? "between_hz" : "between_a_base") << YAML::Value << YAML::Flow
+          << YAML::BeginSeq;
+      if (frequency) {
+        out << ConvertedNumber(RadPerSecondToHz(jump.control_before))
+            << ConvertedNumber(RadPerSecondToHz(jump.control_after));
+      } else {
+        out << ExactNumber(jump.control_before) << ExactNumber(jump.control_after);
+      }
+      out << YAML::EndSeq;
+      if (frequency) {
+        out << YAML::Comment(ExactNumber(jump.control_before) + ", " +
+                             ExactNumber(jump.control_after) + " rad/s");
+      }
+    }
+    out << YAML::EndMap;
+  }
   out << YAML::EndSeq;
 }
 
@@ -73,6 +129,7 @@ std::string ConfigToYaml(const IdentifyConfig& config) {
   out << YAML::Key << "residual" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "error" << YAML::Value << ErrorMeasureName(identification.residual.error);
   out << YAML::Key << "use_point_sigma" << YAML::Value << identification.residual.use_point_sigma;
+  out << YAML::Key << "amplitude_floor" << YAML::Value << identification.residual.amplitude_floor;
   out << YAML::EndMap;
 
   const SolverSettings& solver = identification.solver;
@@ -83,13 +140,20 @@ std::string ConfigToYaml(const IdentifyConfig& config) {
   out << YAML::Key << "parameter_tolerance" << YAML::Value
       << ExactNumber(solver.parameter_tolerance);
   out << YAML::Key << "num_threads" << YAML::Value << solver.num_threads;
+  out << YAML::Key << "nonmonotonic_steps" << YAML::Value << solver.nonmonotonic_steps;
   out << YAML::EndMap;
 
+  EmitPenalties(out, identification.penalties);
+
+  const JumpDetectionOptions& jump_detection = config.jump_detection;
   out << YAML::Key << "jump_detection" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "min_ratio" << YAML::Value << ExactNumber(config.jump_detection.min_ratio);
+  out << YAML::Key << "min_ratio" << YAML::Value << ExactNumber(jump_detection.min_ratio);
   out << YAML::Key << "min_relative_amplitude" << YAML::Value
-      << ExactNumber(config.jump_detection.min_relative_amplitude);
+      << ExactNumber(jump_detection.min_relative_amplitude);
+  out << YAML::Key << "noise_multiple" << YAML::Value << ExactNumber(jump_detection.noise_multiple);
+  out << YAML::Key << "min_candidate_steps" << YAML::Value << jump_detection.min_candidate_steps;
   out << YAML::EndMap;
+  EmitJumpOverrides(out, config.jump_overrides);
 
   if (config.omega_ref_rad_s.has_value()) {
     out << YAML::Key << "effective_nonlinearity_reference_hz" << YAML::Value

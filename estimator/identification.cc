@@ -20,6 +20,7 @@ ceres::Solver::Options MakeSolverOptions(const SolverSettings& settings) {
   options.num_threads = settings.num_threads;
   options.logging_type = ceres::SILENT;
   options.minimizer_progress_to_stdout = false;
+  options.use_nonmonotonic_steps = settings.nonmonotonic_steps;
   return options;
 }
 
@@ -73,15 +74,17 @@ StageSummary RunStage(const std::vector<const Sweep*>& fitted, const Identificat
   StageSummary stage;
   stage.residual = kind;
   if (kind == ResidualKind::kVertical && PenaltiesEnabled(penalties)) {
-    // The penalties are weighed in the data's own units: their weights
-    // multiply the data's sum of squared residuals where the stage starts.
+    // The penalties are weighed in the data's own units, taken where the
+    // stage starts: a few bifurcation-range terms against the data's sum of
+    // squared residuals, one branch-stability term per dwell against the
+    // mean squared residual of a dwell.
     stage.penalty_unit = 2.0 * DataCost(data_blocks, &problem);
     stage.penalty_exponent =
         penalties.bifurcation_range.enabled ? penalties.bifurcation_range.exponent : 0;
     ProblemBuilderOptions penalty_options = builder_options;
     penalty_options.penalties = penalties;
     penalty_options.penalties.bifurcation_range.weight *= stage.penalty_unit;
-    penalty_options.penalties.branch_stability.weight *= stage.penalty_unit;
+    penalty_options.penalties.branch_stability.weight *= stage.penalty_unit / blocks;
     const ProblemBuilder penalty_builder(penalty_options);
     for (const Sweep* sweep : fitted) {
       penalty_builder.AddPenalties(*sweep, parameters->data(), &problem);

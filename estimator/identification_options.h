@@ -27,6 +27,9 @@ struct ResidualOptions {
   ErrorMeasure error = ErrorMeasure::kAbsolute;
   // Divide each point's residual by its `sigma` column when the data has one.
   bool use_point_sigma = true;
+  // f of the relative error ln(a_i + f) - ln(a_model + f), in the data's
+  // amplitude unit: the measurement's noise floor (0: purely relative).
+  double amplitude_floor = 0.0;
 };
 
 struct SolverSettings {
@@ -37,6 +40,10 @@ struct SolverSettings {
   double gradient_tolerance = 1e-30;
   double parameter_tolerance = 1e-20;
   int num_threads = 1;
+  // Let the trust region accept steps that raise the cost for a while
+  // (ceres::Solver::Options::use_nonmonotonic_steps): faster along the
+  // narrow valleys of measured data with penalties.
+  bool nonmonotonic_steps = false;
   bool IsValid(std::string* error) const;
 };
 

@@ -61,6 +61,7 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
   out << "# config in effect\n" << ConfigToYaml(config) << "\n";
   auto outcome = std::make_unique<IdentifyOutcome>();
   outcome->sweeps = LoadLabelledSweeps(config.data_files, config.jump_detection);
+  ApplyJumpOverrides(config.jump_overrides, config.config_path, &outcome->sweeps);
   const std::vector<Sweep>& sweeps = outcome->sweeps;
   const std::vector<const Sweep*> fitted =
       SelectSweeps(sweeps, config.fit_sweeps, config.config_path, "fit");

@@ -40,10 +40,11 @@ ceres::CostFunction* ProblemBuilder::MakeResidual(const DwellPoint& point) const
     // that of ln a, sigma / a.
     weight = options_.residual_options.error == ErrorMeasure::kAbsolute
                  ? 1.0 / *point.sigma
-                 : point.amplitude / *point.sigma;
+                 : (point.amplitude + options_.residual_options.amplitude_floor) / *point.sigma;
   }
   return VerticalErrorResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
-                                       point.branch, options_.residual_options.error, weight);
+                                       point.branch, options_.residual_options.error, weight,
+                                       options_.residual_options.amplitude_floor);
 }
 
 int ProblemBuilder::AddSweep(const Sweep& sweep, double* parameters,

@@ -44,10 +44,23 @@ struct JumpBracket {
   double control_before = 0.0;  // rad/s (frequency sweep) or a_base (amplitude sweep)
   double control_after = 0.0;
   double amplitude_before = 0.0;  // measured a on either side
-  double amplitude_after = 0.0;
+  double amplitude_after = 0.0;   // 0 when into_missing_data
+  // The jump leads into rows recorded as missing (a <= 0) up to the sweep's
+  // end: `index_before` is the last dwell, control_after the control of the
+  // first missing row after it, and no dwell follows on the new branch.
+  bool into_missing_data = false;
 
   double centre() const { return 0.5 * (control_before + control_after); }
   double half_width() const;
+};
+
+// A row of the sweep whose amplitude was recorded as a <= 0: no measurement
+// (not a zero response), so it is no dwell; kept for where it was.
+struct MissingDwell {
+  double drive_frequency_rad_s = 0.0;
+  double a_base = 0.0;
+  int points_before = 0;  // dwells of the sweep measured before it
+  int source_line = 0;    // 1-based line in the source file
 };
 
 struct Sweep {
@@ -56,14 +69,21 @@ struct Sweep {
   SweepKind kind = SweepKind::kFrequency;
   std::vector<DwellPoint> points;  // in measurement order
   std::vector<JumpBracket> jumps;  // filled by jump detection
+  // True when `jumps` (and the branch labels) were stated in the config
+  // (ApplyJumpOverride) instead of detected.
+  bool jumps_from_config = false;
   std::string source_file;
-  int dropped_nonpositive = 0;  // rows with a <= 0, treated as missing
+  int dropped_nonpositive = 0;        // rows with a <= 0, treated as missing
+  std::vector<MissingDwell> missing;  // those rows, in measurement order
 
   // "id/up" or "id/down": the name a config uses to select one direction.
   std::string Name() const;
   // The control that varies: Omega [rad/s] or a_base.
   double Control(const DwellPoint& point) const {
     return kind == SweepKind::kFrequency ? point.drive_frequency_rad_s : point.a_base;
+  }
+  double Control(const MissingDwell& row) const {
+    return kind == SweepKind::kFrequency ? row.drive_frequency_rad_s : row.a_base;
   }
 };
 

@@ -196,9 +196,18 @@ void WarnAboutDroppedRows(const std::string& path, const std::vector<SweepBuilde
       LOG(WARNING) << path << ": sweep " << sweep.Name() << ": all " << builder.num_rows
                    << " rows have a <= 0 (missing measurements); the sweep is left out";
     } else {
+      int trailing = 0;
+      for (const MissingDwell& row : sweep.missing) {
+        trailing += row.points_before == static_cast<int>(sweep.points.size());
+      }
       LOG(WARNING) << path << ": sweep " << sweep.Name() << ": dropped "
                    << sweep.dropped_nonpositive << " of " << builder.num_rows
-                   << " rows with a <= 0 (missing measurements)";
+                   << " rows with a <= 0 (missing measurements"
+                   << (trailing > 0 ? ", " + std::to_string(trailing) +
+                                          " of them after the last "
+                                          "measured row"
+                                    : std::string())
+                   << ")";
     }
   }
 }
@@ -266,6 +275,12 @@ LoadedSweeps LoadSweepsCsv(const std::string& path) {
     TrackControls(where, freq_hz, a_base, &builder);
     if (!(amplitude > 0.0)) {
       ++builder.sweep.dropped_nonpositive;
+      MissingDwell missing;
+      missing.drive_frequency_rad_s = HzToRadPerSecond(freq_hz);
+      missing.a_base = a_base;
+      missing.points_before = static_cast<int>(builder.sweep.points.size());
+      missing.source_line = where.line;
+      builder.sweep.missing.push_back(missing);
       continue;
     }
     DwellPoint point;

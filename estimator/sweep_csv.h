@@ -6,7 +6,8 @@
 //   freq_hz    drive frequency [Hz] > 0 (stored as rad/s)
 //   a_base     base excitation level > 0 (data's unit, e.g. g)
 //   a          response amplitude (data's unit); a <= 0 marks a missing
-//              measurement: the row is dropped and counted, not an error
+//              measurement (no measurement, not a zero response): the row is
+//              no dwell; it is counted and kept in Sweep::missing, not an error
 //   phase_deg | phase_rad   optional response lag gamma (one of them at most)
 //   sigma      optional standard deviation of `a` (> 0, same unit as a)
 // Columns may come in any order; any other column is an error.
@@ -33,7 +34,9 @@ struct LoadedSweeps {
 // Reads the sweeps in `path`. Frequencies are converted to rad/s and phases to
 // radians here. Each sweep's kind follows from which control varies within it
 // (freq_hz: frequency sweep; a_base: amplitude sweep; neither: a frequency
-// sweep of repeated dwells). Dropped rows are reported with LOG(WARNING).
+// sweep of repeated dwells). Dropped rows are reported with LOG(WARNING) and
+// listed, with where they fell among the dwells, in Sweep::missing (jump
+// detection reads a sweep ending in missing rows as a jump into missing data).
 // Throws InputError naming file, line and column for any malformed content.
 LoadedSweeps LoadSweepsCsv(const std::string& path);
 

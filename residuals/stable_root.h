@@ -198,6 +198,63 @@ inline StableRoot SolveStableRoot(const ResponseCoefficients<double>& k, double 
   return root;
 }
 
+namespace internal {
+
+// Certificate that a root r > 0 of G = a_base^2 lies on `branch`, from the
+// quartic h = (dG/da)/a = 6 c6 a^4 + 4 c4 a^2 + 3 c3 a + 2 c2 (c2, c6 >= 0):
+//   upper: h(r) > 0, h'(r) >= 0 and h''(r) >= 0. Since h'' = 72 c6 a^2 + 8 c4
+//     grows with a, h' and then h grow on [r, inf): G rises past r, so r is
+//     the largest root, and stable.
+//   lower (c3 >= 0): h(a) >= 2 c2 + 4 c4 r^2 on [0, r]; when that is > 0, G
+//     rises on (0, r], so r is the smallest root, and stable.
+inline bool CertifiedOnBranch(const ResponseCoefficients<double>& k, double r, Branch branch) {
+  if (branch == Branch::kUpper) {
+    const double h = 2.0 * ((k.k1 + k.k2 * r) * (k.k1 + 2.0 * k.k2 * r) +
+                            (k.k3 + k.k4 * r * r) * (k.k3 + 3.0 * k.k4 * r * r));
+    const double dh = 2.0 * (3.0 * k.k1 * k.k2 + 4.0 * k.k2 * k.k2 * r + 8.0 * k.k3 * k.k4 * r +
+                             12.0 * k.k4 * k.k4 * r * r * r);
+    const double d2h = 2.0 * (4.0 * k.k2 * k.k2 + 8.0 * k.k3 * k.k4 + 36.0 * k.k4 * k.k4 * r * r);
+    return h > 0.0 && dh >= 0.0 && d2h >= 0.0;
+  }
+  if (branch == Branch::kLower) {
+    return k.c3() >= 0.0 && (k.c4() >= 0.0 || 2.0 * k.c2() + 4.0 * k.c4() * r * r > 0.0);
+  }
+  return false;
+}
+
+}  // namespace internal
+
+// The same root as SolveStableRoot, faster where the measured amplitude is
+// near its branch: plain Newton from `a_guess`, accepted only with a
+// certificate that the root lies on `branch` (internal::CertifiedOnBranch);
+// anything else falls back to SolveStableRoot. The returned `branch` is the
+// requested one even where G is monotone.
+inline StableRoot SolveStableRootNear(const ResponseCoefficients<double>& k, double a_base,
+                                      Branch branch, double a_guess) {
+  if (branch != Branch::kOnly && a_guess > 0.0) {
+    const double target = a_base * a_base;
+    double a = a_guess;
+    for (int i = 0; i < 30; ++i) {
+      const double slope = k.dG(a);
+      if (!(slope > 0.0)) break;
+      const double step = (k.G(a) - target) / slope;
+      a -= step;
+      if (!(a > 0.0) || !std::isfinite(a)) break;
+      if (std::abs(step) <= 4.0 * std::numeric_limits<double>::epsilon() * a) {
+        if (internal::CertifiedOnBranch(k, a, branch)) {
+          StableRoot root;
+          root.a = a;
+          root.status = RootStatus::kOnBranch;
+          root.branch = branch;
+          return root;
+        }
+        break;
+      }
+    }
+  }
+  return SolveStableRoot(k, a_base, branch, a_guess);
+}
+
 // Lifts a root found in double to scalar T (double or ceres::Jet) by one Newton
 // step in T arithmetic from the converged root: the value gains one more
 // Newton step, and the derivative part is exactly -F_p / F_a, the implicit

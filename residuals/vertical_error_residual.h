@@ -2,7 +2,10 @@
 //
 // Residual (section 3.2.4, the "vertical error" v of Figure 3.17):
 //   absolute:  r_i = s_i (a_i - a_model(Omega_i, a_base_i; p))
-//   relative:  r_i = s_i (ln a_i - ln a_model(Omega_i, a_base_i; p))
+//   relative:  r_i = s_i (ln(a_i + f) - ln(a_model(Omega_i, a_base_i; p) + f))
+// with f >= 0 an amplitude floor (the measurement's noise floor; 0: pure
+// relative error): dwells far below f weigh little, dwells far above it are
+// measured relatively.
 // where a_model is the stable root of the frequency-response equation (3.11)
 //   G(a; Omega_i, p) = a_base_i^2
 // on the branch the point was measured on (kLower: smallest positive root,
@@ -36,24 +39,27 @@ namespace dwellfit {
 // How the vertical error is measured.
 enum class ErrorMeasure {
   kAbsolute,  // a_i - a_model (the data's length unit)
-  kRelative,  // ln a_i - ln a_model
+  kRelative,  // ln(a_i + f) - ln(a_model + f), f the amplitude floor
 };
 
 class VerticalErrorResidual {
  public:
   VerticalErrorResidual(double drive_frequency_rad_s, double a_base, double a_measured,
-                        Branch branch, ErrorMeasure error, double weight)
+                        Branch branch, ErrorMeasure error, double weight,
+                        double amplitude_floor = 0.0)
       : drive_frequency_rad_s_(drive_frequency_rad_s),
         a_base_(a_base),
         a_measured_(a_measured),
         branch_(branch),
         error_(error),
-        weight_(weight) {}
+        weight_(weight),
+        amplitude_floor_(amplitude_floor) {}
 
   template <typename T>
   bool operator()(const T* const parameters, T* residual) const {
     const auto k = ResponseCoefficients<T>::FromParameters(parameters, drive_frequency_rad_s_);
-    const StableRoot root = SolveStableRoot(ScalarCoefficients(k), a_base_, branch_, a_measured_);
+    const StableRoot root =
+        SolveStableRootNear(ScalarCoefficients(k), a_base_, branch_, a_measured_);
     // Undefined evaluation: no finite root (non-finite parameters, eta_e = 0).
     if (root.status == RootStatus::kFailed) return false;
     const T a_model = LiftRoot(k, a_base_, root);
@@ -61,17 +67,19 @@ class VerticalErrorResidual {
       residual[0] = weight_ * (a_measured_ - a_model);
     } else {
       if (!(ScalarPart(a_model) > 0.0)) return false;  // log undefined
-      residual[0] = weight_ * (std::log(a_measured_) - log(a_model));
+      residual[0] =
+          weight_ * (std::log(a_measured_ + amplitude_floor_) - log(a_model + amplitude_floor_));
     }
     // Undefined evaluation: a root that overflowed at an extreme trial step.
     return std::isfinite(ScalarPart(residual[0]));
   }
 
   static ceres::CostFunction* Create(double drive_frequency_rad_s, double a_base, double a_measured,
-                                     Branch branch, ErrorMeasure error, double weight) {
+                                     Branch branch, ErrorMeasure error, double weight,
+                                     double amplitude_floor = 0.0) {
     return new ceres::AutoDiffCostFunction<VerticalErrorResidual, 1, kNumParameters>(
-        new VerticalErrorResidual(drive_frequency_rad_s, a_base, a_measured, branch, error,
-                                  weight));
+        new VerticalErrorResidual(drive_frequency_rad_s, a_base, a_measured, branch, error, weight,
+                                  amplitude_floor));
   }
 
  private:
@@ -81,6 +89,7 @@ class VerticalErrorResidual {
   const Branch branch_;
   const ErrorMeasure error_;
   const double weight_;
+  const double amplitude_floor_;  // f, the data's amplitude unit
 };
 
 }  // namespace dwellfit

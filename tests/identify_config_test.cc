@@ -187,6 +187,17 @@ TEST(ConfigReadme, AnnotatedExampleLoads) {
   EXPECT_THAT(Names(config.fit_sweeps), ElementsAre("F0.01", "A41.5"));
   EXPECT_DOUBLE_EQ(config.identification.initial[kOmega], HzToRadPerSecond(40.0));
   EXPECT_EQ(config.identification.solver.max_iterations, 200);
+  EXPECT_TRUE(config.identification.penalties.bifurcation_range.enabled);
+  EXPECT_FALSE(config.identification.penalties.branch_stability.enabled);
+  // The example spells out the jump-detection defaults.
+  const JumpDetectionOptions defaults;
+  EXPECT_EQ(config.jump_detection.min_ratio, defaults.min_ratio);
+  EXPECT_EQ(config.jump_detection.min_relative_amplitude, defaults.min_relative_amplitude);
+  EXPECT_EQ(config.jump_detection.noise_multiple, defaults.noise_multiple);
+  EXPECT_EQ(config.jump_detection.min_candidate_steps, defaults.min_candidate_steps);
+  ASSERT_EQ(config.jump_overrides.size(), 2u);
+  EXPECT_EQ(config.jump_overrides[0].sweep, "F0.01/down");
+  EXPECT_TRUE(config.jump_overrides[1].none);
   EXPECT_EQ(config.output_dir, (dir.path() / "out" / "thesis-numerical").string());
 }
 
@@ -243,7 +254,8 @@ TEST(IdentifyConfigErrors, ValueWhereABlockIsExpectedIsAnError) {
                 "jump_detection: 3.0", &path);
   ExpectAt(error, path, 23, "jump_detection");
   EXPECT_THAT(error.what(), HasSubstr("expected a block of keys (min_ratio, "
-                                      "min_relative_amplitude), got a single value"));
+                                      "min_relative_amplitude, noise_multiple, "
+                                      "min_candidate_steps), got a single value"));
 }
 
 TEST(IdentifyConfigErrors, MissingParameterIsReportedAtItsBlock) {
@@ -378,6 +390,37 @@ TEST(IdentifyConfigErrors, InvalidJumpDetectionIsReportedAtItsBlock) {
   const InputError error = ErrorWith(dir, "min_ratio: 3.0", "min_ratio: 0.5", &path);
   ExpectAt(error, path, 23, "jump_detection");
   EXPECT_THAT(error.what(), HasSubstr("jump_detection.min_ratio must be greater than 1"));
+}
+
+TEST(LoadIdentifyConfig, JumpDetectionNoiseTestKeys) {
+  const ConfigDirectory dir;
+  const IdentifyConfig config = LoadIdentifyConfig(dir.WriteConfig(
+      Replace(kValidConfig, "  min_relative_amplitude: 0.25",
+              "  min_relative_amplitude: 0.25\n  noise_multiple: 4.5\n  min_candidate_steps: 8")));
+  EXPECT_EQ(config.jump_detection.noise_multiple, 4.5);
+  EXPECT_EQ(config.jump_detection.min_candidate_steps, 8);
+  const IdentifyConfig reloaded =
+      LoadIdentifyConfig(dir.WriteFile("in_effect.yaml", ConfigToYaml(config)));
+  EXPECT_EQ(reloaded.jump_detection.min_ratio, 3.0);
+  EXPECT_EQ(reloaded.jump_detection.noise_multiple, 4.5);
+  EXPECT_EQ(reloaded.jump_detection.min_candidate_steps, 8);
+}
+
+TEST(IdentifyConfigErrors, InvalidNoiseTestSettingsAreReportedAtTheJumpDetectionBlock) {
+  const ConfigDirectory dir;
+  std::string path;
+  InputError error = ErrorWith(dir, "  min_relative_amplitude: 0.25",
+                               "  min_relative_amplitude: 0.25\n  noise_multiple: -1", &path);
+  ExpectAt(error, path, 23, "jump_detection");
+  EXPECT_THAT(error.what(), HasSubstr("jump_detection.noise_multiple must be a non-negative "
+                                      "number (0: no noise test)"));
+  error = ErrorWith(dir, "  min_relative_amplitude: 0.25",
+                    "  min_relative_amplitude: 0.25\n  min_candidate_steps: 0", &path);
+  ExpectAt(error, path, 23, "jump_detection");
+  EXPECT_THAT(error.what(), HasSubstr("jump_detection.min_candidate_steps must be at least 1"));
+  error = ErrorWith(dir, "  min_relative_amplitude: 0.25",
+                    "  min_relative_amplitude: 0.25\n  min_candidate_steps: 5.5", &path);
+  ExpectAt(error, path, 26, "jump_detection.min_candidate_steps");
 }
 
 TEST(IdentifyConfigErrors, MissingDataFileSaysWhereItLooked) {

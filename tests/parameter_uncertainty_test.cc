@@ -119,7 +119,7 @@ TEST_F(UncertaintyThesisNumerical, NoisyFitGivesStudentTIntervalsFromTheResidual
   ExpectAllFinite(u);
   EXPECT_EQ(u.degrees_of_freedom, 260 - 5);
   // s^2 = 2 F / (n - k): the relative error measures ln(1 + 0.01 N) ~ 0.01 N.
-  EXPECT_NEAR(u.reduced_chi_square, 2.0 * result.final_cost / 255.0, 1e-12);
+  EXPECT_NEAR(u.reduced_chi_square, 2.0 * result.stages.back().final_data_cost / 255.0, 1e-12);
   EXPECT_NEAR(u.noise_sigma, 0.01, 0.0015);
   EXPECT_NEAR(u.interval_quantile, 1.96931, 1e-4);  // t_{0.975, 255}
   for (int i = 0; i < kNumParameters; ++i) {

@@ -81,3 +81,39 @@ TEST(SolveStableRoot, FailsCleanlyOnNonFiniteParameters) {
 
 }  // namespace
 }  // namespace dwellfit
+
+namespace dwellfit {
+namespace {
+
+TEST(SolveStableRootNear, AgreesWithTheSafeguardedSolverEverywhere) {
+  // Frequencies across and beyond the bistable band, levels below, inside and
+  // above it, guesses near and far from each root, and both branches
+  // (including where the requested branch does not reach a_base).
+  int fast_path_used = 0;
+  int cases = 0;
+  for (double hz = 38.0; hz <= 46.0; hz += 0.25) {
+    const auto k = At(hz);
+    for (double a_base : {0.002, 0.006, 0.01, 0.02, 0.035, 0.05}) {
+      for (Branch branch : {Branch::kLower, Branch::kUpper, Branch::kOnly}) {
+        const StableRoot reference = SolveStableRoot(k, a_base, branch, 1e-3);
+        for (double factor : {0.3, 0.9, 1.0, 1.1, 3.0}) {
+          const double guess = reference.a * factor;
+          const StableRoot full = SolveStableRoot(k, a_base, branch, guess);
+          const StableRoot near = SolveStableRootNear(k, a_base, branch, guess);
+          ++cases;
+          ASSERT_EQ(near.status, full.status) << hz << " Hz, a_base " << a_base << ", "
+                                              << BranchName(branch) << ", guess " << guess;
+          EXPECT_NEAR(near.a, full.a, 1e-13 * full.a)
+              << hz << " Hz, a_base " << a_base << ", " << BranchName(branch);
+          fast_path_used += near.branch == branch && full.branch != branch;
+        }
+      }
+    }
+  }
+  EXPECT_GT(cases, 1000);
+  // Where G is monotone the fast path answers without the turning points.
+  EXPECT_GT(fast_path_used, 0);
+}
+
+}  // namespace
+}  // namespace dwellfit

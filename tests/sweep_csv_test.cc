@@ -186,9 +186,41 @@ TEST(SweepCsvTest, DropsNonPositiveAmplitudesCountsAndWarnsPerSweep) {
   ASSERT_EQ(warnings.size(), 2u);
   EXPECT_THAT(warnings[0], HasSubstr("H/up"));
   EXPECT_THAT(warnings[0], HasSubstr("dropped 3 of 5 rows"));
+  EXPECT_THAT(warnings[0], HasSubstr("3 of them after the last measured row"));
   EXPECT_THAT(warnings[1], HasSubstr("Z/down"));
   EXPECT_THAT(warnings[1], HasSubstr("all 2 rows"));
   EXPECT_THAT(warnings[1], HasSubstr("left out"));
+}
+
+TEST(SweepCsvTest, KeepsWhereEachMissingRowFellAmongTheDwells) {
+  // Amplitude sweep: a_base is the control. Missing rows before the first
+  // dwell, between dwells and after the last one.
+  const std::string path = WriteCsv("missing_rows",
+                                    "sweep,direction,freq_hz,a_base,a\n"
+                                    "A,up,41.5,0.010,0\n"
+                                    "A,up,41.5,0.020,1e-3\n"
+                                    "A,up,41.5,0.030,-1\n"
+                                    "A,up,41.5,0.040,4e-3\n"
+                                    "A,up,41.5,0.050,0\n"
+                                    "A,up,41.5,0.060,0\n");
+  const LoadedSweeps loaded = LoadSweepsCsv(path);
+  ASSERT_EQ(loaded.sweeps.size(), 1u);
+  const Sweep& sweep = loaded.sweeps[0];
+  EXPECT_EQ(sweep.kind, SweepKind::kAmplitude);
+  ASSERT_EQ(sweep.points.size(), 2u);
+  EXPECT_EQ(sweep.dropped_nonpositive, 4);
+  ASSERT_EQ(sweep.missing.size(), 4u);
+  std::vector<int> points_before, lines;
+  std::vector<double> controls;
+  for (const MissingDwell& row : sweep.missing) {
+    points_before.push_back(row.points_before);
+    lines.push_back(row.source_line);
+    controls.push_back(sweep.Control(row));
+    EXPECT_DOUBLE_EQ(row.drive_frequency_rad_s, 2.0 * kPi * 41.5);
+  }
+  EXPECT_THAT(points_before, ElementsAre(0, 1, 2, 2));
+  EXPECT_THAT(lines, ElementsAre(2, 4, 6, 7));
+  EXPECT_THAT(controls, ElementsAre(0.010, 0.030, 0.050, 0.060));
 }
 
 TEST(SweepCsvTest, MissingFileSaysItCannotBeOpened) {

@@ -96,6 +96,7 @@ TEST_F(ThesisNumerical, VerticalErrorAloneFromTheFirstStartEndsAtAWrongMinimum) 
   // collapses (the observation, kept as a regression guard).
   IdentificationOptions options = StartAt({1.3, 0.7, 1.3, 0.7, 1.3});
   options.stages = {ResidualKind::kVertical};
+  options.penalties = PenaltyOptions{};  // none
   const IdentificationResult result = Identify(fitted_, options);
   EXPECT_GT(std::abs(result.parameters[kMu2] / kTruth[kMu2] - 1.0), 0.1);
 }
