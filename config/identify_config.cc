@@ -120,8 +120,9 @@ void CheckNoSweepFittedAndValidated(const std::vector<PlacedSelection>& fit,
   }
 }
 
-// The initial_guess block: every parameter, in physical units, omega in Hz.
-ParameterVector ReadInitialGuess(const ConfigValue& value, const ConfigSource& source) {
+// The initial_guess block: `auto`, or per parameter a number (physical
+// units, omega in Hz) or `auto`; a parameter left out is `auto`.
+KnownParameters ReadInitialGuess(const ConfigValue& value, const ConfigSource& source) {
   struct Key {
     ParameterIndex index;
     const char* name;
@@ -135,30 +136,69 @@ ParameterVector ReadInitialGuess(const ConfigValue& value, const ConfigSource& s
       {kAlpha, "alpha", "cubic stiffness"},
       {kOmega, "omega_hz", "linear natural frequency [Hz], > 0"},
   }};
+  KnownParameters known;
+  if (value.node.IsScalar() && value.node.Scalar() == "auto") return known;
   std::vector<std::string> names;
   for (const Key& key : keys) names.push_back(key.name);
   const StrictMap block(value, source, names);
-
-  ParameterVector initial{};
   for (const Key& key : keys) {
-    const ConfigValue entry =
-        block.Required(key.name, std::string("give its initial guess (") + key.meaning + ")");
-    const double number = ReadFiniteDouble(entry, source);
+    const auto entry = block.Optional(key.name);
+    if (!entry || (entry->node.IsScalar() && entry->node.Scalar() == "auto")) continue;
+    const double number = ReadFiniteDouble(*entry, source);
     const bool must_be_positive = key.index == kEtaE || key.index == kOmega;
     const bool must_be_non_negative = key.index == kMu1 || key.index == kMu2;
     if (must_be_positive && !(number > 0.0)) {
-      throw source.Error(entry.path, entry.mark,
-                         "the initial guess must be positive, got " + entry.node.Scalar());
+      throw source.Error(entry->path, entry->mark,
+                         std::string("the initial guess (") + key.meaning +
+                             ") must be positive, got " + entry->node.Scalar() +
+                             "; or write auto to find it from the data");
     }
     if (must_be_non_negative && number < 0.0) {
-      throw source.Error(entry.path, entry.mark,
+      throw source.Error(entry->path, entry->mark,
                          "the initial guess must be non-negative (the parameter is bounded "
                          "below by 0), got " +
-                             entry.node.Scalar());
+                             entry->node.Scalar());
     }
-    initial[key.index] = key.index == kOmega ? HzToRadPerSecond(number) : number;
+    known[key.index] = key.index == kOmega ? HzToRadPerSecond(number) : number;
+  }
+  return known;
+}
+
+// Placeholders for the guesses to be found from the data, so that the
+// options validate before the data are read.
+ParameterVector WithPlaceholders(const KnownParameters& known) {
+  ParameterVector initial = {1.0, 0.0, 0.0, 0.0, 0.0, 1.0};
+  for (int i = 0; i < kNumParameters; ++i) {
+    if (known[i]) initial[i] = *known[i];
   }
   return initial;
+}
+
+void ThrowInvalidBlock(const ConfigValue& block, const ConfigSource& source,
+                       const std::string& message) {
+  std::string set_by;
+  for (const ConfigOverride* applied : source.OverridesWithin(block.path)) {
+    set_by += (set_by.empty() ? "" : ", ") + DescribeOverride(*applied);
+  }
+  std::string what = message;
+  if (!set_by.empty()) what += " (values set on the command line: " + set_by + ")";
+  throw source.Error(block.path, block.mark, what);
+}
+
+MultiStartOptions ReadMultiStart(const ConfigValue& value, const ConfigSource& source) {
+  const StrictMap block(value, source, {"starts", "spread", "seed", "threads"});
+  MultiStartOptions multi_start;
+  if (const auto v = block.Optional("starts")) multi_start.starts = ReadInt(*v, source);
+  if (const auto v = block.Optional("spread")) multi_start.spread = ReadFiniteDouble(*v, source);
+  if (const auto v = block.Optional("seed")) {
+    const int seed = ReadInt(*v, source);
+    if (seed < 0) throw source.Error(v->path, v->mark, "must be a non-negative integer");
+    multi_start.seed = static_cast<std::uint64_t>(seed);
+  }
+  if (const auto v = block.Optional("threads")) multi_start.threads = ReadInt(*v, source);
+  std::string message;
+  if (!multi_start.IsValid(&message)) ThrowInvalidBlock(value, source, message);
+  return multi_start;
 }
 
 std::array<bool, kNumParameters> ReadFixed(const ConfigValue& value, const ConfigSource& source) {
@@ -450,16 +490,6 @@ BranchStabilityOptions ReadBranchStability(const ConfigValue& value, const Confi
 
 // Throws the `IsValid` message of an options struct read from `block`, at the
 // block's line, naming the overrides that changed values inside it.
-void ThrowInvalidBlock(const ConfigValue& block, const ConfigSource& source,
-                       const std::string& message) {
-  std::string set_by;
-  for (const ConfigOverride* applied : source.OverridesWithin(block.path)) {
-    set_by += (set_by.empty() ? "" : ", ") + DescribeOverride(*applied);
-  }
-  std::string what = message;
-  if (!set_by.empty()) what += " (values set on the command line: " + set_by + ")";
-  throw source.Error(block.path, block.mark, what);
-}
 
 ConfigValue OrAbsent(const std::optional<ConfigValue>& value, const std::string& path) {
   return value.has_value() ? *value : ConfigValue{YAML::Node(), path, YAML::Mark::null_mark()};
@@ -490,7 +520,7 @@ PenaltyOptions ReadPenalties(const ConfigValue& value, const ConfigSource& sourc
 IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& config_dir) {
   const StrictMap top(DocumentValue(source), source,
                       {"data", "fit", "validate", "initial_guess", "fixed", "stages", "residual",
-                       "solver", "penalties", "jump_detection", "jumps",
+                       "solver", "penalties", "multi_start", "jump_detection", "jumps",
                        "effective_nonlinearity_reference_hz", "output_dir"});
   IdentifyConfig config;
   config.data_files =
@@ -511,9 +541,10 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
   config.validate_sweeps = Selections(validate);
 
   IdentificationOptions& identification = config.identification;
-  const ConfigValue initial_guess =
-      top.Required("initial_guess", "give eta_e, mu1, mu2, delta, alpha and omega_hz in a block");
-  identification.initial = ReadInitialGuess(initial_guess, source);
+  const ConfigValue initial_guess = OrAbsent(top.Optional("initial_guess"), "initial_guess");
+  if (initial_guess.node.IsDefined())
+    config.initial_guess = ReadInitialGuess(initial_guess, source);
+  identification.initial = WithPlaceholders(config.initial_guess);
   if (const auto value = top.Optional("fixed")) identification.fixed = ReadFixed(*value, source);
   if (const auto value = top.Optional("stages")) identification.stages = ReadStages(*value, source);
   if (const auto value = top.Optional("residual")) {
@@ -527,6 +558,10 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
     identification.penalties = ReadPenalties(*value, source);
   }
   if (!identification.IsValid(&message)) ThrowInvalidBlock(initial_guess, source, message);
+
+  if (const auto value = top.Optional("multi_start")) {
+    config.multi_start = ReadMultiStart(*value, source);
+  }
 
   const ConfigValue jump_detection = OrAbsent(top.Optional("jump_detection"), "jump_detection");
   if (jump_detection.node.IsDefined()) {

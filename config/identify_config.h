@@ -14,7 +14,9 @@
 #include "config/config_override.h"
 #include "config/sweep_selection.h"
 #include "estimator/identification_options.h"
+#include "estimator/initial_guess.h"
 #include "estimator/jump_detection.h"
+#include "estimator/multi_start.h"
 
 namespace dwellfit {
 
@@ -28,9 +30,15 @@ struct IdentifyConfig {
   std::vector<SweepSelection> fit_sweeps;
   // Sweeps only predicted and scored; none of them is also fitted.
   std::vector<SweepSelection> validate_sweeps;
-  // Initial guesses (physical units, omega in rad/s), fixed parameters, fit
-  // stages, residual, penalty and solver settings. IsValid() holds.
+  // The initial guesses the config gives (physical units, omega in rad/s);
+  // an entry left out or `auto` is found from the data (initial_guess.h).
+  KnownParameters initial_guess;
+  // Fixed parameters, fit stages, residual, penalty and solver settings;
+  // `initial` holds the given guesses and placeholders for the automatic
+  // ones until the run fills them. IsValid() holds.
   IdentificationOptions identification;
+  // Fits from several starts (multi_start.h); one start by default.
+  MultiStartOptions multi_start;
   JumpDetectionOptions jump_detection;
   // Jumps stated per sweep (`jumps:`), applied after detection
   // (ApplyJumpOverrides); frequencies in rad/s, one entry per sweep at most.

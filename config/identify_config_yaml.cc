@@ -107,7 +107,9 @@ std::string ConfigToYaml(const IdentifyConfig& config) {
 
   out << YAML::Key << "initial_guess" << YAML::Value << YAML::BeginMap;
   for (int i = 0; i < kNumParameters; ++i) {
-    if (i == kOmega) {
+    if (!config.initial_guess[i]) {
+      out << YAML::Key << (i == kOmega ? "omega_hz" : ParameterName(i)) << YAML::Value << "auto";
+    } else if (i == kOmega) {
       out << YAML::Key << "omega_hz" << YAML::Value
           << ConvertedNumber(RadPerSecondToHz(identification.initial[i]))
           << YAML::Comment(ExactNumber(identification.initial[i]) + " rad/s");
@@ -146,6 +148,13 @@ std::string ConfigToYaml(const IdentifyConfig& config) {
   EmitPenalties(out, identification.penalties);
 
   const JumpDetectionOptions& jump_detection = config.jump_detection;
+  out << YAML::Key << "multi_start" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "starts" << YAML::Value << config.multi_start.starts;
+  out << YAML::Key << "spread" << YAML::Value << ExactNumber(config.multi_start.spread);
+  out << YAML::Key << "seed" << YAML::Value << config.multi_start.seed;
+  out << YAML::Key << "threads" << YAML::Value << config.multi_start.threads;
+  out << YAML::EndMap;
+
   out << YAML::Key << "jump_detection" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "min_ratio" << YAML::Value << ExactNumber(jump_detection.min_ratio);
   out << YAML::Key << "min_relative_amplitude" << YAML::Value

@@ -21,6 +21,9 @@ ceres::Solver::Options MakeSolverOptions(const SolverSettings& settings) {
   options.logging_type = ceres::SILENT;
   options.minimizer_progress_to_stdout = false;
   options.use_nonmonotonic_steps = settings.nonmonotonic_steps;
+  // Ceres' default of 5 cuts the non-monotonic excursions short on the
+  // narrow valleys of measured data with penalties.
+  options.max_consecutive_nonmonotonic_steps = 20;
   return options;
 }
 

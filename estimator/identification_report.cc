@@ -53,6 +53,11 @@ std::string ReportToYaml(const IdentificationReport& report) {
     out << YAML::Key << "value" << YAML::Value << result.parameters[i];
     out << YAML::Key << "initial" << YAML::Value << report.options.initial[i];
     out << YAML::Key << "fixed" << YAML::Value << report.options.fixed[i];
+    if (report.uncertainty.available && !report.options.fixed[i]) {
+      out << YAML::Key << "standard_error" << YAML::Value << report.uncertainty.standard_error[i];
+      out << YAML::Key << "ci95" << YAML::Value << YAML::Flow << YAML::BeginSeq
+          << report.uncertainty.ci95_low[i] << report.uncertainty.ci95_high[i] << YAML::EndSeq;
+    }
     if (i == kOmega) out << YAML::Key << "unit" << YAML::Value << "rad/s";
     out << YAML::EndMap;
   }
@@ -64,7 +69,49 @@ std::string ReportToYaml(const IdentificationReport& report) {
   out << YAML::Key << "value" << YAML::Value
       << EffectiveNonlinearity(result.parameters, report.omega_ref_rad_s);
   out << YAML::Key << "omega_ref_rad_s" << YAML::Value << report.omega_ref_rad_s;
+  if (report.uncertainty.available) {
+    out << YAML::Key << "standard_error" << YAML::Value
+        << report.uncertainty.effective_nonlinearity_standard_error;
+    out << YAML::Key << "ci95" << YAML::Value << YAML::Flow << YAML::BeginSeq
+        << report.uncertainty.effective_nonlinearity_ci95_low
+        << report.uncertainty.effective_nonlinearity_ci95_high << YAML::EndSeq;
+  }
   out << YAML::EndMap;
+  const ParameterUncertainty& u = report.uncertainty;
+  out << YAML::Key << "uncertainty" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "available" << YAML::Value << u.available;
+  out << YAML::Key << "message" << YAML::Value << u.message;
+  out << YAML::Key << "noise_sigma" << YAML::Value << u.noise_sigma;
+  out << YAML::Key << "degrees_of_freedom" << YAML::Value << u.degrees_of_freedom;
+  if (u.available) {
+    out << YAML::Key << "correlation" << YAML::Value << YAML::BeginMap;
+    for (int i = 0; i < kNumParameters; ++i) {
+      if (report.options.fixed[i]) continue;
+      out << YAML::Key << ParameterName(i) << YAML::Value << YAML::Flow << YAML::BeginSeq;
+      for (int j = 0; j < kNumParameters; ++j) {
+        if (!report.options.fixed[j]) out << u.correlation(i, j);
+      }
+      out << YAML::EndSeq;
+    }
+    out << YAML::EndMap;
+  }
+  out << YAML::Key << "warnings" << YAML::Value << YAML::BeginSeq;
+  for (const std::string& warning : u.warnings) out << warning;
+  out << YAML::EndSeq;
+  out << YAML::EndMap;
+  out << YAML::Key << "multi_start" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "starts" << YAML::Value << report.multi_start.starts.size();
+  out << YAML::Key << "reached_best" << YAML::Value << report.multi_start.reached_best;
+  out << YAML::Key << "best_start" << YAML::Value << report.multi_start.best_start;
+  out << YAML::Key << "final_costs" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (double cost : report.multi_start.final_costs) out << cost;
+  out << YAML::EndSeq;
+  out << YAML::EndMap;
+  if (!report.initial_guess_steps.empty()) {
+    out << YAML::Key << "automatic_initial_guess" << YAML::Value << YAML::BeginSeq;
+    for (const std::string& step : report.initial_guess_steps) out << step;
+    out << YAML::EndSeq;
+  }
   out << YAML::Key << "final_cost" << YAML::Value << result.final_cost;
   out << YAML::Key << "iterations" << YAML::Value << result.iterations;
   out << YAML::Key << "converged" << YAML::Value << result.converged;
@@ -73,6 +120,7 @@ std::string ReportToYaml(const IdentificationReport& report) {
   for (const StageSummary& stage : result.stages) {
     out << YAML::BeginMap;
     out << YAML::Key << "residual" << YAML::Value << ResidualKindName(stage.residual);
+    out << YAML::Key << "dwells" << YAML::Value << stage.residual_blocks;
     out << YAML::Key << "initial_cost" << YAML::Value << stage.initial_cost;
     out << YAML::Key << "final_cost" << YAML::Value << stage.final_cost;
     out << YAML::Key << "final_data_cost" << YAML::Value << stage.final_data_cost;
@@ -155,12 +203,19 @@ void PrintReport(const IdentificationReport& report, std::ostream& out) {
   }
   char line[256];
   out << "\n";
-  std::snprintf(line, sizeof(line), "%-8s %-24s %-24s %s\n", "param", "estimate", "initial",
-                "fixed");
+  const ParameterUncertainty& u = report.uncertainty;
+  std::snprintf(line, sizeof(line), "%-8s %-18s %-12s %-34s %-14s %s\n", "param", "estimate",
+                "std.error", "95% interval", "initial", "fixed");
   out << line;
   for (int i = 0; i < kNumParameters; ++i) {
-    std::snprintf(line, sizeof(line), "%-8s %-24.10g %-24.10g %s\n", ParameterName(i),
-                  result.parameters[i], report.options.initial[i],
+    const bool interval = u.available && !report.options.fixed[i];
+    char se[32] = "-", ci[64] = "-";
+    if (interval) {
+      std::snprintf(se, sizeof(se), "%.3g", u.standard_error[i]);
+      std::snprintf(ci, sizeof(ci), "[%.6g, %.6g]", u.ci95_low[i], u.ci95_high[i]);
+    }
+    std::snprintf(line, sizeof(line), "%-8s %-18.10g %-12s %-34s %-14.6g %s\n", ParameterName(i),
+                  result.parameters[i], se, ci, report.options.initial[i],
                   report.options.fixed[i] ? "yes" : "no");
     out << line;
   }
@@ -171,10 +226,23 @@ void PrintReport(const IdentificationReport& report, std::ostream& out) {
                 EffectiveNonlinearity(result.parameters, report.omega_ref_rad_s),
                 report.omega_ref_rad_s);
   out << line;
-  std::snprintf(line, sizeof(line), "final cost %.6g after %d iterations, %s\n\n",
-                result.final_cost, result.iterations,
-                result.converged ? "converged" : "NOT converged");
+  if (u.available) {
+    std::snprintf(line, sizeof(line),
+                  "  effective nonlinearity std.error %.3g, 95%% interval [%.6g, %.6g]\n",
+                  u.effective_nonlinearity_standard_error, u.effective_nonlinearity_ci95_low,
+                  u.effective_nonlinearity_ci95_high);
+    out << line;
+  }
+  std::snprintf(line, sizeof(line), "final cost %.6g after %d iterations, %s\n", result.final_cost,
+                result.iterations, result.converged ? "converged" : "NOT converged");
   out << line;
+  std::snprintf(line, sizeof(line), "starts: %zu, %d reached the best (start %d)\n",
+                report.multi_start.starts.size(), report.multi_start.reached_best,
+                report.multi_start.best_start);
+  out << line;
+  out << "uncertainty: " << u.message << "\n";
+  for (const std::string& warning : u.warnings) out << "warning: " << warning << "\n";
+  out << "\n";
   std::snprintf(line, sizeof(line), "%-20s %-10s %6s %14s %14s %s\n", "sweep", "role", "points",
                 "rms_error", "relative_rms", "off_branch");
   out << line;

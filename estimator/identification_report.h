@@ -10,6 +10,8 @@
 
 #include "estimator/identification.h"
 #include "estimator/identification_options.h"
+#include "estimator/multi_start.h"
+#include "estimator/parameter_uncertainty.h"
 #include "estimator/sweep_prediction.h"
 
 namespace dwellfit {
@@ -20,6 +22,11 @@ struct IdentificationReport {
   IdentificationResult result;
   double omega_ref_rad_s = 0.0;              // reference of the effective nonlinearity
   std::vector<SweepPrediction> predictions;  // fitted sweeps first, then validation
+  // How the automatic starting point was found (empty: every guess given).
+  std::vector<std::string> initial_guess_steps;
+  // The starts and how many reached the best (one start: trivially 1 of 1).
+  MultiStartResult multi_start;
+  ParameterUncertainty uncertainty;
 };
 
 // Builds the report: predicts every sweep at the identified parameters.

@@ -1,11 +1,16 @@
 #include "estimator/identify_run.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 
+#include "estimator/initial_guess.h"
 #include "estimator/input_error.h"
 #include "estimator/jump_detection.h"
+#include "estimator/multi_start.h"
 #include "estimator/output_files.h"
+#include "estimator/parameter_uncertainty.h"
 #include "estimator/sweep_csv.h"
 #include "glog/logging.h"
 
@@ -71,7 +76,43 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
   for (const Sweep* sweep : validation) out << "validate " << DescribeJumps(*sweep) << "\n";
   out << "\n";
 
-  const IdentificationResult result = Identify(fitted, config.identification);
+  // Guesses the config leaves to the data; the automatic start is also one
+  // of the multi-start's starts.
+  IdentificationOptions options = config.identification;
+  std::vector<std::string> guess_steps;
+  std::optional<ParameterVector> automatic;
+  const bool any_automatic = std::any_of(config.initial_guess.begin(), config.initial_guess.end(),
+                                         [](const std::optional<double>& v) { return !v; });
+  if (any_automatic || config.multi_start.starts > 1) {
+    try {
+      const InitialGuessReport guess = AutomaticInitialGuess(fitted, config.initial_guess);
+      automatic = guess.guess;
+      guess_steps = guess.steps;
+    } catch (const InputError& error) {
+      if (any_automatic) {
+        throw InputError(config.config_path, 0, "initial_guess",
+                         std::string("cannot find a starting point from the data: ") +
+                             error.what() + "; give the initial guesses in the config");
+      }
+    }
+    if (any_automatic) {
+      for (int i = 0; i < kNumParameters; ++i) {
+        if (!config.initial_guess[i]) options.initial[i] = (*automatic)[i];
+      }
+      out << "automatic initial guess:\n";
+      for (const std::string& step : guess_steps) out << "  " << step << "\n";
+      out << "\n";
+    }
+  }
+  std::string invalid;
+  if (!options.IsValid(&invalid)) {
+    throw InputError(config.config_path, 0, "initial_guess",
+                     "the starting point is not usable (" + invalid +
+                         "); give the initial guesses in the config");
+  }
+  const MultiStartResult multi_start =
+      IdentifyMultiStart(fitted, options, automatic, config.multi_start);
+  const IdentificationResult& result = multi_start.best;
   for (double value : result.parameters) {
     if (!std::isfinite(value)) {
       throw InputError(config.config_path, 0, "initial_guess",
@@ -79,9 +120,14 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
                        "(see config/README.md, initial_guess)");
     }
   }
+  options.initial = multi_start.starts[multi_start.best_start];
   outcome->report =
-      MakeIdentificationReport(config.config_path, config.identification, result,
+      MakeIdentificationReport(config.config_path, options, result,
                                config.omega_ref_rad_s.value_or(0.0), fitted, validation);
+  outcome->report.initial_guess_steps = guess_steps;
+  outcome->report.multi_start = multi_start;
+  outcome->report.uncertainty =
+      EstimateUncertainty(fitted, options, result.parameters, outcome->report.omega_ref_rad_s);
   const IdentificationReport& report = outcome->report;
   PrintReport(report, out);
   WriteFilesAtomically(config.output_dir, {{"result.yaml", ReportToYaml(report)},

@@ -183,9 +183,9 @@ TEST(ConfigOverrideErrors, WrongTypeNamesTheFlag) {
 }
 
 TEST(ConfigOverrideErrors, RemovingARequiredKeyNamesTheFlag) {
-  const InputError error = LoadErrorWith(ParseSetFlag("initial_guess.mu2=~", "--set"));
-  EXPECT_THAT(error.what(), StartsWith("--set: field 'initial_guess.mu2': missing required key "
-                                       "'mu2' in 'initial_guess'"));
+  const InputError error = LoadErrorWith(ParseSetFlag("output_dir=~", "--set"));
+  EXPECT_THAT(error.what(), HasSubstr("--set"));
+  EXPECT_THAT(error.what(), HasSubstr("output_dir"));
 }
 
 TEST(ConfigOverrideErrors, InvalidValueInAFileBlockNamesTheFlag) {

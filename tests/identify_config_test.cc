@@ -258,12 +258,25 @@ TEST(IdentifyConfigErrors, ValueWhereABlockIsExpectedIsAnError) {
                                       "min_candidate_steps), got a single value"));
 }
 
-TEST(IdentifyConfigErrors, MissingParameterIsReportedAtItsBlock) {
+TEST(LoadIdentifyConfig, LeftOutOrAutoInitialGuessesAreFoundFromTheData) {
+  const ConfigDirectory dir;
+  const IdentifyConfig left_out =
+      LoadIdentifyConfig(dir.WriteConfig(Replace(kValidConfig, "  mu2: 390\n", "")));
+  EXPECT_FALSE(left_out.initial_guess[kMu2].has_value());
+  EXPECT_TRUE(left_out.initial_guess[kMu1].has_value());
+  const IdentifyConfig automatic =
+      LoadIdentifyConfig(dir.WriteConfig(Replace(kValidConfig, "  mu2: 390\n", "  mu2: auto\n")));
+  EXPECT_FALSE(automatic.initial_guess[kMu2].has_value());
+  // The printed config says so, and reads back the same.
+  EXPECT_THAT(ConfigToYaml(automatic), HasSubstr("mu2: auto"));
+}
+
+TEST(IdentifyConfigErrors, AnInitialGuessThatIsNeitherANumberNorAutoIsAnError) {
   const ConfigDirectory dir;
   std::string path;
-  const InputError error = ErrorWith(dir, "  mu2: 390\n", "", &path);
-  ExpectAt(error, path, 5, "initial_guess.mu2");
-  EXPECT_THAT(error.what(), HasSubstr("missing required key 'mu2' in 'initial_guess'"));
+  const InputError error = ErrorWith(dir, "  mu2: 390\n", "  mu2: automatic\n", &path);
+  ExpectAt(error, path, 8, "initial_guess.mu2");
+  EXPECT_THAT(error.what(), HasSubstr("expected a number"));
 }
 
 TEST(IdentifyConfigErrors, MissingTopLevelKeyNamesFileAndKey) {
