@@ -164,6 +164,9 @@ std::string ReportToYaml(const IdentificationReport& report) {
         out << YAML::Null;
       }
       if (jump.measured) out << YAML::Key << "inside" << YAML::Value << jump.inside;
+      if (jump.measured && jump.bracket.into_missing_data) {
+        out << YAML::Key << "into_missing_data" << YAML::Value << true;
+      }
       out << YAML::EndMap;
     }
     out << YAML::EndSeq;
