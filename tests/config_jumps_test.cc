@@ -35,23 +35,6 @@ constexpr char kJumps[] = R"(jumps:
     none: true
 )";
 
-// The InputError `load` throws; fails the test when it throws none.
-template <typename Load>
-InputError ErrorOf(Load load) {
-  try {
-    load();
-  } catch (const InputError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no InputError thrown";
-  return InputError("none");
-}
-
-InputError LoadError(const ConfigDirectory& dir, const std::string& text, std::string* path) {
-  *path = dir.WriteConfig(text);
-  return ErrorOf([&] { LoadIdentifyConfig(*path); });
-}
-
 TEST(ConfigJumps, EntriesLandInJumpOverridesWithHzAsRadPerSecond) {
   const ConfigDirectory dir;
   const IdentifyConfig config = LoadIdentifyConfig(dir.WriteConfig(ConfigWith(kJumps)));

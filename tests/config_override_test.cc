@@ -17,18 +17,6 @@ using ::testing::HasSubstr;
 using ::testing::StartsWith;
 namespace fs = std::filesystem;
 
-// The InputError `load` throws; fails the test when it throws none.
-template <typename Load>
-InputError ErrorOf(Load load) {
-  try {
-    load();
-  } catch (const InputError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no InputError thrown";
-  return InputError("none");
-}
-
 InputError SetFlagError(const std::string& flag_value) {
   return ErrorOf([&] { ParseSetFlag(flag_value, "--set"); });
 }

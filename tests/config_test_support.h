@@ -7,6 +7,8 @@
 #include <fstream>
 #include <string>
 
+#include "config/identify_config.h"
+#include "estimator/input_error.h"
 #include "gtest/gtest.h"
 
 namespace dwellfit {
@@ -78,6 +80,25 @@ inline std::string Replace(std::string text, const std::string& from, const std:
   EXPECT_NE(at, std::string::npos) << from;
   if (at != std::string::npos) text.replace(at, from.size(), to);
   return text;
+}
+
+// The InputError `load` throws; fails the test when it throws none.
+template <typename Load>
+InputError ErrorOf(Load load) {
+  try {
+    load();
+  } catch (const InputError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no InputError thrown";
+  return InputError("none");
+}
+
+// The error of loading `text` written as the config of `dir` (at `*path`).
+inline InputError LoadError(const ConfigDirectory& dir, const std::string& text,
+                            std::string* path) {
+  *path = dir.WriteConfig(text);
+  return ErrorOf([&] { LoadIdentifyConfig(*path); });
 }
 
 }  // namespace dwellfit

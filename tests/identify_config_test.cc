@@ -25,13 +25,7 @@ std::vector<std::string> Names(const std::vector<SweepSelection>& selections) {
 
 // The InputError LoadIdentifyConfig throws; fails the test when it throws none.
 InputError LoadError(const std::string& path) {
-  try {
-    LoadIdentifyConfig(path);
-  } catch (const InputError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "LoadIdentifyConfig(" << path << ") threw no InputError";
-  return InputError("none");
+  return ErrorOf([&] { LoadIdentifyConfig(path); });
 }
 
 // The error of loading kValidConfig with `from` replaced by `to`.
