@@ -20,16 +20,14 @@ const std::string kThesisConfig =
 
 struct ThesisCase {
   IdentifyConfig config;
-  std::vector<Sweep> sweeps;
-  std::vector<const Sweep*> fitted;
+  ConfiguredSweeps data;
 };
 
 const ThesisCase& Thesis() {
   static const ThesisCase* thesis = [] {
     auto* c = new ThesisCase;
     c->config = LoadIdentifyConfig(kThesisConfig);
-    c->sweeps = LoadLabelledSweeps(c->config.data_files, c->config.jump_detection);
-    c->fitted = SelectSweeps(c->sweeps, c->config.fit_sweeps, kThesisConfig, "fit");
+    c->data = LoadConfiguredSweeps(c->config);
     return c;
   }();
   return *thesis;
@@ -40,7 +38,7 @@ void BM_VerticalResidualWithJacobianPerPoint(benchmark::State& state) {
   const ThesisCase& thesis = Thesis();
   ProblemBuilder builder(ProblemBuilderOptions{});
   std::vector<std::unique_ptr<ceres::CostFunction>> costs;
-  for (const Sweep* sweep : thesis.fitted) {
+  for (const Sweep* sweep : thesis.data.fitted) {
     for (const DwellPoint& point : sweep->points) costs.emplace_back(builder.MakeResidual(point));
   }
   ParameterVector p = thesis.config.identification.initial;
@@ -66,7 +64,7 @@ BENCHMARK(BM_VerticalResidualWithJacobianPerPoint)->Unit(benchmark::kMicrosecond
 void BM_ThesisNumericalWholeFit(benchmark::State& state) {
   const ThesisCase& thesis = Thesis();
   for (auto _ : state) {
-    const IdentificationResult result = Identify(thesis.fitted, thesis.config.identification);
+    const IdentificationResult result = Identify(thesis.data.fitted, thesis.config.identification);
     benchmark::DoNotOptimize(result.parameters);
     state.counters["iterations"] = result.iterations;
     state.counters["converged"] = result.converged;
@@ -82,12 +80,11 @@ void BM_ClampedBeamFit(benchmark::State& state) {
     const std::string path =
         std::string(DWELLFIT_SOURCE_DIR) + "/datasets/clamped-beam-27C/beam.yaml";
     c->config = LoadIdentifyConfig(path);
-    c->sweeps = LoadLabelledSweeps(c->config.data_files, c->config.jump_detection);
-    c->fitted = SelectSweeps(c->sweeps, c->config.fit_sweeps, path, "fit");
+    c->data = LoadConfiguredSweeps(c->config);
     return c;
   }();
   for (auto _ : state) {
-    const IdentificationResult result = Identify(beam->fitted, beam->config.identification);
+    const IdentificationResult result = Identify(beam->data.fitted, beam->config.identification);
     benchmark::DoNotOptimize(result.parameters);
     state.counters["iterations"] = result.iterations;
     state.counters["dwells"] = result.residual_blocks;

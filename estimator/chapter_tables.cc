@@ -14,9 +14,7 @@ namespace dwellfit {
 namespace {
 
 struct PairedFit {
-  std::vector<Sweep> sweeps;
-  std::vector<const Sweep*> fitted;
-  std::vector<const Sweep*> validation;
+  ConfiguredSweeps data;
   IdentificationResult with_penalty;
   IdentificationResult without_penalty;
   double omega_ref_rad_s = 0.0;
@@ -24,17 +22,14 @@ struct PairedFit {
 
 PairedFit FitBothWays(const IdentifyConfig& config) {
   PairedFit fit;
-  fit.sweeps = LoadLabelledSweeps(config.data_files, config.jump_detection);
-  ApplyJumpOverrides(config.jump_overrides, config.config_path, &fit.sweeps);
-  fit.fitted = SelectSweeps(fit.sweeps, config.fit_sweeps, config.config_path, "fit");
-  fit.validation = SelectSweeps(fit.sweeps, config.validate_sweeps, config.config_path, "validate");
+  fit.data = LoadConfiguredSweeps(config);
   IdentificationOptions with = config.identification;
   with.penalties.bifurcation_range.enabled = true;
   IdentificationOptions without = config.identification;
   without.penalties.bifurcation_range.enabled = false;
   without.penalties.branch_stability.enabled = false;
-  fit.with_penalty = Identify(fit.fitted, with);
-  fit.without_penalty = Identify(fit.fitted, without);
+  fit.with_penalty = Identify(fit.data.fitted, with);
+  fit.without_penalty = Identify(fit.data.fitted, without);
   fit.omega_ref_rad_s = config.omega_ref_rad_s.value_or(fit.with_penalty.parameters[kOmega]);
   return fit;
 }
@@ -96,8 +91,8 @@ void JumpTable(const PairedFit& fit, std::ostream& out) {
   out << "| sweep | role | jump | measured between | with penalty | error % | without penalty | "
          "error % |\n|---|---|---|---|---|---|---|---|\n";
   std::vector<double> held_out_with, held_out_without;
-  for (const auto* group : {&fit.fitted, &fit.validation}) {
-    const bool fitted = group == &fit.fitted;
+  for (const auto* group : {&fit.data.fitted, &fit.data.validation}) {
+    const bool fitted = group == &fit.data.fitted;
     for (const Sweep* sweep : *group) {
       const bool frequency = sweep->kind == SweepKind::kFrequency;
       auto shown = [frequency](double control) {

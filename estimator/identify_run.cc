@@ -62,16 +62,22 @@ std::vector<const Sweep*> SelectSweeps(const std::vector<Sweep>& sweeps,
   return selected;
 }
 
+ConfiguredSweeps LoadConfiguredSweeps(const IdentifyConfig& config) {
+  ConfiguredSweeps configured;
+  configured.sweeps = LoadLabelledSweeps(config.data_files, config.jump_detection);
+  ApplyJumpOverrides(config.jump_overrides, config.config_path, &configured.sweeps);
+  configured.fitted = SelectSweeps(configured.sweeps, config.fit_sweeps, config.config_path, "fit");
+  configured.validation =
+      SelectSweeps(configured.sweeps, config.validate_sweeps, config.config_path, "validate");
+  return configured;
+}
+
 std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::ostream& out) {
   out << "# config in effect\n" << ConfigToYaml(config) << "\n";
   auto outcome = std::make_unique<IdentifyOutcome>();
-  outcome->sweeps = LoadLabelledSweeps(config.data_files, config.jump_detection);
-  ApplyJumpOverrides(config.jump_overrides, config.config_path, &outcome->sweeps);
-  const std::vector<Sweep>& sweeps = outcome->sweeps;
-  const std::vector<const Sweep*> fitted =
-      SelectSweeps(sweeps, config.fit_sweeps, config.config_path, "fit");
-  const std::vector<const Sweep*> validation =
-      SelectSweeps(sweeps, config.validate_sweeps, config.config_path, "validate");
+  outcome->sweeps = LoadConfiguredSweeps(config);
+  const std::vector<const Sweep*>& fitted = outcome->sweeps.fitted;
+  const std::vector<const Sweep*>& validation = outcome->sweeps.validation;
   for (const Sweep* sweep : fitted) out << "fit      " << DescribeJumps(*sweep) << "\n";
   for (const Sweep* sweep : validation) out << "validate " << DescribeJumps(*sweep) << "\n";
   out << "\n";

@@ -27,10 +27,28 @@ std::vector<const Sweep*> SelectSweeps(const std::vector<Sweep>& sweeps,
                                        const std::vector<SweepSelection>& selections,
                                        const std::string& config_path, const std::string& field);
 
+// The sweeps a config names: every sweep of its data files, labelled (jump
+// detection, then the config's `jumps:`), and the fitted and validation
+// selections, which point into `sweeps` (so the struct moves, never copies).
+struct ConfiguredSweeps {
+  ConfiguredSweeps() = default;
+  ConfiguredSweeps(ConfiguredSweeps&&) = default;
+  ConfiguredSweeps& operator=(ConfiguredSweeps&&) = default;
+  ConfiguredSweeps(const ConfiguredSweeps&) = delete;
+  ConfiguredSweeps& operator=(const ConfiguredSweeps&) = delete;
+
+  std::vector<Sweep> sweeps;
+  std::vector<const Sweep*> fitted;
+  std::vector<const Sweep*> validation;
+};
+
+// Loads, labels and selects as `config` says. Throws InputError.
+ConfiguredSweeps LoadConfiguredSweeps(const IdentifyConfig& config);
+
 // What a run produced: the sweeps it read (the report points into them) and
 // the report it wrote.
 struct IdentifyOutcome {
-  std::vector<Sweep> sweeps;
+  ConfiguredSweeps sweeps;
   IdentificationReport report;
 };
 
