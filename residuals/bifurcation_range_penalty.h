@@ -91,7 +91,7 @@ class BifurcationRangePenalty {
     const double omega = control_kind_ == ControlKind::kDriveFrequency ? centre_ : held_;
     const auto k = ResponseCoefficients<T>::FromParameters(p, omega);
     const T a(a_jump_);
-    const T slack = (k.dG(a) / a) / (2.0 * k.c2());
+    const T slack = k.h(a) / (2.0 * k.c2());
     return slack > 0.0 ? slack : T(0.0);
   }
 

@@ -59,6 +59,18 @@ struct ResponseCoefficients {
     return 2.0 * (dp * dp + P(a) * (2.0 * k2) + dq * dq + Q(a) * (6.0 * k4 * a));
   }
 
+  // h(a) = (dG/da) / a = 6 c6 a^4 + 4 c4 a^2 + 3 c3 a + 2 c2, written through
+  // P and Q for conditioning; its positive roots are the turning points of G.
+  T h(const T& a) const {
+    return 2.0 *
+           ((k1 + k2 * a) * (k1 + 2.0 * k2 * a) + (k3 + k4 * a * a) * (k3 + 3.0 * k4 * a * a));
+  }
+  T dh(const T& a) const {
+    return 2.0 *
+           (3.0 * k1 * k2 + 4.0 * k2 * k2 * a + 8.0 * k3 * k4 * a + 12.0 * k4 * k4 * a * a * a);
+  }
+  T d2h(const T& a) const { return 2.0 * (4.0 * k2 * k2 + 8.0 * k3 * k4 + 36.0 * k4 * k4 * a * a); }
+
   // Coefficients of the sextic G = c6 a^6 + c4 a^4 + c3 a^3 + c2 a^2.
   T c2() const { return k1 * k1 + k3 * k3; }
   T c3() const { return 2.0 * k1 * k2; }

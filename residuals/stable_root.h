@@ -77,18 +77,14 @@ inline TurningPoints FindTurningPoints(const ResponseCoefficients<double>& k) {
   const double c4 = k.c4();
   const double c6 = k.c6();
   if (!(c6 > 0.0) || !(c4 < 0.0)) return tp;
-  // h(a) = dG/da / a, written through P and Q for conditioning, and h'(a).
   auto h = [&k](double a, double* value, double* slope) {
-    *value = 2.0 * ((k.k1 + k.k2 * a) * (k.k1 + 2.0 * k.k2 * a) +
-                    (k.k3 + k.k4 * a * a) * (k.k3 + 3.0 * k.k4 * a * a));
-    *slope = 2.0 * (3.0 * k.k1 * k.k2 + 4.0 * k.k2 * k.k2 * a + 8.0 * k.k3 * k.k4 * a +
-                    12.0 * k.k4 * k.k4 * a * a * a);
+    *value = k.h(a);
+    *slope = k.dh(a);
   };
-  // h'(a) and h''(a); h' has its minimum on a >= 0 at a_inflection.
+  // h' has its minimum on a >= 0 at a_inflection.
   auto dh = [&k](double a, double* value, double* slope) {
-    *value = 2.0 * (3.0 * k.k1 * k.k2 + 4.0 * k.k2 * k.k2 * a + 8.0 * k.k3 * k.k4 * a +
-                    12.0 * k.k4 * k.k4 * a * a * a);
-    *slope = 2.0 * (4.0 * k.k2 * k.k2 + 8.0 * k.k3 * k.k4 + 36.0 * k.k4 * k.k4 * a * a);
+    *value = k.dh(a);
+    *slope = k.d2h(a);
   };
   const double a_inflection = std::sqrt(-c4 / (9.0 * c6));
   double v, s;
@@ -209,12 +205,7 @@ namespace internal {
 //     rises on (0, r], so r is the smallest root, and stable.
 inline bool CertifiedOnBranch(const ResponseCoefficients<double>& k, double r, Branch branch) {
   if (branch == Branch::kUpper) {
-    const double h = 2.0 * ((k.k1 + k.k2 * r) * (k.k1 + 2.0 * k.k2 * r) +
-                            (k.k3 + k.k4 * r * r) * (k.k3 + 3.0 * k.k4 * r * r));
-    const double dh = 2.0 * (3.0 * k.k1 * k.k2 + 4.0 * k.k2 * k.k2 * r + 8.0 * k.k3 * k.k4 * r +
-                             12.0 * k.k4 * k.k4 * r * r * r);
-    const double d2h = 2.0 * (4.0 * k.k2 * k.k2 + 8.0 * k.k3 * k.k4 + 36.0 * k.k4 * k.k4 * r * r);
-    return h > 0.0 && dh >= 0.0 && d2h >= 0.0;
+    return k.h(r) > 0.0 && k.dh(r) >= 0.0 && k.d2h(r) >= 0.0;
   }
   if (branch == Branch::kLower) {
     return k.c3() >= 0.0 && (k.c4() >= 0.0 || 2.0 * k.c2() + 4.0 * k.c4() * r * r > 0.0);
