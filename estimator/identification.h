@@ -32,9 +32,13 @@ struct StageSummary {
   double penalty_unit = 0.0;
   int penalty_exponent = 0;  // n of eq. (3.17) in this stage (0: none)
   int residual_blocks = 0;   // dwell points fitted
-  int iterations = 0;
-  bool converged = false;      // the solver met a convergence test
-  std::string brief_report;    // ceres::Solver::Summary::BriefReport()
+  int iterations = 0;        // over the stage's solves
+  int solves = 0;            // one, and one more per bound held or released
+  bool converged = false;    // its last solve met a convergence test
+  // Bounded parameters the stage ended holding on their bound (an active
+  // set: see RunStage in identification.cc), ParameterIndex values.
+  std::vector<int> held_at_bound;
+  std::string brief_report;    // ceres::Solver::Summary::BriefReport() of its last solve
   ParameterVector parameters;  // where the stage ended
 };
 

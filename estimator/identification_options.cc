@@ -42,8 +42,8 @@ bool SolverSettings::IsValid(std::string* error) const {
     *error = "solver tolerances must be non-negative numbers";
     return false;
   }
-  if (num_threads < 1) {
-    *error = "solver.num_threads must be at least 1";
+  if (num_threads < 0) {
+    *error = "solver.num_threads must be at least 0 (0: one per hardware thread)";
     return false;
   }
   return true;

@@ -34,12 +34,19 @@ struct ResidualOptions {
 
 struct SolverSettings {
   int max_iterations = 200;
-  // Convergence tests of ceres::Solver::Options. The defaults are tight
-  // because parameters span nine orders of magnitude (see ProblemBuilder).
-  double function_tolerance = 1e-14;
+  // Convergence tests of ceres::Solver::Options. The gradient and parameter
+  // tests are off in effect: parameters span nine orders of magnitude (see
+  // ProblemBuilder). A relative cost change of 1e-8 resolves a fit far below
+  // its statistics (noise moves the cost by about 1/N of itself), and exact
+  // data still converge to round-off, their cost falling by decades a step;
+  // tighter, measured data only creep along their weakly determined
+  // directions (the beam's delta-alpha valley).
+  double function_tolerance = 1e-8;
   double gradient_tolerance = 1e-30;
   double parameter_tolerance = 1e-20;
-  int num_threads = 1;
+  // Threads that evaluate the residual blocks (ParallelResidualEvaluator),
+  // 0 for one per hardware thread. Results do not depend on it.
+  int num_threads = 0;
   // Let the trust region accept steps that raise the cost for a while
   // (ceres::Solver::Options::use_nonmonotonic_steps): faster along the
   // narrow valleys of measured data with penalties.

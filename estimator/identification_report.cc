@@ -129,6 +129,10 @@ std::string ReportToYaml(const IdentificationReport& report) {
       out << YAML::Key << "penalty_exponent" << YAML::Value << stage.penalty_exponent;
     }
     out << YAML::Key << "iterations" << YAML::Value << stage.iterations;
+    out << YAML::Key << "solves" << YAML::Value << stage.solves;
+    out << YAML::Key << "held_at_bound" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (int index : stage.held_at_bound) out << ParameterName(index);
+    out << YAML::EndSeq;
     out << YAML::Key << "converged" << YAML::Value << stage.converged;
     out << YAML::Key << "solver" << YAML::Value << stage.brief_report;
     out << YAML::EndMap;
@@ -202,7 +206,14 @@ void PrintReport(const IdentificationReport& report, std::ostream& out) {
   for (const StageSummary& stage : result.stages) {
     out << ResidualKindName(stage.residual);
     if (stage.penalty_unit > 0.0) out << " + penalties (exponent " << stage.penalty_exponent << ")";
-    out << " stage: " << stage.brief_report << "\n";
+    char costs[64];
+    std::snprintf(costs, sizeof(costs), "%.7g -> %.7g", stage.initial_cost, stage.final_cost);
+    out << " stage: cost " << costs << ", " << stage.iterations << " iterations";
+    if (stage.solves > 1) out << " in " << stage.solves << " solves";
+    for (size_t i = 0; i < stage.held_at_bound.size(); ++i) {
+      out << (i == 0 ? ", held at bound: " : ", ") << ParameterName(stage.held_at_bound[i]);
+    }
+    out << "\n  last solve: " << stage.brief_report << "\n";
   }
   char line[256];
   out << "\n";

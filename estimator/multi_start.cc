@@ -7,6 +7,8 @@
 #include <random>
 #include <thread>
 
+#include "estimator/parallel_residual_evaluator.h"
+
 namespace dwellfit {
 
 bool MultiStartOptions::IsValid(std::string* error) const {
@@ -61,16 +63,22 @@ MultiStartResult IdentifyMultiStart(const std::vector<const Sweep*>& fitted,
   result.starts = MultiStartPoints(options, automatic, multi_start);
   const int n = static_cast<int>(result.starts.size());
   std::vector<IdentificationResult> fits(n);
+  const int parallel_starts = std::min(multi_start.threads, n);
+  // The starts share the machine's threads (the result does not depend on
+  // how many evaluate each start's residuals).
+  IdentificationOptions per_start = options;
+  per_start.solver.num_threads =
+      std::max(1, ResolveThreadCount(options.solver.num_threads) / std::max(parallel_starts, 1));
   std::atomic<int> next{0};
   auto worker = [&]() {
     for (int i = next++; i < n; i = next++) {
-      IdentificationOptions start = options;
+      IdentificationOptions start = per_start;
       start.initial = result.starts[i];
       fits[i] = Identify(fitted, start);
     }
   };
   std::vector<std::thread> pool;
-  for (int t = 1; t < std::min(multi_start.threads, n); ++t) pool.emplace_back(worker);
+  for (int t = 1; t < parallel_starts; ++t) pool.emplace_back(worker);
   worker();
   for (std::thread& thread : pool) thread.join();
 

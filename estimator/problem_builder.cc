@@ -47,10 +47,19 @@ ceres::CostFunction* ProblemBuilder::MakeResidual(const DwellPoint& point) const
                                        options_.residual_options.amplitude_floor);
 }
 
-int ProblemBuilder::AddSweep(const Sweep& sweep, double* parameters,
-                             ceres::Problem* problem) const {
+namespace {
+
+// `cost` as the problem receives it: through `evaluator` when there is one.
+ceres::CostFunction* Evaluated(ceres::CostFunction* cost, ParallelResidualEvaluator* evaluator) {
+  return evaluator != nullptr ? evaluator->Wrap(cost) : cost;
+}
+
+}  // namespace
+
+int ProblemBuilder::AddSweep(const Sweep& sweep, double* parameters, ceres::Problem* problem,
+                             ParallelResidualEvaluator* evaluator) const {
   for (const DwellPoint& point : sweep.points) {
-    problem->AddResidualBlock(MakeResidual(point), nullptr, parameters);
+    problem->AddResidualBlock(Evaluated(MakeResidual(point), evaluator), nullptr, parameters);
   }
   return static_cast<int>(sweep.points.size());
 }
@@ -76,8 +85,8 @@ ceres::CostFunction* MakeBifurcationRangePenalty(const Sweep& sweep, const JumpB
       jump.control_after, jump.amplitude_before, options.exponent, options.weight);
 }
 
-int ProblemBuilder::AddPenalties(const Sweep& sweep, double* parameters,
-                                 ceres::Problem* problem) const {
+int ProblemBuilder::AddPenalties(const Sweep& sweep, double* parameters, ceres::Problem* problem,
+                                 ParallelResidualEvaluator* evaluator) const {
   int blocks = 0;
   const BifurcationRangeOptions& range = options_.penalties.bifurcation_range;
   if (range.enabled) {
@@ -86,8 +95,9 @@ int ProblemBuilder::AddPenalties(const Sweep& sweep, double* parameters,
       if (std::find(range.enforce.begin(), range.enforce.end(), target) == range.enforce.end()) {
         continue;
       }
-      problem->AddResidualBlock(MakeBifurcationRangePenalty(sweep, jump, range), nullptr,
-                                parameters);
+      problem->AddResidualBlock(
+          Evaluated(MakeBifurcationRangePenalty(sweep, jump, range), evaluator), nullptr,
+          parameters);
       ++blocks;
     }
   }
@@ -99,8 +109,9 @@ int ProblemBuilder::AddPenalties(const Sweep& sweep, double* parameters,
     for (const DwellPoint& point : sweep.points) {
       if (point.branch == Branch::kOnly) continue;
       problem->AddResidualBlock(
-          BranchStabilityPenalty::Create(point.drive_frequency_rad_s, point.amplitude, point.branch,
-                                         lambda, stability.weight),
+          Evaluated(BranchStabilityPenalty::Create(point.drive_frequency_rad_s, point.amplitude,
+                                                   point.branch, lambda, stability.weight),
+                    evaluator),
           nullptr, parameters);
       ++blocks;
     }

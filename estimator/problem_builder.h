@@ -20,6 +20,7 @@
 
 #include "ceres/problem.h"
 #include "estimator/identification_options.h"
+#include "estimator/parallel_residual_evaluator.h"
 #include "estimator/sweep.h"
 #include "residuals/model_parameters.h"
 
@@ -48,13 +49,17 @@ class ProblemBuilder {
 
   // Adds one residual block per dwell of `sweep`, each reading the 6-double
   // block `parameters` (owned by the caller, must outlive `problem`).
-  // Returns the number of residual blocks added.
-  int AddSweep(const Sweep& sweep, double* parameters, ceres::Problem* problem) const;
+  // Returns the number of residual blocks added. With an `evaluator` (the
+  // problem's evaluation callback, reading `parameters`) the blocks are
+  // evaluated through it, on its threads.
+  int AddSweep(const Sweep& sweep, double* parameters, ceres::Problem* problem,
+               ParallelResidualEvaluator* evaluator = nullptr) const;
 
   // Adds the enabled penalties for `sweep`: one BifurcationRangePenalty per
   // measured jump whose target is enforced, one BranchStabilityPenalty per
   // dwell labelled lower or upper. Returns the number of blocks added.
-  int AddPenalties(const Sweep& sweep, double* parameters, ceres::Problem* problem) const;
+  int AddPenalties(const Sweep& sweep, double* parameters, ceres::Problem* problem,
+                   ParallelResidualEvaluator* evaluator = nullptr) const;
 
   // Sets bounds (eta_e >= 0; mu1, mu2 >= 0 unless !bound_damping), fixed parameters and scaling on
   // the block. Call once, after the block has residuals in `problem`.

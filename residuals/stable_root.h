@@ -197,20 +197,35 @@ inline StableRoot SolveStableRoot(const ResponseCoefficients<double>& k, double 
 namespace internal {
 
 // Certificate that a root r > 0 of G = a_base^2 lies on `branch`, from the
-// quartic h = (dG/da)/a = 6 c6 a^4 + 4 c4 a^2 + 3 c3 a + 2 c2 (c2, c6 >= 0):
-//   upper: h(r) > 0, h'(r) >= 0 and h''(r) >= 0. Since h'' = 72 c6 a^2 + 8 c4
-//     grows with a, h' and then h grow on [r, inf): G rises past r, so r is
-//     the largest root, and stable.
-//   lower (c3 >= 0): h(a) >= 2 c2 + 4 c4 r^2 on [0, r]; when that is > 0, G
-//     rises on (0, r], so r is the smallest root, and stable.
+// quartic h = (dG/da)/a = 6 c6 a^4 + 4 c4 a^2 + 3 c3 a + 2 c2 (c2, c6 >= 0).
+// Where c3 >= 0 (mu1 mu2 >= 0), h >= 2 c2 + 3 c3 a_min + min q over an
+// interval starting at a_min, q(a) = 6 c6 a^4 + 4 c4 a^2, whose minimum on
+// a >= 0 is -(2/3) c4^2 / c6 at a^2 = -c4 / (3 c6) when c4 < 0:
+//   upper: h > 0 on [r, inf) (bound with a_min = r), so G rises past r: r
+//     is the largest root, and stable. Failing that, h(r) > 0, h'(r) >= 0
+//     and h''(r) >= 0 also suffice: h'' = 72 c6 a^2 + 8 c4 grows with a, so
+//     h' and then h grow on [r, inf).
+//   lower: h > 0 on (0, r] (bound with a_min = 0), so G rises on (0, r]: r
+//     is the smallest root, and stable.
 inline bool CertifiedOnBranch(const ResponseCoefficients<double>& k, double r, Branch branch) {
+  if (branch != Branch::kUpper && branch != Branch::kLower) return false;
+  const double c2 = k.c2();
+  const double c3 = k.c3();
+  const double c4 = k.c4();
+  const double c6 = k.c6();
+  auto q = [c4, c6](double a) { return (6.0 * c6 * a * a + 4.0 * c4) * a * a; };
+  // a^2 where q has its minimum on a >= 0 (0 when q only grows).
+  const double a2_min = c4 < 0.0 && c6 > 0.0 ? -c4 / (3.0 * c6) : 0.0;
   if (branch == Branch::kUpper) {
+    if (c3 >= 0.0) {
+      const double q_min = r * r >= a2_min ? q(r) : q(std::sqrt(a2_min));
+      if (2.0 * c2 + 3.0 * c3 * r + q_min > 0.0) return true;
+    }
     return k.h(r) > 0.0 && k.dh(r) >= 0.0 && k.d2h(r) >= 0.0;
   }
-  if (branch == Branch::kLower) {
-    return k.c3() >= 0.0 && (k.c4() >= 0.0 || 2.0 * k.c2() + 4.0 * k.c4() * r * r > 0.0);
-  }
-  return false;
+  if (!(c3 >= 0.0)) return false;
+  const double q_min = r * r <= a2_min ? q(r) : q(std::sqrt(a2_min));
+  return 2.0 * c2 + q_min > 0.0;
 }
 
 }  // namespace internal

@@ -24,9 +24,16 @@
 // branch does not reach a_base_i at the current parameters, a_model is the
 // turning point where that branch ends (dG/da = 0), the continuous extension
 // of the branch, so the residual stays continuous as a fold moves past a point.
+//
+// Warm start: the Newton iteration starts from this dwell's root at its last
+// evaluation (from a_i at the first), which is near the new root while a
+// solver steps. The start only saves iterations: whether the root found is on
+// the dwell's branch is decided by a certificate (stable_root.h), and the
+// value agrees with a cold start to the last bits.
 #ifndef DWELLFIT_RESIDUALS_VERTICAL_ERROR_RESIDUAL_H_
 #define DWELLFIT_RESIDUALS_VERTICAL_ERROR_RESIDUAL_H_
 
+#include <atomic>
 #include <cmath>
 
 #include "ceres/autodiff_cost_function.h"
@@ -58,10 +65,14 @@ class VerticalErrorResidual {
   template <typename T>
   bool operator()(const T* const parameters, T* residual) const {
     const auto k = ResponseCoefficients<T>::FromParameters(parameters, drive_frequency_rad_s_);
-    const StableRoot root =
-        SolveStableRootNear(ScalarCoefficients(k), a_base_, branch_, a_measured_);
+    const double last_root = last_root_.load(std::memory_order_relaxed);
+    const StableRoot root = SolveStableRootNear(ScalarCoefficients(k), a_base_, branch_,
+                                                last_root > 0.0 ? last_root : a_measured_);
     // Undefined evaluation: no finite root (non-finite parameters, eta_e = 0).
     if (root.status == RootStatus::kFailed) return false;
+    if (root.status == RootStatus::kOnBranch) {
+      last_root_.store(root.a, std::memory_order_relaxed);
+    }
     const T a_model = LiftRoot(k, a_base_, root);
     if (error_ == ErrorMeasure::kAbsolute) {
       residual[0] = weight_ * (a_measured_ - a_model);
@@ -90,6 +101,9 @@ class VerticalErrorResidual {
   const ErrorMeasure error_;
   const double weight_;
   const double amplitude_floor_;  // f, the data's amplitude unit
+  // The root at the last evaluation (0: none yet): the next Newton start.
+  // Atomic so that concurrent evaluations stay well defined.
+  mutable std::atomic<double> last_root_{0.0};
 };
 
 }  // namespace dwellfit
