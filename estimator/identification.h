@@ -9,6 +9,8 @@
 // data determine (on exact data it vanishes). The default is [algebraic, vertical]: the algebraic
 // residual of eq. (3.11) is smooth and branch-free and so lands near the minimum from a rough
 // start; the vertical error, which respects branches and stability, then converges from there.
+// Within a stage the bounds eta_e, mu1, mu2 >= 0 are an active set: a parameter resting on its
+// bound is held there, and released if the cost falls as it leaves (RunStage in the .cc).
 #ifndef DWELLFIT_ESTIMATOR_IDENTIFICATION_H_
 #define DWELLFIT_ESTIMATOR_IDENTIFICATION_H_
 

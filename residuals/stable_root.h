@@ -216,14 +216,15 @@ inline bool CertifiedOnBranch(const ResponseCoefficients<double>& k, double r, B
   auto q = [c4, c6](double a) { return (6.0 * c6 * a * a + 4.0 * c4) * a * a; };
   // a^2 where q has its minimum on a >= 0 (0 when q only grows).
   const double a2_min = c4 < 0.0 && c6 > 0.0 ? -c4 / (3.0 * c6) : 0.0;
+  // (c6 = k4^2 = 0 makes c4 = k2^2 >= 0: q never falls without bound.)
   if (branch == Branch::kUpper) {
-    if (c3 >= 0.0) {
+    if (c3 >= 0.0 && (c6 > 0.0 || c4 >= 0.0)) {
       const double q_min = r * r >= a2_min ? q(r) : q(std::sqrt(a2_min));
       if (2.0 * c2 + 3.0 * c3 * r + q_min > 0.0) return true;
     }
     return k.h(r) > 0.0 && k.dh(r) >= 0.0 && k.d2h(r) >= 0.0;
   }
-  if (!(c3 >= 0.0)) return false;
+  if (!(c3 >= 0.0) || !(c6 > 0.0 || c4 >= 0.0)) return false;
   const double q_min = r * r <= a2_min ? q(r) : q(std::sqrt(a2_min));
   return 2.0 * c2 + q_min > 0.0;
 }

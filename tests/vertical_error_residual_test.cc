@@ -135,6 +135,46 @@ TEST(VerticalErrorResidual, BranchEndExtensionIsContinuousAndDifferentiable) {
   EXPECT_NEAR(Evaluate(*below, Truth()), Evaluate(*above, Truth()), 1e-7);
 }
 
+// Each functor starts its Newton iteration from its root at the last
+// evaluation. Along a path on which the upper branch at 42.2 Hz ends and comes
+// back (alpha lowered and raised moves the jump-down across the dwell), and
+// for the lower branch and the single-valued region, the warm-started
+// residual and Jacobian equal those of a fresh functor at every point.
+TEST(VerticalErrorResidual, WarmStartGivesTheColdStartValueAlongAPathAcrossAFold) {
+  const std::vector<Dwell> dwells = {OnBranch(42.2, 0.01, Branch::kUpper, 0.003),
+                                     OnBranch(42.2, 0.01, Branch::kLower, -0.003),
+                                     OnBranch(38.0, 0.01, Branch::kOnly, 0.05)};
+  const std::vector<double> alpha_factors = {1.0, 0.99, 0.95, 0.9, 1.05, 1.3, 1.0, 0.97, 1.0};
+  for (const Dwell& d : dwells) {
+    SCOPED_TRACE(BranchName(d.branch));
+    std::unique_ptr<ceres::CostFunction> warm(VerticalErrorResidual::Create(
+        d.omega, d.a_base, d.a, d.branch, ErrorMeasure::kRelative, 1.0));
+    int branch_ends = 0;
+    for (double factor : alpha_factors) {
+      ParameterVector p = Truth();
+      p[kAlpha] *= factor;
+      std::unique_ptr<ceres::CostFunction> cold(VerticalErrorResidual::Create(
+          d.omega, d.a_base, d.a, d.branch, ErrorMeasure::kRelative, 1.0));
+      const double* blocks[] = {p.data()};
+      double warm_residual, cold_residual;
+      double warm_jacobian[kNumParameters], cold_jacobian[kNumParameters];
+      double* warm_jacobians[] = {warm_jacobian};
+      double* cold_jacobians[] = {cold_jacobian};
+      ASSERT_TRUE(warm->Evaluate(blocks, &warm_residual, warm_jacobians));
+      ASSERT_TRUE(cold->Evaluate(blocks, &cold_residual, cold_jacobians));
+      EXPECT_NEAR(warm_residual, cold_residual, 1e-12) << "alpha x " << factor;
+      for (int j = 0; j < kNumParameters; ++j) {
+        EXPECT_NEAR(warm_jacobian[j], cold_jacobian[j], 1e-9 * std::abs(cold_jacobian[j]) + 1e-300)
+            << ParameterName(j) << ", alpha x " << factor;
+      }
+      const StableRoot root = ModelAmplitude(p, d.omega, d.a_base, d.branch, d.a);
+      branch_ends += root.status == RootStatus::kBranchEnd;
+    }
+    // The path does cross the fold for the upper branch.
+    if (d.branch == Branch::kUpper) EXPECT_GT(branch_ends, 0);
+  }
+}
+
 TEST(AlgebraicResidual, VanishesAtTheTruthAndPassesTheGradientChecker) {
   const Dwell d = OnBranch(41.5, 0.02, Branch::kUpper, 0.0);
   std::unique_ptr<ceres::CostFunction> exact(
