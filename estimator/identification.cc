@@ -28,7 +28,6 @@ ceres::Solver::Options MakeSolverOptions(const SolverSettings& settings) {
   options.num_threads = 1;
   options.logging_type = ceres::SILENT;
   options.minimizer_progress_to_stdout = false;
-
   options.use_nonmonotonic_steps = settings.nonmonotonic_steps;
   // Ceres' default of 5 cuts the non-monotonic excursions short on the
   // narrow valleys of measured data with penalties.
@@ -50,6 +49,8 @@ bool PenaltiesEnabled(const PenaltyOptions& penalties) {
 
 // Successful steps a parameter sits on its bound before it is held there.
 constexpr int kStepsAtBoundBeforeHolding = 5;
+// Solves in one stage at the most (see RunStage).
+constexpr int kMaxSolvesPerStage = 12;
 
 // One solve's problem on `parameters`: the data of the fitted sweeps, then
 // (AddPenalties) the penalties, evaluated on the evaluator's threads.
@@ -202,14 +203,15 @@ StageSummary RunStage(const std::vector<const Sweep*>& fitted, const Identificat
     stage.converged = summary.termination_type == ceres::CONVERGENCE;
     stage.brief_report = summary.BriefReport();
     stage.final_data_cost = problem.DataCost();
-    const bool usable = summary.IsSolutionUsable();
-    if (usable && problem.resting()) {
+    // Each of the three bounded parameters is held at most twice and
+    // released at most once, so this bound is never reached in practice.
+    if (!summary.IsSolutionUsable() || round + 1 >= kMaxSolvesPerStage) break;
+    if (problem.resting()) {
       held[*problem.resting()] = true;
       VLOG(1) << ResidualKindName(kind) << " stage: holding " << ParameterName(*problem.resting())
               << " at its bound";
       continue;
     }
-    if (!usable || round > 2 * kNumParameters) break;
     // A held parameter's bound stays active while the cost rises as it
     // leaves the bound: d cost / d p_i >= 0 at p_i = 0.
     std::vector<double> gradient;

@@ -110,8 +110,8 @@ TEST_F(ClampedBeamIdentification, Mu2IsHeldOnItsBoundWhereTheCostPushesItOutward
   }
   double cost = 0.0;
   std::vector<double> gradient;
-  ASSERT_TRUE(problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, &gradient,
-                               nullptr));
+  ASSERT_TRUE(
+      problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, &gradient, nullptr));
   std::cout << "stage cost " << cost << ", d cost / d mu2 " << gradient[kMu2] << "\n";
   EXPECT_NEAR(cost, held_stage->final_cost, 1e-6 * cost);
   EXPECT_GT(gradient[kMu2], 0.0);
@@ -128,8 +128,7 @@ TEST_F(ClampedBeamIdentification, SameMinimumWithoutNonmonotonicStepsOrTheAlgebr
   vertical_only.stages = {ResidualKind::kVertical};
   for (const IdentificationOptions& options : {monotonic, vertical_only}) {
     const IdentificationResult fit = Identify(data_->fitted, options);
-    std::cout << "final cost " << fit.final_cost << " against " << committed_->final_cost
-              << "\n";
+    std::cout << "final cost " << fit.final_cost << " against " << committed_->final_cost << "\n";
     EXPECT_TRUE(fit.converged);
     EXPECT_NEAR(fit.final_cost, committed_->final_cost, 1e-4 * committed_->final_cost);
     EXPECT_NEAR(fit.parameters[kOmega], committed_->parameters[kOmega],

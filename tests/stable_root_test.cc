@@ -124,9 +124,7 @@ TEST(SolveStableRootNear, AgreesWithTheSafeguardedSolverEverywhere) {
 TEST(SolveStableRootNear, AgreesWithTheSafeguardedSolverOnRandomModels) {
   std::mt19937_64 generator(20261122);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  auto log_uniform = [&](double lo, double hi) {
-    return lo * std::pow(hi / lo, unit(generator));
-  };
+  auto log_uniform = [&](double lo, double hi) { return lo * std::pow(hi / lo, unit(generator)); };
   int cases = 0;
   int certified = 0;
   for (int model = 0; model < 400; ++model) {
@@ -149,8 +147,8 @@ TEST(SolveStableRootNear, AgreesWithTheSafeguardedSolverOnRandomModels) {
         const StableRoot near = SolveStableRootNear(k, a_base, branch, guess);
         ++cases;
         ASSERT_EQ(near.status, full.status) << "model " << model << ", " << BranchName(branch);
-        EXPECT_NEAR(near.a, full.a, 1e-12 * full.a) << "model " << model << ", "
-                                                    << BranchName(branch);
+        EXPECT_NEAR(near.a, full.a, 1e-12 * full.a)
+            << "model " << model << ", " << BranchName(branch);
         certified += internal::CertifiedOnBranch(k, near.a, branch);
       }
     }

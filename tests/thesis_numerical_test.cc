@@ -50,6 +50,25 @@ TEST_F(ThesisNumerical, CommittedConfigStartsAtTheFirstStartOfTheIssue) {
   EXPECT_EQ(validation_.size(), 4u);
 }
 
+// The active set's release: from eta_e at half its value the vertical error
+// first pushes mu1 onto its bound 0, where the stage holds it; the reduced
+// solve converges (mu2 takes all the damping), the cost gradient then points
+// back into mu1 > 0, the stage releases mu1 and a third solve reaches the
+// truth with nothing held.
+TEST_F(ThesisNumerical, AParameterHeldOnItsBoundIsReleasedWhenTheCostPullsItBack) {
+  IdentificationOptions options = StartAt({0.5, 1.0, 1.0, 1.0, 1.0});
+  options.stages = {ResidualKind::kVertical};
+  const IdentificationResult result = Identify(fitted_, options);
+  ASSERT_EQ(result.stages.size(), 1u);
+  const StageSummary& stage = result.stages.front();
+  EXPECT_EQ(stage.solves, 3);  // held, reduced, released
+  EXPECT_TRUE(stage.held_at_bound.empty());
+  EXPECT_TRUE(result.converged);
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_NEAR(result.parameters[i] / kTruth[i], 1.0, 1e-6) << ParameterName(i);
+  }
+}
+
 TEST_F(ThesisNumerical, BothStartsRecoverTheTruthAndPredictTheValidationSweeps) {
   for (const std::vector<double>& factors : {std::vector<double>{1.3, 0.7, 1.3, 0.7, 1.3},
                                              std::vector<double>{0.7, 1.3, 0.7, 1.3, 0.7}}) {
