@@ -98,14 +98,11 @@ ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_f
 }
 
 void ParallelResidualEvaluator::PrepareForEvaluation(bool /*evaluate_jacobians*/,
-                                                     bool new_evaluation_point) {
-  // The same point again (as Ceres says, or as a line search's trial step
-  // and the trust-region candidate are): the values, Jacobians included,
-  // are already there.
-  const bool same_point =
-      computed_ && std::equal(last_point_.begin(), last_point_.end(), parameters_);
-  if (same_point || (!new_evaluation_point && computed_)) return;
-  // Ceres has copied the point into the caller's block.
+                                                     bool /*new_evaluation_point*/) {
+  // Ceres has copied the point into the caller's block. The same point again
+  // (the Jacobian at an accepted step, a line search's trial step and the
+  // trust-region candidate): the values, Jacobians included, are there.
+  if (computed_ && std::equal(last_point_.begin(), last_point_.end(), parameters_)) return;
   PrecomputeAll(parameters_);
 }
 

@@ -5,10 +5,10 @@
 // and gradient in per-thread partial sums whose membership follows the
 // scheduling, so their last bits, and with them a trust-region path that is
 // sensitive to last bits, vary from run to run; on this problem (thousands
-// of one-row blocks) it is also no faster, as the threads contend for those
-// sums. Here Ceres runs on one thread and this class, its EvaluationCallback,
-// evaluates every wrapped cost function at each new point in fixed
-// contiguous chunks, one per thread. Each block's residual and Jacobian come
+// of one-row blocks) it was also no faster (the measured-beam fit: 0.78 s on
+// two threads, 0.76 s on one). Here Ceres runs on one thread and this class,
+// its EvaluationCallback, evaluates every wrapped cost function at each new
+// point in fixed contiguous chunks, one per thread. Each block's residual and Jacobian come
 // from the same code whatever the thread count, and Ceres sums them in block
 // order, so the solve does not depend on the number of threads.
 //
