@@ -25,11 +25,13 @@
 // turning point where that branch ends (dG/da = 0), the continuous extension
 // of the branch, so the residual stays continuous as a fold moves past a point.
 //
-// Warm start: the Newton iteration starts from this dwell's root at its last
-// evaluation (from a_i at the first), which is near the new root while a
-// solver steps. The start only saves iterations: whether the root found is on
-// the dwell's branch is decided by a certificate (stable_root.h), and the
-// value agrees with a cold start to the last bits.
+// Warm start: on a labelled branch (kLower, kUpper) the Newton iteration
+// starts from this dwell's root at its last evaluation (from a_i at the
+// first), which is near the new root while a solver steps. The start only
+// saves iterations: whether the root found is on the dwell's branch is decided
+// by a certificate (stable_root.h), and the value agrees with a cold start to
+// the last bits. A kOnly dwell always starts from a_i, since it takes the
+// stable root nearest a_i where there are two.
 #ifndef DWELLFIT_RESIDUALS_VERTICAL_ERROR_RESIDUAL_H_
 #define DWELLFIT_RESIDUALS_VERTICAL_ERROR_RESIDUAL_H_
 
@@ -65,9 +67,10 @@ class VerticalErrorResidual {
   template <typename T>
   bool operator()(const T* const parameters, T* residual) const {
     const auto k = ResponseCoefficients<T>::FromParameters(parameters, drive_frequency_rad_s_);
+    // kOnly picks the stable root nearest its guess: that stays a_i.
     const double last_root = last_root_.load(std::memory_order_relaxed);
-    const StableRoot root = SolveStableRootNear(ScalarCoefficients(k), a_base_, branch_,
-                                                last_root > 0.0 ? last_root : a_measured_);
+    const double start = branch_ != Branch::kOnly && last_root > 0.0 ? last_root : a_measured_;
+    const StableRoot root = SolveStableRootNear(ScalarCoefficients(k), a_base_, branch_, start);
     // Undefined evaluation: no finite root (non-finite parameters, eta_e = 0).
     if (root.status == RootStatus::kFailed) return false;
     if (root.status == RootStatus::kOnBranch) {

@@ -141,10 +141,16 @@ TEST(VerticalErrorResidual, BranchEndExtensionIsContinuousAndDifferentiable) {
 // for the lower branch and the single-valued region, the warm-started
 // residual and Jacobian equal those of a fresh functor at every point.
 TEST(VerticalErrorResidual, WarmStartGivesTheColdStartValueAlongAPathAcrossAFold) {
+  // The last dwell is labelled only (no jump seen) inside the bistable band,
+  // measured on the upper branch: wherever the model has both roots it takes
+  // the one nearer the measured amplitude, not the one it had last.
+  Dwell only_in_band = OnBranch(41.5, 0.02, Branch::kUpper, 0.01);
+  only_in_band.branch = Branch::kOnly;
   const std::vector<Dwell> dwells = {OnBranch(42.2, 0.01, Branch::kUpper, 0.003),
                                      OnBranch(42.2, 0.01, Branch::kLower, -0.003),
-                                     OnBranch(38.0, 0.01, Branch::kOnly, 0.05)};
-  const std::vector<double> alpha_factors = {1.0, 0.99, 0.95, 0.9, 1.05, 1.3, 1.0, 0.97, 1.0};
+                                     OnBranch(38.0, 0.01, Branch::kOnly, 0.05), only_in_band};
+  const std::vector<double> alpha_factors = {1.0, 0.99, 0.95, 0.9, 1.05, 1.3,
+                                             1.0, 0.97, 0.1,  0.3, 1.0};
   for (const Dwell& d : dwells) {
     SCOPED_TRACE(BranchName(d.branch));
     std::unique_ptr<ceres::CostFunction> warm(VerticalErrorResidual::Create(
