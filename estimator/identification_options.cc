@@ -43,7 +43,7 @@ bool SolverSettings::IsValid(std::string* error) const {
     return false;
   }
   if (num_threads < 0) {
-    *error = "solver.num_threads must be at least 0 (0: one per hardware thread)";
+    *error = "solver.num_threads must be at least 0 (0: one per processor available)";
     return false;
   }
   return true;

@@ -45,7 +45,8 @@ struct SolverSettings {
   double gradient_tolerance = 1e-30;
   double parameter_tolerance = 1e-20;
   // Threads that evaluate the residual blocks (ParallelResidualEvaluator),
-  // 0 for one per hardware thread. Results do not depend on it.
+  // 0 for one per processor this process may run on. Results do not depend
+  // on it.
   int num_threads = 0;
   // Let the trust region accept steps that raise the cost for a while
   // (ceres::Solver::Options::use_nonmonotonic_steps): faster along the

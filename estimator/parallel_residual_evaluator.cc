@@ -1,7 +1,8 @@
 #include "estimator/parallel_residual_evaluator.h"
 
+#include <omp.h>
+
 #include <algorithm>
-#include <thread>
 
 #include "glog/logging.h"
 
@@ -16,7 +17,9 @@ constexpr int kMinBlocksPerThread = 256;
 
 int ResolveThreadCount(int num_threads) {
   if (num_threads > 0) return num_threads;
-  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  // The processors this process may run on (its affinity mask), not every
+  // processor of the host.
+  return std::max(1, omp_get_num_procs());
 }
 
 // Owns one wrapped cost function and the values it had at the last point the

@@ -37,7 +37,7 @@
 namespace dwellfit {
 
 // The number of threads a `num_threads` setting means: itself when positive,
-// one per hardware thread for 0.
+// for 0 one per processor this process may run on.
 int ResolveThreadCount(int num_threads);
 
 class ParallelResidualEvaluator : public ceres::EvaluationCallback {

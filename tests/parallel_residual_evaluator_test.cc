@@ -359,7 +359,7 @@ TEST(ParallelResidualEvaluator, FailureOfAWrappedFunctionIsReplayed) {
   EXPECT_EQ(evaluator.evaluated_directly(), 0);
 }
 
-// A positive thread count is itself; 0 is one per hardware thread, at least 1.
+// A positive thread count is itself; 0 is one per processor available, at least 1.
 TEST(ParallelResidualEvaluator, ResolveThreadCount) {
   EXPECT_EQ(ResolveThreadCount(3), 3);
   EXPECT_EQ(ResolveThreadCount(1), 1);
