@@ -75,21 +75,25 @@ YAML::Node ListWithout(const YAML::Node& list, const YAML::Node& to_remove,
 
 }  // namespace
 
-ConfigSource ConfigSource::Load(const std::string& path) {
+ConfigSource ConfigSource::Load(const std::string& path, const std::string& kind) {
   std::error_code error;
   if (std::filesystem::is_directory(path, error)) {
-    throw InputError(path, 0, "", "is a directory; give the path of the YAML config file");
+    throw InputError(path, 0, "", "is a directory; give the path of the YAML " + kind);
   }
   std::ifstream stream(path);
   if (!stream) {
-    throw InputError(path, 0, "", "cannot open the config file; check the path");
+    throw InputError(path, 0, "", "cannot open the " + kind + "; check the path");
   }
   std::stringstream text;
   text << stream.rdbuf();
+  return Parse(path, text.str());
+}
+
+ConfigSource ConfigSource::Parse(const std::string& file, const std::string& yaml_text) {
   try {
-    return ConfigSource(path, YAML::Load(text.str()));
+    return ConfigSource(file, YAML::Load(yaml_text));
   } catch (const YAML::ParserException& e) {
-    throw InputError(path, OneBasedLine(e.mark), "", "YAML syntax error: " + e.msg);
+    throw InputError(file, OneBasedLine(e.mark), "", "YAML syntax error: " + e.msg);
   }
 }
 

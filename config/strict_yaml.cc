@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <utility>
 
 namespace dwellfit {
@@ -45,6 +46,22 @@ std::size_t EditDistance(const std::string& a, const std::string& b) {
 // The text without a leading '+', which std::from_chars does not accept.
 std::string WithoutPlus(const std::string& text) {
   return !text.empty() && text[0] == '+' ? text.substr(1) : text;
+}
+
+// `value` read as a Number by std::from_chars (a leading '+' allowed). The
+// error names `kind` for a value that is not a single one, else `expected`.
+template <typename Number>
+Number ReadNumber(const ConfigValue& value, const ConfigSource& source, const std::string& kind,
+                  const std::string& expected) {
+  const std::string& text = ScalarText(value, source, kind);
+  const std::string digits = WithoutPlus(text);
+  Number number = 0;
+  const char* end = digits.data() + digits.size();
+  const auto [stop, error] = std::from_chars(digits.data(), end, number);
+  if (error != std::errc() || stop != end) {
+    throw source.Error(value.path, value.mark, "expected " + expected + ", got '" + text + "'");
+  }
+  return number;
 }
 
 }  // namespace
@@ -108,32 +125,22 @@ ConfigValue StrictMap::Required(const std::string& key, const std::string& hint)
 }
 
 double ReadFiniteDouble(const ConfigValue& value, const ConfigSource& source) {
-  const std::string& text = ScalarText(value, source, "a number");
-  const std::string digits = WithoutPlus(text);
-  double number = 0.0;
-  const char* end = digits.data() + digits.size();
-  const auto [stop, error] = std::from_chars(digits.data(), end, number);
-  if (error != std::errc() || stop != end) {
-    throw source.Error(value.path, value.mark,
-                       "expected a number (e.g. 130, 0.26 or 1.3e4), got '" + text + "'");
-  }
+  const double number =
+      ReadNumber<double>(value, source, "a number", "a number (e.g. 130, 0.26 or 1.3e4)");
   if (!std::isfinite(number)) {
-    throw source.Error(value.path, value.mark, "expected a finite number, got '" + text + "'");
+    throw source.Error(value.path, value.mark,
+                       "expected a finite number, got '" + value.node.Scalar() + "'");
   }
   return number;
 }
 
 int ReadInt(const ConfigValue& value, const ConfigSource& source) {
-  const std::string& text = ScalarText(value, source, "an integer");
-  const std::string digits = WithoutPlus(text);
-  int number = 0;
-  const char* end = digits.data() + digits.size();
-  const auto [stop, error] = std::from_chars(digits.data(), end, number);
-  if (error != std::errc() || stop != end) {
-    throw source.Error(value.path, value.mark,
-                       "expected a whole number (e.g. 200), got '" + text + "'");
-  }
-  return number;
+  return ReadNumber<int>(value, source, "an integer", "a whole number (e.g. 200)");
+}
+
+std::uint64_t ReadUint64(const ConfigValue& value, const ConfigSource& source) {
+  return ReadNumber<std::uint64_t>(value, source, "an integer",
+                                   "a whole number from 0 to 2^64 - 1");
 }
 
 bool ReadBool(const ConfigValue& value, const ConfigSource& source) {
@@ -147,6 +154,17 @@ std::string ReadNonEmptyString(const ConfigValue& value, const ConfigSource& sou
   const std::string& text = ScalarText(value, source, "a single value");
   if (text.empty()) throw source.Error(value.path, value.mark, "must not be empty");
   return text;
+}
+
+std::string ReadOneOf(const ConfigValue& value, const ConfigSource& source, const std::string& what,
+                      const std::vector<std::string>& allowed) {
+  const std::string name = ReadNonEmptyString(value, source);
+  if (std::find(allowed.begin(), allowed.end(), name) == allowed.end()) {
+    throw source.Error(value.path, value.mark,
+                       "unknown " + what + " '" + name + "'" + DidYouMean(name, allowed) +
+                           "; allowed: " + JoinNames(allowed));
+  }
+  return name;
 }
 
 std::vector<ConfigValue> ReadList(const ConfigValue& value, const ConfigSource& source) {

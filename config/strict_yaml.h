@@ -5,6 +5,7 @@
 #ifndef DWELLFIT_CONFIG_STRICT_YAML_H_
 #define DWELLFIT_CONFIG_STRICT_YAML_H_
 
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -52,8 +53,13 @@ class StrictMap {
 // Typed values; each throws InputError on a value of the wrong type.
 double ReadFiniteDouble(const ConfigValue& value, const ConfigSource& source);
 int ReadInt(const ConfigValue& value, const ConfigSource& source);
+std::uint64_t ReadUint64(const ConfigValue& value, const ConfigSource& source);
 bool ReadBool(const ConfigValue& value, const ConfigSource& source);
 std::string ReadNonEmptyString(const ConfigValue& value, const ConfigSource& source);
+// A name that must be one of `allowed`; else the error "unknown <what> 'x'"
+// with a did-you-mean and the allowed names.
+std::string ReadOneOf(const ConfigValue& value, const ConfigSource& source, const std::string& what,
+                      const std::vector<std::string>& allowed);
 // The entries of a list; a single value counts as a one-entry list. Entries
 // keep the list's path and carry their own position.
 std::vector<ConfigValue> ReadList(const ConfigValue& value, const ConfigSource& source);

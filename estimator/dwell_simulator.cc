@@ -88,7 +88,7 @@ bool SweepPlan::IsValid(std::string* error) const {
     return fail(std::string(frequency ? "the held a_base" : "the held frequency [Hz]") +
                 " must be a positive number, got " + G12(held));
   }
-  // Named as in a plan file (estimator/dwell_plan_reader.h).
+  // Named as in a plan file (config/dwell_plan_reader.h).
   const std::string from_key = frequency ? "from_hz" : "a_base_from";
   const std::string to_key = frequency ? "to_hz" : "a_base_to";
   const std::string step_key = frequency ? "step_hz" : "a_base_step";

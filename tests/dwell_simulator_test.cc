@@ -7,10 +7,11 @@
 #include <string>
 #include <vector>
 
-#include "estimator/dwell_plan_reader.h"
+#include "config/dwell_plan_reader.h"
 #include "estimator/input_error.h"
 #include "estimator/sweep_csv.h"
 #include "estimator/sweep_csv_writer.h"
+#include "gmock/gmock.h"
 #include "gtest/gtest.h"
 
 namespace dwellfit {
@@ -393,6 +394,16 @@ std::string PlanError(const std::string& yaml) {
   return "no error";
 }
 
+// A plan text and the error it gives, as PlanError prints it.
+struct PlanErrorCase {
+  std::string yaml;
+  std::string error;
+};
+
+void ExpectPlanErrors(const std::vector<PlanErrorCase>& cases) {
+  for (const PlanErrorCase& c : cases) EXPECT_EQ(PlanError(c.yaml), c.error) << c.yaml;
+}
+
 const char kTruth[] =
     "truth: {eta_e: 100, mu1: 0.2, mu2: 300, delta: 1.0e4, alpha: 9.0e8, omega_hz: 40}\n";
 
@@ -424,50 +435,80 @@ TEST(DwellPlanReader, ErrorsNameLineFieldAndFix) {
   const std::string grid = "    a_base: 0.01\n    from_hz: 38\n    to_hz: 46\n    step_hz: 0.1\n";
   EXPECT_EQ(PlanError(sweep_head + grid).substr(0, 2), "no");
 
-  std::string error = PlanError(sweep_head + grid + "    stpe: 3\n");
-  EXPECT_NE(error.find("9 sweeps[0].stpe: "), std::string::npos) << error;
-  EXPECT_NE(error.find("unknown key"), std::string::npos) << error;
+  ExpectPlanErrors({
+      {sweep_head + grid + "    stpe: 3\n",
+       "9 sweeps[0].stpe: plan.yaml:9: field 'sweeps[0].stpe': unknown key 'stpe' in 'sweeps[0]'; "
+       "allowed: id, kind, directions, start, a_base, from_hz, to_hz, step_hz"},
+      // A key of the other kind of sweep.
+      {sweep_head + grid + "    freq_hz: 41\n",
+       "9 sweeps[0].freq_hz: plan.yaml:9: field 'sweeps[0].freq_hz': 'freq_hz' belongs to "
+       "amplitude sweeps, and this sweep has kind frequency; allowed: id, kind, directions, start, "
+       "a_base, from_hz, to_hz, step_hz (or set kind: amplitude)"},
+      {sweep_head + "    a_base: 0.01\n    from_hz: 38\n    to_hz: 46.05\n    step_hz: 0.1\n",
+       "3 sweeps[0]: plan.yaml:3: field 'sweeps[0]': to_hz - from_hz (8.05) must be a whole number "
+       "of steps of step_hz (0.1), at most 1000000; adjust to_hz or step_hz"},
+      {sweep_head + "    a_base: -0.01\n    from_hz: 38\n    to_hz: 46\n    step_hz: 0.1\n",
+       "5 sweeps[0].a_base: plan.yaml:5: field 'sweeps[0].a_base': must be positive, got -0.01"},
+      {sweep_head + "    from_hz: 38\n    to_hz: 46\n    step_hz: 0.1\n",
+       "3 sweeps[0].a_base: plan.yaml:3: field 'sweeps[0].a_base': missing required key 'a_base' "
+       "in 'sweeps[0]'; add a_base (the base level held) to this frequency sweep"},
+      {sweep_head + grid + "    directions: [up, sideways]\n",
+       "9 sweeps[0].directions: plan.yaml:9: field 'sweeps[0].directions': unknown direction "
+       "'sideways'; allowed: up, down"},
+      {sweep_head + grid + "  - id: F\n    kind: frequency\n" + grid,
+       "9 sweeps[1].id: plan.yaml:9: field 'sweeps[1].id': sweep id 'F' is used twice (first at "
+       "line 3); ids must be unique"},
+      {std::string(kTruth) + "sweeps: []\n",
+       "2 sweeps: plan.yaml:2: field 'sweeps': expected a list of one sweep or more, each a block "
+       "of keys (- id: F0.01, ...)"},
+      {"truth: {eta_e: 100, mu1: 0.2, mu2: 300, delta: 1.0e4, alpha: x, omega_hz: 40}\n"
+       "sweeps: []\n",
+       "1 truth.alpha: plan.yaml:1: field 'truth.alpha': expected a number (e.g. 130, 0.26 or "
+       "1.3e4), got 'x'"},
+      {sweep_head + grid + "noise: {relative_sigma: 0.01, seed: -3}\n",
+       "9 noise.seed: plan.yaml:9: field 'noise.seed': expected a whole number from 0 to 2^64 - 1, "
+       "got '-3'"},
+  });
+  EXPECT_THAT(PlanError("truth: [1, 2\n"),
+              ::testing::StartsWith("2 : plan.yaml:2: YAML syntax error: "));
+}
 
-  // A key of the other kind of sweep.
-  error = PlanError(sweep_head + grid + "    freq_hz: 41\n");
-  EXPECT_NE(error.find("9 sweeps[0].freq_hz"), std::string::npos) << error;
-  EXPECT_NE(error.find("a_base, from_hz, to_hz, step_hz"), std::string::npos) << error;
+TEST(DwellPlanReader, UnknownKeysGetADidYouMean) {
+  const std::string head = std::string(kTruth) + "sweeps:\n  - id: F\n";
+  const std::string grid = "    a_base: 0.01\n    from_hz: 38\n    to_hz: 46\n";
+  const std::string sweep = head + "    kind: frequency\n" + grid + "    step_hz: 0.1\n";
+  ExpectPlanErrors({
+      {head + "    kind: frequency\n" + grid + "    step_hx: 0.1\n",
+       "8 sweeps[0].step_hx: plan.yaml:8: field 'sweeps[0].step_hx': unknown key 'step_hx' in "
+       "'sweeps[0]' (did you mean 'step_hz'?); allowed: id, kind, directions, start, a_base, "
+       "from_hz, to_hz, step_hz"},
+      {std::string(kTruth) + "sweep:\n  - id: F\n",
+       "2 sweep: plan.yaml:2: field 'sweep': unknown key 'sweep' at the top level (did you mean "
+       "'sweeps'?); allowed: truth, sweeps, noise"},
+      {sweep + "noise: {relative_sigma: 0.01, sed: 7}\n",
+       "9 noise.sed: plan.yaml:9: field 'noise.sed': unknown key 'sed' in 'noise' (did you mean "
+       "'seed'?); allowed: relative_sigma, seed"},
+      {head + "    kind: frequncy\n" + grid + "    step_hz: 0.1\n",
+       "4 sweeps[0].kind: plan.yaml:4: field 'sweeps[0].kind': unknown sweep kind 'frequncy' (did "
+       "you mean 'frequency'?); allowed: frequency, amplitude"},
+  });
+}
 
-  error = PlanError(sweep_head +
-                    "    a_base: 0.01\n    from_hz: 38\n    to_hz: 46.05\n"
-                    "    step_hz: 0.1\n");
-  EXPECT_NE(error.find("3 sweeps[0]: "), std::string::npos) << error;
-  EXPECT_NE(error.find("whole number"), std::string::npos) << error;
-
-  error = PlanError(sweep_head +
-                    "    a_base: -0.01\n    from_hz: 38\n    to_hz: 46\n"
-                    "    step_hz: 0.1\n");
-  EXPECT_NE(error.find("5 sweeps[0].a_base: "), std::string::npos) << error;
-
-  error = PlanError(sweep_head + "    from_hz: 38\n    to_hz: 46\n    step_hz: 0.1\n");
-  EXPECT_NE(error.find("sweeps[0].a_base: "), std::string::npos) << error;
-  EXPECT_NE(error.find("missing"), std::string::npos) << error;
-
-  error = PlanError(sweep_head + grid + "    directions: [up, sideways]\n");
-  EXPECT_NE(error.find("9 sweeps[0].directions: "), std::string::npos) << error;
-
-  error = PlanError(sweep_head + grid + "  - id: F\n    kind: frequency\n" + grid);
-  EXPECT_NE(error.find("9 sweeps[1].id: "), std::string::npos) << error;
-  EXPECT_NE(error.find("used twice"), std::string::npos) << error;
-
-  error = PlanError(std::string(kTruth) + "sweeps: []\n");
-  EXPECT_NE(error.find("2 sweeps: "), std::string::npos) << error;
-
-  error = PlanError(
-      "truth: {eta_e: 100, mu1: 0.2, mu2: 300, delta: 1.0e4, alpha: x, "
-      "omega_hz: 40}\nsweeps: []\n");
-  EXPECT_NE(error.find("1 truth.alpha: "), std::string::npos) << error;
-
-  error = PlanError(sweep_head + grid + "noise: {relative_sigma: 0.01, seed: -3}\n");
-  EXPECT_NE(error.find("9 noise.seed: "), std::string::npos) << error;
-
-  error = PlanError("truth: [1, 2\n");
-  EXPECT_NE(error.find("not valid YAML"), std::string::npos) << error;
+TEST(DwellPlanReader, AFileThatCannotBeReadIsNamedAsThePlanFile) {
+  const std::string missing = ::testing::TempDir() + "/no-such-dir/plan.yaml";
+  try {
+    ReadDwellPlan(missing);
+    ADD_FAILURE() << "no error for " << missing;
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), missing + ": cannot open the plan file; check the path");
+  }
+  try {
+    ReadDwellPlan(::testing::TempDir());
+    ADD_FAILURE() << "no error for a directory";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(),
+                ::testing::EndsWith("is a directory; give the path of the YAML plan file"));
+  }
 }
 
 TEST(DwellSimulator, RejectsAPlanThatIsNotValid) {

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "estimator/dwell_plan_reader.h"
+#include "config/dwell_plan_reader.h"
 #include "estimator/dwell_simulator.h"
 #include "estimator/identification.h"
 #include "estimator/input_error.h"

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "estimator/dwell_plan_reader.h"
+#include "config/dwell_plan_reader.h"
 #include "estimator/dwell_simulator.h"
 #include "estimator/identification_options.h"
 #include "estimator/input_error.h"

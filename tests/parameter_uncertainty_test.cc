@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "config/dwell_plan_reader.h"
 #include "config/identify_config.h"
 #include "estimator/coverage_study.h"
-#include "estimator/dwell_plan_reader.h"
 #include "estimator/dwell_simulator.h"
 #include "estimator/identification.h"
 #include "estimator/identify_run.h"

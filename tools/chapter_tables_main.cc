@@ -4,9 +4,9 @@
 #include <iostream>
 #include <string>
 
+#include "config/dwell_plan_reader.h"
 #include "config/identify_config.h"
 #include "estimator/chapter_tables.h"
-#include "estimator/dwell_plan_reader.h"
 #include "estimator/input_error.h"
 #include "estimator/output_files.h"
 #include "gflags/gflags.h"

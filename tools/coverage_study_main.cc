@@ -8,9 +8,9 @@
 // interval covers the truth (estimator/coverage_study.h).
 #include <iostream>
 
+#include "config/dwell_plan_reader.h"
 #include "config/identify_config.h"
 #include "estimator/coverage_study.h"
-#include "estimator/dwell_plan_reader.h"
 #include "estimator/input_error.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"

@@ -3,11 +3,11 @@
 //   simulate_dwell --plan datasets/thesis-numerical/plan.yaml \
 //                  --out datasets/thesis-numerical/sweeps.csv
 //
-// The plan (estimator/dwell_plan_reader.h) gives the true parameters, the
+// The plan (config/dwell_plan_reader.h) gives the true parameters, the
 // sweeps and the noise; the plan in effect and each sweep's jumps are printed.
 #include <iostream>
 
-#include "estimator/dwell_plan_reader.h"
+#include "config/dwell_plan_reader.h"
 #include "estimator/dwell_simulator.h"
 #include "estimator/input_error.h"
 #include "estimator/sweep_csv_writer.h"

@@ -26,10 +26,12 @@
 //     relative_sigma: 0.01  # a *= 1 + relative_sigma N(0, 1)
 //     seed: 7               # std::mt19937_64 seed, a non-negative integer
 //
-// Keys are strict: an unknown, misplaced or repeated key is an error, as is a
-// value that does not make a sweep (see SweepPlan::IsValid).
-#ifndef DWELLFIT_ESTIMATOR_DWELL_PLAN_READER_H_
-#define DWELLFIT_ESTIMATOR_DWELL_PLAN_READER_H_
+// Keys are strict, as in identify's config (config/strict_yaml.h): an
+// unknown, misplaced or repeated key is an error, as is a value that does not
+// make a sweep (see SweepPlan::IsValid). Errors name the file, the 1-based
+// line and the key path (`sweeps[0].a_base`).
+#ifndef DWELLFIT_CONFIG_DWELL_PLAN_READER_H_
+#define DWELLFIT_CONFIG_DWELL_PLAN_READER_H_
 
 #include <string>
 
@@ -46,4 +48,4 @@ DwellPlan ReadDwellPlan(const std::string& path);
 
 }  // namespace dwellfit
 
-#endif  // DWELLFIT_ESTIMATOR_DWELL_PLAN_READER_H_
+#endif  // DWELLFIT_CONFIG_DWELL_PLAN_READER_H_
