@@ -17,29 +17,50 @@
 namespace dwellfit {
 namespace {
 
-const std::string kThesisConfig =
-    std::string(DWELLFIT_SOURCE_DIR) + "/datasets/thesis-numerical/beam.yaml";
-
-struct ThesisCase {
+// A committed dataset config, loaded once, and the sweeps it names.
+struct ConfiguredCase {
   IdentifyConfig config;
   ConfiguredSweeps data;
 };
 
-const ThesisCase& Thesis() {
-  static const ThesisCase* thesis = [] {
-    auto* c = new ThesisCase;
-    c->config = LoadIdentifyConfig(kThesisConfig);
-    c->data = LoadConfiguredSweeps(c->config);
-    return c;
-  }();
+ConfiguredCase* LoadCase(const std::string& dataset) {
+  auto* c = new ConfiguredCase;
+  c->config =
+      LoadIdentifyConfig(std::string(DWELLFIT_SOURCE_DIR) + "/datasets/" + dataset + "/beam.yaml");
+  c->data = LoadConfiguredSweeps(c->config);
+  return c;
+}
+
+const ConfiguredCase& Thesis() {
+  static const ConfiguredCase* thesis = LoadCase("thesis-numerical");
   return *thesis;
+}
+
+const ConfiguredCase& ClampedBeam() {
+  static const ConfiguredCase* beam = LoadCase("clamped-beam-27C");
+  return *beam;
+}
+
+// The configured fit of `fit_case`, with its residual blocks evaluated on
+// state.range(0) threads.
+void RunConfiguredFit(benchmark::State& state, const ConfiguredCase& fit_case) {
+  IdentificationOptions options = fit_case.config.identification;
+  options.solver.num_threads = static_cast<int>(state.range(0));
+  for (auto _ : state) {
+    const IdentificationResult result = Identify(fit_case.data.fitted, options);
+    benchmark::DoNotOptimize(result.parameters);
+    state.counters["iterations"] = result.iterations;
+    state.counters["dwells"] = result.residual_blocks;
+    state.counters["final_cost"] = result.final_cost;
+    state.counters["converged"] = result.converged;
+  }
 }
 
 // Residual plus Jacobian of every fitted dwell, per point, alternating between
 // the start and a point 0.1 % away in every parameter, as a solver's steps
 // do (each dwell's Newton iteration starts from its root at the last point).
 void BM_VerticalResidualWithJacobianPerPoint(benchmark::State& state) {
-  const ThesisCase& thesis = Thesis();
+  const ConfiguredCase& thesis = Thesis();
   ProblemBuilder builder(ProblemBuilderOptions{});
   std::vector<std::unique_ptr<ceres::CostFunction>> costs;
   for (const Sweep* sweep : thesis.data.fitted) {
@@ -71,17 +92,7 @@ void BM_VerticalResidualWithJacobianPerPoint(benchmark::State& state) {
 BENCHMARK(BM_VerticalResidualWithJacobianPerPoint)->Unit(benchmark::kMicrosecond);
 
 // The whole default fit (algebraic stage, then vertical) from the config's start.
-void BM_ThesisNumericalWholeFit(benchmark::State& state) {
-  const ThesisCase& thesis = Thesis();
-  IdentificationOptions options = thesis.config.identification;
-  options.solver.num_threads = static_cast<int>(state.range(0));
-  for (auto _ : state) {
-    const IdentificationResult result = Identify(thesis.data.fitted, options);
-    benchmark::DoNotOptimize(result.parameters);
-    state.counters["iterations"] = result.iterations;
-    state.counters["converged"] = result.converged;
-  }
-}
+void BM_ThesisNumericalWholeFit(benchmark::State& state) { RunConfiguredFit(state, Thesis()); }
 BENCHMARK(BM_ThesisNumericalWholeFit)
     ->ArgName("threads")
     ->Arg(1)
@@ -92,25 +103,7 @@ BENCHMARK(BM_ThesisNumericalWholeFit)
 // The committed clamped-beam config: algebraic stage, then the vertical error
 // with the bifurcation-range penalty (exponent 2, then 10), from its start.
 // Wall time is what counts here (UseRealTime): the evaluation runs on threads.
-void BM_ClampedBeamFit(benchmark::State& state) {
-  static const ThesisCase* beam = [] {
-    auto* c = new ThesisCase;
-    const std::string path =
-        std::string(DWELLFIT_SOURCE_DIR) + "/datasets/clamped-beam-27C/beam.yaml";
-    c->config = LoadIdentifyConfig(path);
-    c->data = LoadConfiguredSweeps(c->config);
-    return c;
-  }();
-  IdentificationOptions options = beam->config.identification;
-  options.solver.num_threads = static_cast<int>(state.range(0));
-  for (auto _ : state) {
-    const IdentificationResult result = Identify(beam->data.fitted, options);
-    benchmark::DoNotOptimize(result.parameters);
-    state.counters["iterations"] = result.iterations;
-    state.counters["dwells"] = result.residual_blocks;
-    state.counters["final_cost"] = result.final_cost;
-  }
-}
+void BM_ClampedBeamFit(benchmark::State& state) { RunConfiguredFit(state, ClampedBeam()); }
 BENCHMARK(BM_ClampedBeamFit)
     ->ArgName("threads")
     ->Arg(1)
