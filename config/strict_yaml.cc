@@ -82,7 +82,9 @@ StrictMap::StrictMap(const ConfigValue& block, const ConfigSource& source,
                             DescribeKind(block_.node));
   }
   for (auto it = block_.node.begin(); it != block_.node.end(); ++it) {
-    const YAML::Node& key_node = it->first;
+    // A copy: yaml-cpp's iterator yields its pair by value, so a reference
+    // to `it->first` would outlive the temporary it points into.
+    const YAML::Node key_node = it->first;
     if (!key_node.IsScalar()) {
       throw source_.Error(
           block_.path, key_node.Mark(),
