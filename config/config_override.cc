@@ -105,6 +105,13 @@ std::vector<ConfigOverride> ParseSetFlag(const std::string& flag_value, const st
                        "entry '" + entry + "' has no value after '='; to remove an optional " +
                            "key write " + override_value.key_path + "=null");
     }
+    for (const ConfigOverride& earlier : overrides) {
+      if (earlier.key_path == override_value.key_path) {
+        throw InputError(origin, 0, override_value.key_path,
+                         "'" + override_value.key_path + "' is set twice (" + earlier.key_path +
+                             "=" + earlier.yaml_value + " and " + entry + "); give each key once");
+      }
+    }
     overrides.push_back(override_value);
   }
   return overrides;
@@ -131,7 +138,9 @@ ConfigOverride ListFlagOverride(const std::string& key_path, const std::string& 
 }
 
 std::string DescribeOverride(const ConfigOverride& override_value) {
-  const char* op = override_value.action == OverrideAction::kReplace ? "=" : "-=";
+  const char* op = override_value.action == OverrideAction::kReplace     ? "="
+                   : override_value.action == OverrideAction::kAddToList ? "+="
+                                                                         : "-=";
   return override_value.origin + " " + override_value.key_path + op + override_value.yaml_value;
 }
 

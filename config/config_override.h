@@ -18,6 +18,9 @@ enum class OverrideAction {
   // The entries of yaml_value (a list or one scalar) are removed from the list
   // at key_path; each must be in it (`--free=omega`).
   kRemoveFromList,
+  // The entries of yaml_value are appended to the list at key_path (created
+  // when missing); an entry already in it stays once (`--fix=delta`).
+  kAddToList,
 };
 
 struct ConfigOverride {
@@ -31,18 +34,19 @@ struct ConfigOverride {
 // Commas inside [], {} or quotes do not split; space around keys and values is
 // trimmed; an empty flag gives no overrides. Throws InputError naming `origin`
 // for an entry without '=', an empty key or key segment ("a..b"), an empty
-// value, or unbalanced brackets.
+// value, unbalanced brackets, or a key given twice.
 std::vector<ConfigOverride> ParseSetFlag(const std::string& flag_value, const std::string& origin);
 
 // A comma-separated flag value as a YAML list override: ("fixed", "delta,omega",
-// "--fix") gives {fixed, "[delta, omega]", --fix}. For --fix, --free
-// (kRemoveFromList) and --stages.
+// "--fix") gives {fixed, "[delta, omega]", --fix}. For --fix (kAddToList),
+// --free (kRemoveFromList), --stages, --fit and --validate.
 ConfigOverride ListFlagOverride(const std::string& key_path, const std::string& comma_list,
                                 const std::string& origin,
                                 OverrideAction action = OverrideAction::kReplace);
 
-// "--set solver.max_iterations=50" or "--free fixed-=[omega]": how the override
-// is shown in errors and in the printed config.
+// "--set solver.max_iterations=50", "--fix fixed+=[delta]" or "--free
+// fixed-=[omega]": how the override is shown in errors and in the printed
+// config.
 std::string DescribeOverride(const ConfigOverride& override_value);
 
 }  // namespace dwellfit

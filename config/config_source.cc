@@ -7,6 +7,8 @@
 #include <system_error>
 #include <utility>
 
+#include "yaml-cpp/depthguard.h"
+
 namespace dwellfit {
 namespace {
 
@@ -36,26 +38,45 @@ const char* NodeKindName(const YAML::Node& node) {
 
 int OneBasedLine(const YAML::Mark& mark) { return mark.is_null() ? 0 : mark.line + 1; }
 
-// `list` (a list, one value, or undefined) without the entries of `to_remove`
-// (a list or one value); each must be in it.
+// The entries of the list at an override's key: a list's entries, one value
+// as one entry, none for an absent key. Throws for a block of keys.
+std::vector<YAML::Node> ListEntries(const YAML::Node& list, const ConfigOverride& override_value) {
+  std::vector<YAML::Node> entries;
+  if (list.IsMap()) {
+    throw InputError(override_value.origin, 0, override_value.key_path,
+                     "'" + override_value.key_path +
+                         "' holds a block of keys, not a list, so entries cannot be added to "
+                         "or removed from it");
+  }
+  if (list.IsSequence()) {
+    for (const YAML::Node& entry : list) entries.push_back(entry);
+  } else if (list.IsScalar()) {
+    entries.push_back(list);
+  }
+  return entries;
+}
+
+bool SameScalar(const YAML::Node& a, const YAML::Node& b) {
+  return a.IsScalar() && b.IsScalar() && a.Scalar() == b.Scalar();
+}
+
+// `entries` as a new flow-style list; the entries are the same nodes, so
+// those from the file keep their lines.
+YAML::Node FlowList(const std::vector<YAML::Node>& entries) {
+  YAML::Node list(YAML::NodeType::Sequence);
+  for (const YAML::Node& entry : entries) list.push_back(entry);
+  list.SetStyle(YAML::EmitterStyle::Flow);
+  return list;
+}
+
+// `list` without the entries of `to_remove` (a list or one value); each must
+// be in it.
 YAML::Node ListWithout(const YAML::Node& list, const YAML::Node& to_remove,
                        const ConfigOverride& override_value) {
-  std::vector<YAML::Node> kept;
-  if (list.IsSequence()) {
-    for (const YAML::Node& entry : list) kept.push_back(entry);
-  } else if (list.IsScalar()) {
-    kept.push_back(list);
-  }
-  std::vector<YAML::Node> removed;
-  if (to_remove.IsSequence()) {
-    for (const YAML::Node& entry : to_remove) removed.push_back(entry);
-  } else if (to_remove.IsScalar()) {
-    removed.push_back(to_remove);
-  }
-  for (const YAML::Node& entry : removed) {
-    const auto match = std::find_if(kept.begin(), kept.end(), [&](const YAML::Node& k) {
-      return k.IsScalar() && entry.IsScalar() && k.Scalar() == entry.Scalar();
-    });
+  std::vector<YAML::Node> kept = ListEntries(list, override_value);
+  for (const YAML::Node& entry : ListEntries(to_remove, override_value)) {
+    const auto match = std::find_if(kept.begin(), kept.end(),
+                                    [&](const YAML::Node& k) { return SameScalar(k, entry); });
     if (match == kept.end()) {
       YAML::Emitter shown;
       shown << (list.IsDefined() ? list : YAML::Node(YAML::NodeType::Sequence));
@@ -66,11 +87,100 @@ YAML::Node ListWithout(const YAML::Node& list, const YAML::Node& to_remove,
     }
     kept.erase(match);
   }
-  // Kept entries are the file's nodes, so they keep their lines.
-  YAML::Node new_list(YAML::NodeType::Sequence);
-  for (const YAML::Node& entry : kept) new_list.push_back(entry);
-  new_list.SetStyle(YAML::EmitterStyle::Flow);
-  return new_list;
+  return FlowList(kept);
+}
+
+// `list` with the entries of `to_add` that it lacks appended; those are
+// also appended to `*added`.
+YAML::Node ListWith(const YAML::Node& list, const YAML::Node& to_add,
+                    const ConfigOverride& override_value, std::vector<YAML::Node>* added) {
+  std::vector<YAML::Node> entries = ListEntries(list, override_value);
+  for (const YAML::Node& entry : ListEntries(to_add, override_value)) {
+    if (std::none_of(entries.begin(), entries.end(),
+                     [&](const YAML::Node& e) { return SameScalar(e, entry); })) {
+      entries.push_back(entry);
+      added->push_back(entry);
+    }
+  }
+  return FlowList(entries);
+}
+
+// The value of `key` in `map`; a null node when the key is absent.
+YAML::Node Get(const YAML::Node& map, const std::string& key) {
+  const YAML::Node value = map[key];  // const access adds no key
+  return value.IsDefined() ? value : YAML::Node();
+}
+
+// A copy of the block `block`: a map of its own whose entries are the same
+// nodes (so they keep their lines).
+YAML::Node ShallowCopy(const YAML::Node& block) {
+  YAML::Node copy(YAML::NodeType::Map);
+  for (auto it = block.begin(); it != block.end(); ++it) copy[it->first] = it->second;
+  return copy;
+}
+
+// Sets `key` of `*map` to `value` and returns the value's node there. A
+// yaml-cpp assignment would write into the node the key held, which a YAML
+// alias shares with another key; so the entry is removed and added again,
+// with its key node (and so the key's line).
+YAML::Node Rebind(YAML::Node* map, const std::string& key, const YAML::Node& value) {
+  YAML::Node key_node(key);
+  for (auto it = map->begin(); it != map->end(); ++it) {
+    if (it->first.IsScalar() && it->first.Scalar() == key) key_node.reset(it->first);
+  }
+  map->remove(key);
+  (*map)[key_node] = value;
+  return (*map)[key_node];
+}
+
+// The names a list override gives ("[delta, omega]"); none when its value is
+// not a list of names.
+std::vector<std::string> ListedNames(const ConfigOverride& override_value) {
+  std::vector<std::string> names;
+  try {
+    const YAML::Node list = YAML::Load(override_value.yaml_value);
+    if (list.IsSequence()) {
+      for (const YAML::Node& entry : list) {
+        if (entry.IsScalar()) names.push_back(entry.Scalar());
+      }
+    }
+  } catch (const YAML::Exception&) {
+    // Applying it reports the syntax error.
+  }
+  return names;
+}
+
+// Throws when two overrides change the same key or one a key inside the
+// other's: only --fix and --free may both change one list, with different
+// names.
+void CheckNoConflicts(const std::vector<ConfigOverride>& overrides) {
+  for (std::size_t j = 0; j < overrides.size(); ++j) {
+    const ConfigOverride& later = overrides[j];
+    for (std::size_t i = 0; i < j; ++i) {
+      const ConfigOverride& earlier = overrides[i];
+      if (!PathWithin(later.key_path, earlier.key_path) &&
+          !PathWithin(earlier.key_path, later.key_path)) {
+        continue;
+      }
+      const bool edits = earlier.action != OverrideAction::kReplace &&
+                         later.action != OverrideAction::kReplace &&
+                         earlier.key_path == later.key_path;
+      if (!edits) {
+        throw InputError(
+            later.origin, 0, later.key_path,
+            "conflicts with " + DescribeOverride(earlier) + ": both change it; give each key once");
+      }
+      if (earlier.action == later.action) continue;
+      for (const std::string& name : ListedNames(later)) {
+        const std::vector<std::string> names = ListedNames(earlier);
+        if (std::find(names.begin(), names.end(), name) != names.end()) {
+          throw InputError(later.origin, 0, later.key_path,
+                           "'" + name + "' is given to both " + earlier.origin + " and " +
+                               later.origin + "; give it to one of them");
+        }
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -90,38 +200,102 @@ ConfigSource ConfigSource::Load(const std::string& path, const std::string& kind
 }
 
 ConfigSource ConfigSource::Parse(const std::string& file, const std::string& yaml_text) {
+  std::vector<YAML::Node> documents;
   try {
-    return ConfigSource(file, YAML::Load(yaml_text));
+    documents = YAML::LoadAll(yaml_text);
+  } catch (const YAML::DeepRecursion& e) {
+    throw InputError(file, OneBasedLine(e.mark), "",
+                     "the YAML is nested too deeply (the reader stops at " +
+                         std::to_string(e.depth()) +
+                         " levels); a config's blocks and lists are a few levels deep: look for "
+                         "runaway brackets or indentation here");
   } catch (const YAML::ParserException& e) {
     throw InputError(file, OneBasedLine(e.mark), "", "YAML syntax error: " + e.msg);
   }
+  // Later documents are not read: one with content is an error, not ignored.
+  for (std::size_t i = 1; i < documents.size(); ++i) {
+    if (documents[i].IsNull()) continue;
+    throw InputError(file, OneBasedLine(documents[i].Mark()), "",
+                     "a second YAML document starts here (after a '---' line), and only the "
+                     "first would be read; the file holds one document: move these keys into "
+                     "the first one, or remove the '---' line");
+  }
+  return ConfigSource(file, documents.empty() ? YAML::Node() : documents.front());
 }
 
 ConfigSource::ConfigSource(std::string file, YAML::Node root)
     : file_(std::move(file)), root_(std::move(root)) {}
 
 void ConfigSource::Apply(const std::vector<ConfigOverride>& overrides) {
+  CheckNoConflicts(overrides);
   for (const ConfigOverride& override_value : overrides) ApplyOne(override_value);
 }
 
-void ConfigSource::ApplyOne(const ConfigOverride& override_value) {
+YAML::Node ConfigSource::ParseValue(const ConfigOverride& override_value) const {
   const std::string& origin = override_value.origin;
   const std::string& key_path = override_value.key_path;
-  const std::vector<std::string> segments = SplitKeyPath(key_path);
-  for (const std::string& segment : segments) {
-    if (segment.empty()) {
-      throw InputError(origin, 0, key_path,
-                       "malformed key path; write keys joined by single dots, e.g. "
-                       "solver.max_iterations");
-    }
+  if (override_value.yaml_value.find_first_not_of(" \t\r\n") == std::string::npos) {
+    throw InputError(origin, 0, key_path,
+                     "the flag's value is empty; give a value for '" + key_path + "'");
   }
   YAML::Node value;
   try {
     value = YAML::Load(override_value.yaml_value);
+  } catch (const YAML::DeepRecursion&) {
+    throw InputError(origin, 0, key_path, "the value is nested too deeply to be a config value");
   } catch (const YAML::ParserException& e) {
-    throw InputError(origin, 0, key_path,
-                     "value '" + override_value.yaml_value + "' is not valid YAML: " + e.msg);
+    throw InputError(
+        origin, 0, key_path,
+        "value '" + EscapeForMessage(override_value.yaml_value) + "' is not valid YAML: " + e.msg);
   }
+  const bool edit = override_value.action != OverrideAction::kReplace;
+  if (edit && (value.IsNull() || (value.IsSequence() && value.size() == 0))) {
+    throw InputError(
+        origin, 0, key_path,
+        "the flag's value is empty; give the names to " +
+            std::string(override_value.action == OverrideAction::kAddToList ? "add to '"
+                                                                            : "remove from '") +
+            key_path + "'");
+  }
+  return value;
+}
+
+YAML::Node ConfigSource::WalkToParent(const ConfigOverride& override_value,
+                                      const std::vector<std::string>& segments) {
+  const std::size_t index = applied_.size();
+  YAML::Node map;
+  map.reset(root_);  // Node::reset rebinds `map`; assigning would overwrite the tree
+  std::string walked;
+  for (std::size_t i = 0; i + 1 < segments.size(); ++i) {
+    walked += (walked.empty() ? "" : ".") + segments[i];
+    const YAML::Node child = Get(map, segments[i]);
+    YAML::Node next;
+    if (child.IsNull()) {
+      next.reset(Rebind(&map, segments[i], YAML::Node(YAML::NodeType::Map)));
+      set_paths_.push_back(SetPath{walked, index});
+    } else if (!child.IsMap()) {
+      throw InputError(override_value.origin, 0, override_value.key_path,
+                       "'" + walked + "' holds a " + NodeKindName(child) +
+                           ", not a block of keys; set '" + walked + "' itself");
+    } else {
+      next.reset(Rebind(&map, segments[i], ShallowCopy(child)));
+    }
+    map.reset(next);
+  }
+  return map;
+}
+
+void ConfigSource::ApplyOne(const ConfigOverride& override_value) {
+  const std::string& key_path = override_value.key_path;
+  const std::vector<std::string> segments = SplitKeyPath(key_path);
+  for (const std::string& segment : segments) {
+    if (segment.empty()) {
+      throw InputError(override_value.origin, 0, key_path,
+                       "malformed key path; write keys joined by single dots, e.g. "
+                       "solver.max_iterations");
+    }
+  }
+  const YAML::Node value = ParseValue(override_value);
   if (!root_.IsDefined() || root_.IsNull()) root_ = YAML::Node(YAML::NodeType::Map);
   if (!root_.IsMap()) {
     throw InputError(file_, OneBasedLine(root_.Mark()), "",
@@ -129,42 +303,25 @@ void ConfigSource::ApplyOne(const ConfigOverride& override_value) {
                          ", not a block of keys, so " + DescribeOverride(override_value) +
                          " cannot be applied");
   }
-
-  // Walk to the map that holds the last segment, creating missing blocks.
-  // Node::reset rebinds `map`; assigning would overwrite the tree.
   const std::size_t index = applied_.size();
-  YAML::Node map;
-  map.reset(root_);
-  std::string walked;
-  for (std::size_t i = 0; i + 1 < segments.size(); ++i) {
-    walked += (walked.empty() ? "" : ".") + segments[i];
-    YAML::Node child = map[segments[i]];
-    if (!child.IsDefined() || child.IsNull()) {
-      map[segments[i]] = YAML::Node(YAML::NodeType::Map);
-      child.reset(map[segments[i]]);
-      set_paths_.push_back(SetPath{walked, index});
-    } else if (!child.IsMap()) {
-      throw InputError(origin, 0, key_path,
-                       "'" + walked + "' holds a " + NodeKindName(child) +
-                           ", not a block of keys; set '" + walked + "' itself");
-    }
-    map.reset(child);
-  }
+  YAML::Node map = WalkToParent(override_value, segments);
   const std::string& key = segments.back();
-
+  const YAML::Node current = Get(map, key);
   if (override_value.action == OverrideAction::kRemoveFromList) {
-    map[key] = ListWithout(map[key], value, override_value);
     // The remaining entries still come from the file: not recorded as set.
-    applied_.push_back(override_value);
-    return;
-  }
-
-  if (value.IsNull()) {
-    map.remove(key);
+    Rebind(&map, key, ListWithout(current, value, override_value));
+  } else if (override_value.action == OverrideAction::kAddToList) {
+    std::vector<YAML::Node> added;
+    Rebind(&map, key, ListWith(current, value, override_value, &added));
+    for (const YAML::Node& entry : added) added_.emplace_back(entry, index);
   } else {
-    map[key] = value;
+    if (value.IsNull()) {
+      map.remove(key);
+    } else {
+      Rebind(&map, key, value);
+    }
+    set_paths_.push_back(SetPath{key_path, index});
   }
-  set_paths_.push_back(SetPath{key_path, index});
   applied_.push_back(override_value);
 }
 
@@ -182,6 +339,13 @@ std::vector<const ConfigOverride*> ConfigSource::OverridesWithin(
     if (PathWithin(applied.key_path, key_path)) within.push_back(&applied);
   }
   return within;
+}
+
+const ConfigOverride* ConfigSource::AddedBy(const YAML::Node& entry) const {
+  for (const auto& [node, by] : added_) {
+    if (node.is(entry)) return &applied_[by];
+  }
+  return nullptr;
 }
 
 InputError ConfigSource::Error(const std::string& key_path, const YAML::Mark& mark,

@@ -4,7 +4,9 @@
 #ifndef DWELLFIT_CONFIG_CONFIG_SOURCE_H_
 #define DWELLFIT_CONFIG_CONFIG_SOURCE_H_
 
+#include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "config/config_override.h"
@@ -27,8 +29,12 @@ class ConfigSource {
   ConfigSource(std::string file, YAML::Node root);
 
   // Applies `overrides` in order to the tree (see ConfigOverride). Throws
-  // InputError naming the override's origin when its value is not YAML or its
-  // key path runs through a value that is not a block of keys.
+  // InputError naming the override's origin when its value is empty or not
+  // YAML, its key path runs through a value that is not a block of keys, or
+  // it changes a key another override changes too (only --fix and --free
+  // may both touch one list, with different names). A block on the way to
+  // the key is copied before it is written, so a YAML alias of it elsewhere
+  // in the file keeps its values.
   void Apply(const std::vector<ConfigOverride>& overrides);
 
   const std::string& file() const { return file_; }
@@ -40,6 +46,9 @@ class ConfigSource {
   const ConfigOverride* OverrideFor(const std::string& key_path) const;
   // Overrides applied to `key_path` or to a key inside it, in order.
   std::vector<const ConfigOverride*> OverridesWithin(const std::string& key_path) const;
+  // The override that added `entry` to a list (kAddToList), or nullptr when
+  // the entry comes from the file.
+  const ConfigOverride* AddedBy(const YAML::Node& entry) const;
 
   // An error about the value at `key_path` (the InputError field), located at
   // `mark` in the file, or at the override's flag when an override set it.
@@ -51,6 +60,12 @@ class ConfigSource {
 
  private:
   void ApplyOne(const ConfigOverride& override_value);
+  // The value `override_value` sets: its YAML text parsed, and checked.
+  YAML::Node ParseValue(const ConfigOverride& override_value) const;
+  // The block that holds the last key of `segments`, created or copied on the
+  // way (see Apply).
+  YAML::Node WalkToParent(const ConfigOverride& override_value,
+                          const std::vector<std::string>& segments);
 
   std::string file_;
   YAML::Node root_;
@@ -62,6 +77,8 @@ class ConfigSource {
     std::size_t by;
   };
   std::vector<SetPath> set_paths_;
+  // Entries added to a list by a kAddToList override, with its index in applied_.
+  std::vector<std::pair<YAML::Node, std::size_t>> added_;
 };
 
 }  // namespace dwellfit

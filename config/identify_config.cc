@@ -208,7 +208,21 @@ MultiStartOptions ReadMultiStart(const ConfigValue& value, const ConfigSource& s
   return multi_start;
 }
 
-std::array<bool, kNumParameters> ReadFixed(const ConfigValue& value, const ConfigSource& source) {
+// An error about one entry of a list: named by the flag that added it
+// (--fix), else by its line or the override that set the list.
+InputError EntryError(const ConfigValue& entry, const ConfigSource& source,
+                      const std::string& what) {
+  if (const ConfigOverride* added = source.AddedBy(entry.node)) {
+    return InputError(added->origin, 0, entry.path, what);
+  }
+  return source.Error(entry.path, entry.mark, what);
+}
+
+// The `fixed` list. A fixed parameter is held at the value the config gives,
+// so it must have one in `known` (initial_guess): the automatic value is a
+// rough start, not a value to hold.
+std::array<bool, kNumParameters> ReadFixed(const ConfigValue& value, const ConfigSource& source,
+                                           const KnownParameters& known) {
   const std::vector<std::string> allowed(kParameterNames.begin(), kParameterNames.end());
   std::array<bool, kNumParameters> fixed{};
   for (const ConfigValue& entry : ReadList(value, source)) {
@@ -217,13 +231,20 @@ std::array<bool, kNumParameters> ReadFixed(const ConfigValue& value, const Confi
     if (!ParameterIndexFromName(name, &index)) {
       const std::string hint =
           name == "omega_hz" ? " (the parameter is called 'omega')" : DidYouMean(name, allowed);
-      throw source.Error(
-          entry.path, entry.mark,
-          "unknown parameter '" + name + "'" + hint + "; allowed: " + JoinNames(allowed));
+      throw EntryError(entry, source,
+                       "unknown parameter '" + EscapeForMessage(name) + "'" + hint +
+                           "; allowed: " + JoinNames(allowed));
     }
     if (fixed[index]) {
-      throw source.Error(entry.path, entry.mark,
-                         "parameter '" + name + "' is listed twice; keep one");
+      throw EntryError(entry, source, "parameter '" + name + "' is listed twice; keep one");
+    }
+    if (!known[index]) {
+      const std::string key = index == kOmega ? "omega_hz" : name;
+      throw EntryError(entry, source,
+                       "parameter '" + name +
+                           "' is fixed but has no initial guess, and a fixed parameter is held "
+                           "at the value the config gives: add initial_guess." +
+                           key + ", or do not fix '" + name + "'");
     }
     fixed[index] = true;
   }
@@ -239,8 +260,8 @@ std::vector<ResidualKind> ReadStages(const ConfigValue& value, const ConfigSourc
     ResidualKind kind;
     if (!ResidualKindFromName(name, &kind)) {
       throw source.Error(entry.path, entry.mark,
-                         "unknown stage '" + name + "'" + DidYouMean(name, allowed) +
-                             "; allowed: " + JoinNames(allowed));
+                         "unknown stage '" + EscapeForMessage(name) + "'" +
+                             DidYouMean(name, allowed) + "; allowed: " + JoinNames(allowed));
     }
     stages.push_back(kind);
   }
@@ -261,8 +282,8 @@ ResidualOptions ReadResidual(const ConfigValue& value, const ConfigSource& sourc
       const std::vector<std::string> allowed = {ErrorMeasureName(ErrorMeasure::kAbsolute),
                                                 ErrorMeasureName(ErrorMeasure::kRelative)};
       throw source.Error(error->path, error->mark,
-                         "unknown error measure '" + name + "'" + DidYouMean(name, allowed) +
-                             "; allowed: " + JoinNames(allowed));
+                         "unknown error measure '" + EscapeForMessage(name) + "'" +
+                             DidYouMean(name, allowed) + "; allowed: " + JoinNames(allowed));
     }
   }
   if (const auto use_point_sigma = block.Optional("use_point_sigma")) {
@@ -370,8 +391,8 @@ JumpKind ReadJumpKind(const ConfigValue& value, const ConfigSource& source) {
   const std::vector<std::string> allowed = {JumpKindName(JumpKind::kJumpUp),
                                             JumpKindName(JumpKind::kJumpDown)};
   throw source.Error(value.path, value.mark,
-                     "unknown jump kind '" + name + "'" + DidYouMean(name, allowed) +
-                         "; allowed: " + JoinNames(allowed));
+                     "unknown jump kind '" + EscapeForMessage(name) + "'" +
+                         DidYouMean(name, allowed) + "; allowed: " + JoinNames(allowed));
 }
 
 // One entry of `jumps`: a sweep and exactly one of between_hz, between_a_base
@@ -465,8 +486,8 @@ std::vector<JumpTarget> ReadJumpTargets(const ConfigValue& value, const ConfigSo
     JumpTarget target;
     if (!JumpTargetFromName(name, &target)) {
       throw source.Error(entry.path, entry.mark,
-                         "unknown jump '" + name + "'" + DidYouMean(name, allowed) +
-                             "; allowed: " + JoinNames(allowed));
+                         "unknown jump '" + EscapeForMessage(name) + "'" +
+                             DidYouMean(name, allowed) + "; allowed: " + JoinNames(allowed));
     }
     if (std::find(targets.begin(), targets.end(), target) != targets.end()) {
       throw source.Error(entry.path, entry.mark, "jump '" + name + "' is listed twice; keep one");
@@ -552,7 +573,9 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
   if (initial_guess.node.IsDefined())
     config.initial_guess = ReadInitialGuess(initial_guess, source);
   identification.initial = WithPlaceholders(config.initial_guess);
-  if (const auto value = top.Optional("fixed")) identification.fixed = ReadFixed(*value, source);
+  if (const auto value = top.Optional("fixed")) {
+    identification.fixed = ReadFixed(*value, source, config.initial_guess);
+  }
   if (const auto value = top.Optional("stages")) identification.stages = ReadStages(*value, source);
   if (const auto value = top.Optional("residual")) {
     identification.residual = ReadResidual(*value, source);

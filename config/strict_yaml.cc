@@ -59,7 +59,8 @@ Number ReadNumber(const ConfigValue& value, const ConfigSource& source, const st
   const char* end = digits.data() + digits.size();
   const auto [stop, error] = std::from_chars(digits.data(), end, number);
   if (error != std::errc() || stop != end) {
-    throw source.Error(value.path, value.mark, "expected " + expected + ", got '" + text + "'");
+    throw source.Error(value.path, value.mark,
+                       "expected " + expected + ", got '" + EscapeForMessage(text) + "'");
   }
   return number;
 }
@@ -93,8 +94,9 @@ StrictMap::StrictMap(const ConfigValue& block, const ConfigSource& source,
     const std::string& key = key_node.Scalar();
     const std::string path = ChildPath(key);
     if (std::find(allowed_keys_.begin(), allowed_keys_.end(), key) == allowed_keys_.end()) {
-      throw source_.Error(path, key_node.Mark(),
-                          "unknown key '" + key + "' " + where + DidYouMean(key, allowed_keys_) +
+      throw source_.Error(ChildPath(EscapeForMessage(key)), key_node.Mark(),
+                          "unknown key '" + EscapeForMessage(key) + "' " + where +
+                              DidYouMean(key, allowed_keys_) +
                               "; allowed: " + JoinNames(allowed_keys_));
     }
     const auto previous = entries_.find(key);
@@ -130,8 +132,9 @@ double ReadFiniteDouble(const ConfigValue& value, const ConfigSource& source) {
   const double number =
       ReadNumber<double>(value, source, "a number", "a number (e.g. 130, 0.26 or 1.3e4)");
   if (!std::isfinite(number)) {
-    throw source.Error(value.path, value.mark,
-                       "expected a finite number, got '" + value.node.Scalar() + "'");
+    throw source.Error(
+        value.path, value.mark,
+        "expected a finite number, got '" + EscapeForMessage(value.node.Scalar()) + "'");
   }
   return number;
 }
@@ -149,7 +152,8 @@ bool ReadBool(const ConfigValue& value, const ConfigSource& source) {
   const std::string& text = ScalarText(value, source, "true or false");
   if (text == "true" || text == "True" || text == "TRUE") return true;
   if (text == "false" || text == "False" || text == "FALSE") return false;
-  throw source.Error(value.path, value.mark, "expected true or false, got '" + text + "'");
+  throw source.Error(value.path, value.mark,
+                     "expected true or false, got '" + EscapeForMessage(text) + "'");
 }
 
 std::string ReadNonEmptyString(const ConfigValue& value, const ConfigSource& source) {
@@ -163,8 +167,8 @@ std::string ReadOneOf(const ConfigValue& value, const ConfigSource& source, cons
   const std::string name = ReadNonEmptyString(value, source);
   if (std::find(allowed.begin(), allowed.end(), name) == allowed.end()) {
     throw source.Error(value.path, value.mark,
-                       "unknown " + what + " '" + name + "'" + DidYouMean(name, allowed) +
-                           "; allowed: " + JoinNames(allowed));
+                       "unknown " + what + " '" + EscapeForMessage(name) + "'" +
+                           DidYouMean(name, allowed) + "; allowed: " + JoinNames(allowed));
   }
   return name;
 }

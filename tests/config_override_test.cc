@@ -207,5 +207,149 @@ TEST(ConfigOverrideErrors, FileErrorsStillNameTheFileLine) {
   EXPECT_EQ(error.field(), "solver.num_threads");
 }
 
+// Hostile overrides (the override rows of the Hardening issue's table).
+
+TEST(ParseSetFlag, ARepeatedKeyIsAnError) {
+  // Before: the last value won.
+  const InputError error = SetFlagError("k=5,solver.max_iterations=50,k=6");
+  EXPECT_STREQ(error.what(),
+               "--set: field 'k': 'k' is set twice (k=5 and k=6); give each key once");
+}
+
+TEST(ConfigOverrideErrors, TwoOverridesOfOneKeyConflict) {
+  InputError error = LoadErrorWith({{"solver.max_iterations", "5", "--max_iterations"},
+                                    {"solver.max_iterations", "6", "--set"}});
+  EXPECT_STREQ(error.what(),
+               "--set: field 'solver.max_iterations': conflicts with --max_iterations "
+               "solver.max_iterations=5: both change it; give each key once");
+  // A block and a key inside it conflict too.
+  error = LoadErrorWith({{"solver", "{num_threads: 1}", "--set"},
+                         {"solver.max_iterations", "6", "--max_iterations"}});
+  EXPECT_THAT(error.what(), StartsWith("--max_iterations: field 'solver.max_iterations': "
+                                       "conflicts with --set solver={num_threads: 1}"));
+  // --set fixed=[...] would silently undo --fix.
+  error = LoadErrorWith({ListFlagOverride("fixed", "delta", "--fix", OverrideAction::kAddToList),
+                         {"fixed", "[mu1]", "--set"}});
+  EXPECT_THAT(error.what(),
+              StartsWith("--set: field 'fixed': conflicts with --fix fixed+=[delta]"));
+}
+
+TEST(ConfigOverrides, FixAddsToTheFixedListOfTheFile) {
+  // Before: --fix replaced the list and so freed omega.
+  const ConfigDirectory dir;
+  const std::string path = dir.WriteConfig(kValidConfig);  // fixed: [omega]
+  IdentifyConfig config = LoadIdentifyConfig(
+      path, {ListFlagOverride("fixed", "delta,omega", "--fix", OverrideAction::kAddToList)});
+  EXPECT_THAT(config.identification.fixed, ElementsAre(false, false, false, true, false, true));
+  EXPECT_THAT(ConfigToYaml(config), HasSubstr("# override: --fix fixed+=[delta, omega]"));
+  // Added to a list the file lacks; --fix and --free of different names combine.
+  const std::string without =
+      dir.WriteFile("without.yaml", Replace(kValidConfig, "fixed: [omega]\n", ""));
+  config = LoadIdentifyConfig(
+      without, {ListFlagOverride("fixed", "mu2", "--fix", OverrideAction::kAddToList)});
+  EXPECT_THAT(config.identification.fixed, ElementsAre(false, false, true, false, false, false));
+  config = LoadIdentifyConfig(
+      path, {ListFlagOverride("fixed", "mu2", "--fix", OverrideAction::kAddToList),
+             ListFlagOverride("fixed", "omega", "--free", OverrideAction::kRemoveFromList)});
+  EXPECT_THAT(config.identification.fixed, ElementsAre(false, false, true, false, false, false));
+}
+
+TEST(ConfigOverrideErrors, FixAndFreeOfOneNameConflict) {
+  const InputError error = LoadErrorWith(
+      {ListFlagOverride("fixed", "delta", "--fix", OverrideAction::kAddToList),
+       ListFlagOverride("fixed", "mu1,delta", "--free", OverrideAction::kRemoveFromList)});
+  EXPECT_STREQ(error.what(),
+               "--free: field 'fixed': 'delta' is given to both --fix and --free; give it to one "
+               "of them");
+}
+
+TEST(ConfigOverrideErrors, ErrorsAboutAnAddedEntryNameTheFlagAndAboutTheFileItsLine) {
+  InputError error =
+      LoadErrorWith({ListFlagOverride("fixed", "omgea", "--fix", OverrideAction::kAddToList)});
+  EXPECT_THAT(error.what(), StartsWith("--fix: field 'fixed': unknown parameter 'omgea' (did "
+                                       "you mean 'omega'?)"));
+  const ConfigDirectory dir;
+  const std::string path =
+      dir.WriteConfig(Replace(kValidConfig, "fixed: [omega]", "fixed: [omega, mu3]"));
+  error = ErrorOf([&] {
+    LoadIdentifyConfig(path,
+                       {ListFlagOverride("fixed", "delta", "--fix", OverrideAction::kAddToList)});
+  });
+  EXPECT_EQ(error.file(), path);
+  EXPECT_EQ(error.line(), 12);
+  EXPECT_THAT(error.what(), HasSubstr("unknown parameter 'mu3'"));
+  // A parameter --fix adds needs an initial guess too.
+  const std::string no_delta =
+      dir.WriteFile("no_delta.yaml", Replace(kValidConfig, "  delta: 1.3e4\n", ""));
+  error = ErrorOf([&] {
+    LoadIdentifyConfig(no_delta,
+                       {ListFlagOverride("fixed", "delta", "--fix", OverrideAction::kAddToList)});
+  });
+  EXPECT_STREQ(error.what(),
+               "--fix: field 'fixed': parameter 'delta' is fixed but has no initial guess, and a "
+               "fixed parameter is held at the value the config gives: add initial_guess.delta, "
+               "or do not fix 'delta'");
+}
+
+TEST(ConfigOverrideErrors, AnEmptyFlagValueSaysSo) {
+  // Before: --output_dir= removed the key and said "missing required key".
+  InputError error = LoadErrorWith({{"output_dir", "", "--output_dir"}});
+  EXPECT_STREQ(error.what(),
+               "--output_dir: field 'output_dir': the flag's value is empty; give a value for "
+               "'output_dir'");
+  error = LoadErrorWith({ListFlagOverride("fixed", "", "--fix", OverrideAction::kAddToList)});
+  EXPECT_STREQ(error.what(),
+               "--fix: field 'fixed': the flag's value is empty; give the names to add to "
+               "'fixed'");
+  error =
+      LoadErrorWith({ListFlagOverride("fixed", " , ", "--free", OverrideAction::kRemoveFromList)});
+  EXPECT_THAT(error.what(), HasSubstr("give the names to remove from 'fixed'"));
+}
+
+// Two penalty blocks sharing one YAML anchor.
+constexpr char kAliasedPenalties[] = R"(penalties:
+  bifurcation_range: &common {enabled: true, weight: 2}
+  branch_stability: *common
+)";
+
+TEST(ConfigOverrides, SetOnAnAliasedBlockChangesOnlyTheNamedPath) {
+  // Before: the alias was written through, changing both blocks.
+  const ConfigDirectory dir;
+  const std::string path = dir.WriteConfig(
+      Replace(kValidConfig, "output_dir:", std::string(kAliasedPenalties) + "output_dir:"));
+  IdentifyConfig config = LoadIdentifyConfig(path);
+  EXPECT_EQ(config.identification.penalties.branch_stability.weight, 2.0);  // the alias reads
+  config = LoadIdentifyConfig(path, ParseSetFlag("penalties.branch_stability.weight=5", "--set"));
+  EXPECT_EQ(config.identification.penalties.branch_stability.weight, 5.0);
+  EXPECT_EQ(config.identification.penalties.bifurcation_range.weight, 2.0);
+  EXPECT_TRUE(config.identification.penalties.branch_stability.enabled);
+  config = LoadIdentifyConfig(path,
+                              ParseSetFlag("penalties.branch_stability={enabled: false}", "--set"));
+  EXPECT_FALSE(config.identification.penalties.branch_stability.enabled);
+  EXPECT_TRUE(config.identification.penalties.bifurcation_range.enabled);
+  // A value the override did not set still names its line in the file.
+  const std::string bad = dir.WriteFile(
+      "bad.yaml",
+      Replace(Replace(kValidConfig, "output_dir:", std::string(kAliasedPenalties) + "output_dir:"),
+              "enabled: true", "enabled: maybe"));
+  const InputError error = ErrorOf([&] {
+    LoadIdentifyConfig(bad, ParseSetFlag("penalties.branch_stability.weight=5", "--set"));
+  });
+  EXPECT_EQ(error.file(), bad);
+  EXPECT_EQ(error.line(), 28);
+  EXPECT_THAT(error.what(), HasSubstr("expected true or false, got 'maybe'"));
+}
+
+TEST(ConfigOverrides, SetOnAnAliasedValueChangesOnlyThatKey) {
+  const ConfigDirectory dir;
+  const std::string path = dir.WriteConfig(Replace(
+      Replace(kValidConfig, "  omega_hz: 40", "  omega_hz: &f 41"),
+      "effective_nonlinearity_reference_hz: 41", "effective_nonlinearity_reference_hz: *f"));
+  const IdentifyConfig config =
+      LoadIdentifyConfig(path, ParseSetFlag("initial_guess.omega_hz=40", "--set"));
+  EXPECT_DOUBLE_EQ(config.identification.initial[kOmega], HzToRadPerSecond(40.0));
+  EXPECT_DOUBLE_EQ(*config.omega_ref_rad_s, HzToRadPerSecond(41.0));
+}
+
 }  // namespace
 }  // namespace dwellfit

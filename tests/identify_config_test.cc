@@ -5,6 +5,7 @@
 #include <sstream>
 #include <string>
 
+#include "config/dwell_plan_reader.h"
 #include "estimator/input_error.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -465,6 +466,130 @@ TEST(IdentifyConfigErrors, MissingConfigFile) {
   const InputError error = LoadError(path);
   EXPECT_EQ(error.file(), path);
   EXPECT_THAT(error.what(), HasSubstr("cannot open the config file"));
+}
+
+// Hostile configs (the config rows of the Hardening issue's table).
+
+TEST(IdentifyConfigErrors, ASecondYamlDocumentIsAnErrorAtItsLine) {
+  // Before: the second document was silently ignored.
+  const ConfigDirectory dir;
+  std::string path;
+  const InputError error =
+      LoadError(dir, std::string(kValidConfig) + "---\nfixed: [delta]\n", &path);
+  EXPECT_EQ(std::string(error.what()),
+            path +
+                ":29: a second YAML document starts here (after a '---' line), and only the "
+                "first would be read; the file holds one document: move these keys into the "
+                "first one, or remove the '---' line");
+  // A leading '---', and an empty document after a trailing one, hold nothing more.
+  EXPECT_NO_THROW(LoadIdentifyConfig(
+      dir.WriteConfig("---\n" + std::string(kValidConfig) + "---\n# nothing here\n")));
+}
+
+TEST(IdentifyConfigErrors, ASecondYamlDocumentInAPlanFileIsAnError) {
+  const ConfigDirectory dir;
+  const std::string plan = dir.WriteFile("plan.yaml", "output: out.csv\n---\noutput: other.csv\n");
+  const InputError error = ErrorOf([&] { ReadDwellPlan(plan); });
+  EXPECT_EQ(error.file(), plan);
+  EXPECT_EQ(error.line(), 3);
+  EXPECT_THAT(error.what(), HasSubstr("a second YAML document starts here"));
+}
+
+TEST(IdentifyConfigErrors, AFixedParameterWithoutAnInitialGuessIsAnError) {
+  // Before: held at the automatic guess, unflagged.
+  const ConfigDirectory dir;
+  std::string path;
+  InputError error = ErrorWith(dir, "  omega_hz: 40\n", "", &path);
+  ExpectAt(error, path, 11, "fixed");
+  EXPECT_THAT(error.what(),
+              HasSubstr("parameter 'omega' is fixed but has no initial guess, and a fixed "
+                        "parameter is held at the value the config gives: add "
+                        "initial_guess.omega_hz, or do not fix 'omega'"));
+  path = dir.WriteConfig(Replace(Replace(kValidConfig, "  delta: 1.3e4", "  delta: auto"),
+                                 "fixed: [omega]", "fixed: [omega, delta]"));
+  error = LoadError(path);
+  ExpectAt(error, path, 12, "fixed");
+  EXPECT_THAT(error.what(), HasSubstr("add initial_guess.delta, or do not fix 'delta'"));
+}
+
+TEST(IdentifyConfigErrors, TenThousandNestedListsSayTheYamlIsNestedTooDeeply) {
+  // Before: "YAML syntax error: bad file".
+  const ConfigDirectory dir;
+  std::string path;
+  const InputError error =
+      LoadError(dir,
+                std::string(kValidConfig) + "jumps: " + std::string(10000, '[') +
+                    std::string(10000, ']') + "\n",
+                &path);
+  EXPECT_EQ(error.file(), path);
+  EXPECT_EQ(error.line(), 28);
+  EXPECT_THAT(error.what(), HasSubstr("the YAML is nested too deeply"));
+  EXPECT_THAT(error.what(), HasSubstr("look for runaway brackets or indentation here"));
+}
+
+TEST(IdentifyConfigErrors, MultiStartStartsAreBounded) {
+  // Before: 2147483647 starts ran for hours.
+  const ConfigDirectory dir;
+  std::string path;
+  const InputError error =
+      ErrorWith(dir, "output_dir:", "multi_start:\n  starts: 2147483647\noutput_dir:", &path);
+  ExpectAt(error, path, 27, "multi_start");
+  EXPECT_THAT(error.what(),
+              HasSubstr("multi_start.starts must be from 1 to 1000 (each start is a whole fit)"));
+  const IdentifyConfig config = LoadIdentifyConfig(dir.WriteConfig(
+      Replace(kValidConfig, "output_dir:", "multi_start: {starts: 1000}\noutput_dir:")));
+  EXPECT_EQ(config.multi_start.starts, 1000);
+  const InputError too_big =
+      ErrorWith(dir, "  max_iterations: 150", "  max_iterations: 99999999999", &path);
+  ExpectAt(too_big, path, 18, "solver.max_iterations");
+  EXPECT_THAT(too_big.what(), HasSubstr("expected a whole number (e.g. 200), got '99999999999'"));
+}
+
+TEST(IdentifyConfigErrors, ADataPathThatIsADirectoryOrADeviceSaysWhatItIs) {
+  // Before: "not found".
+  const ConfigDirectory dir;
+  std::string path;
+  fs::create_directories(dir.path() / "sweeps_dir");
+  InputError error = ErrorWith(dir, "data: sweeps.csv", "data: sweeps_dir", &path);
+  ExpectAt(error, path, 2, "data");
+  EXPECT_THAT(error.what(),
+              HasSubstr("data file 'sweeps_dir' at " + (dir.path() / "sweeps_dir").string() +
+                        " is a directory; give the path of a sweeps CSV file"));
+  error = ErrorWith(dir, "data: sweeps.csv", "data: /dev/null", &path);
+  EXPECT_THAT(error.what(), HasSubstr("data file '/dev/null' at /dev/null is a character "
+                                      "device, not a file; give the path of a sweeps CSV file"));
+}
+
+TEST(IdentifyConfigErrors, BillionLaughsAliasesFailFastAtTheFirstWrongType) {
+  // Nine levels of ten aliases each: 10^9 leaves if expanded; yaml-cpp shares
+  // the nodes and the reader stops at the first value of the wrong type.
+  std::string laughs = "&a0 [lol]";
+  for (int i = 1; i <= 9; ++i) {
+    laughs += ", &a" + std::to_string(i) + " [";
+    for (int j = 0; j < 10; ++j)
+      laughs += std::string(j > 0 ? ", " : "") + "*a" + std::to_string(i - 1);
+    laughs += "]";
+  }
+  const ConfigDirectory dir;
+  std::string path;
+  InputError error = LoadError(dir, "laughs: [" + laughs + "]\n" + kValidConfig, &path);
+  ExpectAt(error, path, 1, "laughs");
+  EXPECT_THAT(error.what(), HasSubstr("unknown key 'laughs' at the top level"));
+  error = LoadError(dir, std::string(kValidConfig) + "jumps: [" + laughs + "]\n", &path);
+  ExpectAt(error, path, 28, "jumps[0]");
+  EXPECT_THAT(error.what(), HasSubstr("expected a block of keys (sweep, kind, between_hz, "
+                                      "between_a_base, none), got a list"));
+}
+
+TEST(IdentifyConfigErrors, ControlBytesAreEscapedInMessages) {
+  const ConfigDirectory dir;
+  std::string path;
+  InputError error =
+      ErrorWith(dir, "  max_iterations: 150", "  max_iterations: \"15\\r0\\u0001\"", &path);
+  ExpectAt(error, path, 18, "solver.max_iterations");
+  EXPECT_THAT(error.what(), HasSubstr("expected a whole number (e.g. 200), got '15\\r0\\x01'"));
+  error = ErrorWith(dir, "  num_threads: 2", "  \"num\\tthreads\": 2", &path);
+  EXPECT_THAT(error.what(), HasSubstr("unknown key 'num\\tthreads' in 'solver'"));
 }
 
 }  // namespace

@@ -13,16 +13,18 @@
 
 DEFINE_string(config, "", "YAML config file (required), e.g. datasets/thesis-numerical/beam.yaml");
 DEFINE_string(output_dir, "", "Overrides output_dir (relative to the working directory)");
-DEFINE_string(fix, "", "Overrides the fixed parameters: comma list, e.g. delta,omega");
-DEFINE_string(free, "", "Frees parameters the config fixes: comma list, e.g. omega");
+DEFINE_string(fix, "",
+              "Adds parameters to the config's fixed list: comma list, e.g. delta,omega (each "
+              "needs an initial_guess)");
+DEFINE_string(free, "", "Removes parameters from the config's fixed list: comma list, e.g. omega");
 DEFINE_string(stages, "", "Overrides the fit stages: comma list of algebraic, vertical");
 DEFINE_string(residual_error, "", "Overrides residual.error: absolute or relative");
 DEFINE_int32(max_iterations, 0, "Overrides solver.max_iterations when positive");
 DEFINE_string(fit, "", "Overrides the fitted sweeps: comma list of ids or id/direction");
 DEFINE_string(validate, "", "Overrides the validation sweeps: comma list");
 DEFINE_string(set, "",
-              "Overrides any config value: key.path=value[,key.path=value...], e.g. "
-              "initial_guess.mu1=0.3,solver.function_tolerance=1e-12");
+              "Overrides any config value: key.path=value[,key.path=value...], each key once, "
+              "e.g. initial_guess.mu1=0.3,solver.function_tolerance=1e-12");
 
 namespace {
 
@@ -34,7 +36,10 @@ std::vector<dwellfit::ConfigOverride> OverridesFromFlags() {
   std::vector<ConfigOverride> overrides;
   if (FlagGiven("output_dir"))
     overrides.push_back({"output_dir", FLAGS_output_dir, "--output_dir"});
-  if (FlagGiven("fix")) overrides.push_back(ListFlagOverride("fixed", FLAGS_fix, "--fix"));
+  if (FlagGiven("fix")) {
+    overrides.push_back(
+        ListFlagOverride("fixed", FLAGS_fix, "--fix", dwellfit::OverrideAction::kAddToList));
+  }
   if (FlagGiven("free")) {
     overrides.push_back(
         ListFlagOverride("fixed", FLAGS_free, "--free", dwellfit::OverrideAction::kRemoveFromList));
