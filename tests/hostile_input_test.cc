@@ -214,5 +214,25 @@ TEST_F(HostileInput, ResultFilesAreByteIdenticalAcrossThreadCounts) {
   EXPECT_EQ(files[0], files[1]);
 }
 
+TEST_F(HostileInput, AbsurdThreadCountsAreBoundedByTheWork) {
+  // Threads are capped by the dwells and the starts, so 2^31 - 1 is harmless
+  // and the result the same as on one thread.
+  const std::string data = WriteSweeps(lines_);
+  std::string files[2];
+  for (int run = 0; run < 2; ++run) {
+    const std::string threads = run == 0 ? "1" : "2147483647";
+    const std::string out = "out" + std::to_string(run);
+    std::ostringstream printed;
+    RunIdentify(Config(data,
+                       {{"solver.num_threads", threads, "--set"},
+                        {"multi_start", "{starts: 2, threads: " + threads + "}", "--set"}},
+                       out),
+                printed);
+    files[run] = ReadFile(dir_ / out / "result.yaml");
+  }
+  EXPECT_FALSE(files[0].empty());
+  EXPECT_EQ(files[0], files[1]);
+}
+
 }  // namespace
 }  // namespace dwellfit
