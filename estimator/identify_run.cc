@@ -74,6 +74,7 @@ ConfiguredSweeps LoadConfiguredSweeps(const IdentifyConfig& config) {
 
 std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::ostream& out) {
   out << "# config in effect\n" << ConfigToYaml(config) << "\n";
+  CheckOutputDirectory(config.output_dir, "output_dir");
   auto outcome = std::make_unique<IdentifyOutcome>();
   outcome->sweeps = LoadConfiguredSweeps(config);
   const std::vector<const Sweep*>& fitted = outcome->sweeps.fitted;
@@ -138,7 +139,8 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
   PrintReport(report, out);
   WriteFilesAtomically(config.output_dir, {{"result.yaml", ReportToYaml(report)},
                                            {"predictions.csv", ReportToPredictionsCsv(report)}});
-  out << "\nwrote " << config.output_dir << "/result.yaml and predictions.csv\n";
+  out << "\nwrote " << config.output_dir << "/result.yaml and predictions.csv (listed in "
+      << kManifestFileName << ")\n";
   return outcome;
 }
 

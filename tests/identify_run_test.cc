@@ -16,6 +16,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 const std::string kConfig =
     std::string(DWELLFIT_SOURCE_DIR) + "/datasets/thesis-numerical/beam.yaml";
@@ -69,6 +70,10 @@ TEST(RunIdentify, WritesResultYamlAndPredictionsForTheThesisCase) {
   const std::string csv = ReadFile(fs::path(out_dir) / "predictions.csv");
   EXPECT_THAT(csv, HasSubstr("sweep,direction,role,freq_hz,a_base,a,a_model,branch,model_status"));
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 2 * 81 + 6 * 49);
+
+  const YAML::Node manifest = YAML::LoadFile(out_dir + "/manifest.yaml");
+  ASSERT_EQ(manifest["files"].size(), 2u);
+  EXPECT_EQ(manifest["files"][1]["bytes"].as<std::size_t>(), csv.size());
 }
 
 TEST(RunIdentify, SameInputGivesTheSameFiles) {
@@ -108,6 +113,9 @@ TEST(RunIdentify, AnUnwritableOutputDirLeavesNoPartialFile) {
       LoadIdentifyConfig(kConfig, {{"output_dir", parent + "/blocked/out", "--test"}});
   std::ostringstream printed;
   EXPECT_THROW(RunIdentify(config, printed), InputError);
+  // The directory is checked before the data are read and the fit runs.
+  EXPECT_THAT(printed.str(), Not(HasSubstr("fit ")));
+  EXPECT_THAT(printed.str(), Not(HasSubstr("Ceres Solver Report")));
   for (const auto& entry : fs::recursive_directory_iterator(parent)) {
     EXPECT_EQ(entry.path().filename(), "blocked") << entry.path();
   }
