@@ -35,7 +35,7 @@
 
 #include <string>
 
-#include "estimator/dwell_simulator.h"
+#include "dwellfit/estimator/simulation/dwell_simulator.h"
 
 namespace dwellfit {
 
