@@ -5,7 +5,7 @@
 //
 // Fits `replicas` noisy simulations of the plan with the config and prints,
 // per free parameter and for the effective nonlinearity, how often the 95 %
-// interval covers the truth (estimator/coverage_study.h).
+// interval covers the truth (estimator/studies/coverage_study.h).
 #include <iostream>
 
 #include "dwellfit/config/dwell_plan_reader.h"

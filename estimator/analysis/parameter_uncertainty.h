@@ -2,7 +2,7 @@
 // correlations of the parameters, from the local linearisation of the
 // vertical-error fit at its estimate.
 //
-// With r(p) the data residuals (vertical error, residuals/vertical_error_residual.h;
+// With r(p) the data residuals (vertical error, residuals/functors/vertical_error_residual.h;
 // no penalties), J = dr/dp over the k free parameters at the estimate p^ and
 // n dwell points, the Gauss-Newton covariance of the least-squares estimate is
 //

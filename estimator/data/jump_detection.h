@@ -1,6 +1,6 @@
 // Jumps in measured sweeps and the stable branch of every dwell.
 //
-// In a stepped dwell test of the single-mode model (model.md, "Stability and
+// In a stepped dwell test of the single-mode model (docs/model.md, "Stability and
 // folds") a sweep passes at most one saddle-node fold, so it shows at most one
 // jump: a step between consecutive dwells where the response leaves one stable
 // branch for the other. The detected jump brackets the fold between its two

@@ -1,5 +1,5 @@
 // Writing sine-dwell sweeps in the project's CSV format (read by
-// LoadSweepsCsv, estimator/sweep_csv.h).
+// LoadSweepsCsv, estimator/data/sweep_csv.h).
 //
 // Header `sweep,direction,freq_hz,a_base,a`, plus `sigma` when the points carry
 // one; then one row per dwell, sweeps in the given order and each sweep's

@@ -2,7 +2,7 @@
 //
 // The fit stages (identification.h) need a start within a factor of about 2
 // of the minimum. This estimates one from features any sine-dwell test shows,
-// with the fixed points of model.md (units: Omega, w in rad/s):
+// with the fixed points of docs/model.md (units: Omega, w in rad/s):
 //
 //   P(a) = Omega a (mu1 + c mu2 a) / eta_e = a_base sin(gamma),  c = 4 / (3 pi)
 //   Q(a) = a D / (2 eta_e)                 = a_base cos(gamma),

@@ -8,8 +8,8 @@
 //   subject to                            eta_e, mu1, mu2 >= 0
 //
 // where r_i is either the algebraic residual of eq. (3.11)
-// (residuals/algebraic_residual.h) or the vertical error of section 3.2.4
-// (residuals/vertical_error_residual.h). Fixed parameters keep their value;
+// (residuals/functors/algebraic_residual.h) or the vertical error of section 3.2.4
+// (residuals/functors/vertical_error_residual.h). Fixed parameters keep their value;
 // the free ones are stepped in units of their scale (ScaledSubsetManifold).
 #ifndef DWELLFIT_ESTIMATOR_FIT_PROBLEM_BUILDER_H_
 #define DWELLFIT_ESTIMATOR_FIT_PROBLEM_BUILDER_H_

@@ -1,4 +1,4 @@
-// A stepped sine-dwell test, simulated on the model (model.md).
+// A stepped sine-dwell test, simulated on the model (docs/model.md).
 //
 // A dwell test steps one control, the drive frequency Omega (frequency sweep,
 // a_base held) or the base level a_base (amplitude sweep, Omega held), and at

@@ -1,5 +1,5 @@
 // FoldPoint: where the model jumps, for a measured jump bracket
-// (model.md, "Stability and folds"; section 3.2.4).
+// (docs/model.md, "Stability and folds"; section 3.2.4).
 //
 // A jump-up is where the lower stable branch ends (the local maximum of G at
 // a_lower_end); a jump-down is where the upper branch ends (the local minimum

@@ -2,11 +2,11 @@
 // block every dwellfit functor reads.
 //
 //   index  name    unit / meaning
-//   0      eta_e   forcing effectiveness (modal force per unit a_base)
+//   0      eta_e   forcing effectiveness [A/(B s^2)], A the unit of a, B of a_base
 //   1      mu1     linear damping [1/s]
-//   2      mu2     quadratic (aerodynamic) damping [1/length]
-//   3      delta   nonlinear inertia [1/length^2]
-//   4      alpha   cubic stiffness [1/(length^2 s^2)]
+//   2      mu2     quadratic (aerodynamic) damping [1/(A s)]: the term is (mu2/Omega) u'|u'|
+//   3      delta   nonlinear inertia [1/A^2]
+//   4      alpha   cubic stiffness [1/(A^2 s^2)]
 //   5      omega   linear natural frequency w [rad/s]
 #ifndef DWELLFIT_RESIDUALS_MODEL_MODEL_PARAMETERS_H_
 #define DWELLFIT_RESIDUALS_MODEL_MODEL_PARAMETERS_H_
@@ -53,7 +53,7 @@ inline double HzToRadPerSecond(double hz) { return kTwoPi * hz; }
 inline double RadPerSecondToHz(double rad_s) { return rad_s / kTwoPi; }
 
 // The chapter's effective cubic nonlinearity -(1/3)(2 delta Omega_ref^2 - 3 alpha)
-// = alpha - (2/3) delta Omega_ref^2 (model.md, "Identifiability").
+// = alpha - (2/3) delta Omega_ref^2 (docs/model.md, "Identifiability").
 inline double EffectiveNonlinearity(const ParameterVector& p, double omega_ref_rad_s) {
   return p[kAlpha] - (2.0 / 3.0) * p[kDelta] * omega_ref_rad_s * omega_ref_rad_s;
 }

@@ -1,5 +1,5 @@
 // The single-mode response model of the chapter, templated on the scalar so that
-// ceres::Jet values flow through (model.md, "Fixed points").
+// ceres::Jet values flow through (docs/model.md, "Fixed points").
 //
 // Fixed points (3.1)-(3.2), with u ~ a cos(Omega t - gamma):
 //   P(a) = k1 a + k2 a^2 = a_base sin(gamma)

@@ -1,7 +1,7 @@
 // The stable fixed point on a named branch, found in double precision, and its
 // lift to any scalar type by the implicit function theorem.
 //
-// Structure used (model.md, "Stability and folds"): dG/da = a h(a) with the
+// Structure used (docs/model.md, "Stability and folds"): dG/da = a h(a) with the
 // quartic h(a) = 6 c6 a^4 + 4 c4 a^2 + 3 c3 a + 2 c2, c2, c3, c6 >= 0. By
 // Descartes' rule h has no positive root when c4 >= 0 and zero or two when
 // c4 < 0. So G has at most two turning points on a > 0: a local maximum at

@@ -1,4 +1,4 @@
-// The automatic starting point (estimator/initial_guess.h) on the chapter's
+// The automatic starting point (estimator/fit/initial_guess.h) on the chapter's
 // numerical case, its 1 % noise replica and the real clamped-beam data, and
 // the identification run from it.
 #include "dwellfit/estimator/fit/initial_guess.h"
@@ -184,7 +184,7 @@ TEST_F(InitialGuessThesis, SweepsWithoutResonanceAreAnInputError) {
 TEST(InitialGuess, OnePercentNoiseReplicaStaysWithinAFactorTwo) {
   DwellPlan plan = ReadDwellPlan(kThesis + "/plan.yaml");
   plan.noise.relative_sigma = 0.01;
-  plan.noise.seed = 20261121;  // the replica of tests/thesis_numerical_test.cc
+  plan.noise.seed = 20261121;  // the replica of tests/fit/thesis_numerical_test.cc
   {
     const std::vector<Sweep> noisy = Labelled(SimulateDwells(plan));
     const std::vector<const Sweep*> fitted = Select(noisy, {"F0.01", "A41.5"});

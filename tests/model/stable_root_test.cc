@@ -9,7 +9,7 @@
 namespace dwellfit {
 namespace {
 
-// Table 3.1 truth with w = 2 pi 40 rad/s (model.md).
+// Table 3.1 truth with w = 2 pi 40 rad/s (docs/model.md).
 ParameterVector Truth() { return {100.0, 0.2, 300.0, 1e4, 9e8, HzToRadPerSecond(40.0)}; }
 
 ResponseCoefficients<double> At(double hz) {
@@ -24,7 +24,7 @@ TEST(FindTurningPoints, AmplitudeSweepJumpLevelsAt41_5HzMatchTheChapter) {
   EXPECT_LT(tp.a_lower_end, tp.a_upper_end);
   EXPECT_NEAR(k.dG(tp.a_lower_end), 0.0, 1e-12);
   EXPECT_NEAR(k.dG(tp.a_upper_end), 0.0, 1e-12);
-  // model.md: jumps up near a_base = 0.0354 and down near 0.0068.
+  // docs/model.md: jumps up near a_base = 0.0354 and down near 0.0068.
   EXPECT_NEAR(std::sqrt(k.G(tp.a_lower_end)), 0.0354, 0.0005);
   EXPECT_NEAR(std::sqrt(k.G(tp.a_upper_end)), 0.0068, 0.0002);
   EXPECT_GT(k.d2G(tp.a_upper_end), 0.0);  // a local minimum of G
@@ -38,8 +38,8 @@ TEST(FindTurningPoints, NoFoldFarBelowResonance) {
 TEST(SolveStableRoot, FrequencySweepBranchesEndWhereTheChapterSays) {
   const double a_base = 0.01;
   // Going up: the upper branch still exists at 42.2 Hz and is gone at 42.3 Hz.
-  // (model.md quotes 42.0-42.1 Hz; a brute-force root count of its own G(a)
-  // puts three roots at 42.2 Hz and one at 42.25 Hz.)
+  // (the fold is at 42.215 Hz, docs/model.md; a brute-force root count of
+  // G(a) puts three roots at 42.2 Hz and one at 42.25 Hz.)
   EXPECT_EQ(SolveStableRoot(At(42.2), a_base, Branch::kUpper, 4e-3).status, RootStatus::kOnBranch);
   EXPECT_EQ(SolveStableRoot(At(42.3), a_base, Branch::kUpper, 4e-3).status, RootStatus::kBranchEnd);
   // Coming down: the lower branch exists at 40.7 Hz and is gone at 40.6 Hz.

@@ -1,6 +1,6 @@
 // Cross-check of the fixed-point model against the equation of motion itself.
 //
-// Equation of motion (model.md, 3.12), Omega constant during one dwell:
+// Equation of motion (docs/model.md, 3.12), Omega constant during one dwell:
 //   u'' + w^2 u + delta (u u'^2 + u^2 u'') + alpha u^3 + 2 mu1 u' + (mu2/Omega) u'|u'|
 //       = 2 eta_e a_base cos(Omega t)
 // solved for u'' (the delta term multiplies it):
@@ -34,7 +34,7 @@ using State = std::array<double, 2>;  // u, u'
 
 constexpr int kStepsPerPeriod = 64;
 
-// Table 3.1 truth with w = 2 pi 40 rad/s (model.md).
+// Table 3.1 truth with w = 2 pi 40 rad/s (docs/model.md).
 ParameterVector Truth() { return {100.0, 0.2, 300.0, 1e4, 9e8, HzToRadPerSecond(40.0)}; }
 
 // Right-hand side of (3.12) as a first-order system.

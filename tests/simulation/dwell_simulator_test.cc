@@ -19,7 +19,7 @@ namespace {
 
 const std::string kDatasetDir = std::string(DWELLFIT_SOURCE_DIR) + "/datasets/thesis-numerical/";
 
-// Table 3.1 truth with w = 2 pi 40 rad/s (model.md).
+// Table 3.1 truth with w = 2 pi 40 rad/s (docs/model.md).
 ParameterVector Truth() { return {100.0, 0.2, 300.0, 1e4, 9e8, HzToRadPerSecond(40.0)}; }
 
 ResponseCoefficients<double> At(double omega_rad_s) {
@@ -151,8 +151,8 @@ TEST(DwellSimulator, ThesisJumpsLandWhereTheModelPutsThem) {
     JumpKind kind;
     double before, after;  // Hz for frequency sweeps, a_base for amplitude sweeps
   };
-  // model.md quotes 42.0-42.1 Hz for the frequency jump down; its own G(a)
-  // puts the fold between 42.2 and 42.3 Hz (see stable_root_test.cc).
+  // G(a) puts the frequency jump down's fold at 42.215 Hz, between the 42.2
+  // and 42.3 Hz dwells (docs/model.md; see stable_root_test.cc).
   const std::vector<Expected> expected = {
       {"F0.01/up", JumpKind::kJumpDown, 42.2, 42.3},
       {"F0.01/down", JumpKind::kJumpUp, 40.7, 40.6},
