@@ -9,6 +9,7 @@
 
 #include "dwellfit/config/config_source.h"
 #include "dwellfit/config/strict_yaml.h"
+#include "dwellfit/estimator/data/sweep_csv.h"
 
 namespace dwellfit {
 namespace {
@@ -50,6 +51,12 @@ std::vector<std::string> ReadDataFiles(const ConfigValue& value, const ConfigSou
     const std::string text = ReadNonEmptyString(entry, source);
     const std::string resolved = ResolvePath(text, entry, source, config_dir).string();
     std::error_code error;
+    const std::string not_a_file = NotARegularFile(resolved);
+    if (!not_a_file.empty()) {
+      throw source.Error(entry.path, entry.mark,
+                         "data file '" + text + "' at " + resolved + " " + not_a_file +
+                             "; give the path of a sweeps CSV file");
+    }
     if (!fs::is_regular_file(resolved, error)) {
       throw source.Error(entry.path, entry.mark,
                          "data file '" + text + "' not found at " + resolved + " (" +

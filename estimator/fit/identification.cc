@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 #include <optional>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "dwellfit/estimator/fit/bound_rest_watcher.h"
@@ -64,9 +66,11 @@ class StageProblem {
         problem_(ProblemOptions(&evaluator_)) {
     for (const Sweep* sweep : fitted) {
       blocks_ += builder_.AddSweep(*sweep, parameters->data(), &problem_, &evaluator_);
+      for (const DwellPoint& point : sweep->points) dwells_.push_back({sweep, &point});
     }
     CHECK_GT(blocks_, 0) << "no dwell points to fit";
     problem_.GetResidualBlocks(&data_blocks_);
+    CHECK_EQ(data_blocks_.size(), dwells_.size()) << "one residual block per dwell";
   }
 
   // Adds the penalties of `options` (weights in the caller's units).
@@ -127,7 +131,55 @@ class StageProblem {
   std::optional<int> resting() const { return resting_; }
   int blocks() const { return blocks_; }
 
+  // Why a solve that `summary` reports as failed could not evaluate its
+  // cost: the dwells (or penalties) whose residual or Jacobian is not finite
+  // at the current values, or else Ceres' message.
+  std::string DescribeFailure(const ceres::Solver::Summary& summary) {
+    std::vector<ceres::ResidualBlockId> blocks;
+    problem_.GetResidualBlocks(&blocks);
+    int bad_dwells = 0;
+    int first_bad = -1;
+    bool bad_penalty = false;
+    for (std::size_t i = 0; i < blocks.size(); ++i) {
+      if (EvaluatesFinite(blocks[i])) continue;
+      if (i >= dwells_.size()) {
+        bad_penalty = true;
+      } else if (bad_dwells++ == 0) {
+        first_bad = static_cast<int>(i);
+      }
+    }
+    if (first_bad < 0) {
+      return bad_penalty ? "a penalty term is not finite there (penalties, config/README.md)"
+                         : "Ceres: " + summary.message;
+    }
+    const auto [sweep, point] = dwells_[first_bad];
+    std::ostringstream text;
+    text << (bad_dwells == static_cast<int>(dwells_.size())
+                 ? "no dwell's residual is finite there, so the parameters are at fault (the "
+                   "first dwell: "
+                 : std::to_string(bad_dwells) + " dwell(s) have a residual that is not finite " +
+                       "there (the first: ")
+         << sweep->source_file << ":" << point->source_line << ", sweep " << sweep->Name() << ", "
+         << RadPerSecondToHz(point->drive_frequency_rad_s) << " Hz, a_base " << point->a_base
+         << ", a " << point->amplitude << ")";
+    return text.str();
+  }
+
  private:
+  // Whether the block evaluates, with finite residuals and Jacobian.
+  bool EvaluatesFinite(ceres::ResidualBlockId block) {
+    const ceres::CostFunction* cost = problem_.GetCostFunctionForResidualBlock(block);
+    std::vector<double> residuals(cost->num_residuals());
+    std::vector<double> jacobian(cost->num_residuals() * kNumParameters);
+    double* jacobians[] = {jacobian.data()};
+    const double* point[] = {parameters_->data()};
+    if (!cost->Evaluate(point, residuals.data(), jacobians)) return false;
+    bool finite = true;
+    for (double r : residuals) finite = finite && std::isfinite(r);
+    for (double j : jacobian) finite = finite && std::isfinite(j);
+    return finite;
+  }
+
   static ceres::Problem::Options ProblemOptions(ParallelResidualEvaluator* evaluator) {
     ceres::Problem::Options options;
     options.evaluation_callback = evaluator;
@@ -139,9 +191,50 @@ class StageProblem {
   ParallelResidualEvaluator evaluator_;  // outlives problem_, which calls it
   ceres::Problem problem_;
   std::vector<ceres::ResidualBlockId> data_blocks_;
+  // The sweep and dwell of each data block, in the order of data_blocks_.
+  std::vector<std::pair<const Sweep*, const DwellPoint*>> dwells_;
   int blocks_ = 0;
   std::optional<int> resting_;
 };
+
+// The parameter scale of a stage: the user's start, not where an earlier
+// stage landed, so that a stage that drove a parameter to its bound still
+// steps sensibly.
+ParameterVector StartScale(const ParameterVector& initial) {
+  ParameterVector scale;
+  for (int i = 0; i < kNumParameters; ++i) {
+    scale[i] = std::abs(initial[i]) > 0.0 ? std::abs(initial[i]) : 1.0;
+  }
+  return scale;
+}
+
+// "eta_e 130, mu1 0.14, ..., omega 251.327 rad/s".
+std::string DescribeParameters(const ParameterVector& parameters) {
+  std::ostringstream text;
+  for (int i = 0; i < kNumParameters; ++i) {
+    text << (i > 0 ? ", " : "") << ParameterName(i) << " " << parameters[i];
+  }
+  text << " rad/s";
+  return text.str();
+}
+
+// Releases, once each, the held parameters whose cost gradient points into
+// the feasible side (the cost falls as they leave their bound: d cost / d p_i
+// < 0 at p_i = 0). True when one was released.
+bool ReleaseHeld(StageProblem* problem, std::array<bool, kNumParameters>* held,
+                 std::array<bool, kNumParameters>* released) {
+  std::vector<double> gradient;
+  if (!problem->CostGradient(&gradient)) return false;
+  bool released_any = false;
+  for (int i = 0; i < kNumParameters; ++i) {
+    if ((*held)[i] && !(*released)[i] && gradient[i] < 0.0) {
+      (*held)[i] = false;
+      (*released)[i] = true;
+      released_any = true;
+    }
+  }
+  return released_any;
+}
 
 // One stage: the residual `kind` (with `penalties` on a vertical stage) from
 // `*parameters`, which it updates.
@@ -151,21 +244,15 @@ class StageProblem {
 // ends, a held parameter whose cost gradient points into the feasible side
 // (the cost falls as it leaves its bound) is released, once, and the stage
 // solves again. A solve that ends on a convergence test with nothing to
-// release ends the stage.
+// release ends the stage. A solve that cannot evaluate its cost (Ceres'
+// FAILURE, or a cost that is not finite) ends it with `failure` set.
 StageSummary RunStage(const std::vector<const Sweep*>& fitted, const IdentificationOptions& options,
                       ResidualKind kind, const PenaltyOptions& penalties,
                       ParameterVector* parameters) {
   ProblemBuilderOptions builder_options;
   builder_options.residual = kind;
   builder_options.residual_options = options.residual;
-  builder_options.fixed = options.fixed;
-  // Scale from the user's start, not from where an earlier stage landed, so
-  // that a stage that drove a parameter to its bound still steps sensibly.
-  ParameterVector scale;
-  for (int i = 0; i < kNumParameters; ++i) {
-    scale[i] = std::abs(options.initial[i]) > 0.0 ? std::abs(options.initial[i]) : 1.0;
-  }
-  builder_options.scale = scale;
+  builder_options.scale = StartScale(options.initial);
   builder_options.bound_damping = kind != ResidualKind::kAlgebraic;
   const int threads = ResolveThreadCount(options.solver.num_threads);
   const bool with_penalties = kind == ResidualKind::kVertical && PenaltiesEnabled(penalties);
@@ -192,40 +279,34 @@ StageSummary RunStage(const std::vector<const Sweep*>& fitted, const Identificat
     if (with_penalties) problem.AddPenalties(fitted, weighted);
     stage.residual_blocks = problem.blocks();
 
+    const ParameterVector start = *parameters;
     const ceres::Solver::Summary summary = problem.Solve(options.solver);
     VLOG(2) << ResidualKindName(kind) << " stage, solve " << round + 1 << ": "
-            << summary.BriefReport() << "; mu1 " << (*parameters)[kMu1] << ", mu2 "
-            << (*parameters)[kMu2];
+            << summary.BriefReport();
     if (round == 0) stage.initial_cost = summary.initial_cost;
     stage.final_cost = summary.final_cost;
     stage.iterations += std::max(static_cast<int>(summary.iterations.size()) - 1, 0);
     ++stage.solves;
     stage.converged = summary.termination_type == ceres::CONVERGENCE;
     stage.brief_report = summary.BriefReport();
+    if (!summary.IsSolutionUsable() || !std::isfinite(summary.final_cost)) {
+      stage.converged = false;
+      stage.failure = std::string("the ") + ResidualKindName(kind) +
+                      " stage cannot evaluate its cost at " + DescribeParameters(start) + ": " +
+                      problem.DescribeFailure(summary);
+      break;
+    }
     stage.final_data_cost = problem.DataCost();
     // Each of the three bounded parameters is held at most twice and
     // released at most once, so this bound is never reached in practice.
-    if (!summary.IsSolutionUsable() || round + 1 >= kMaxSolvesPerStage) break;
+    if (round + 1 >= kMaxSolvesPerStage) break;
     if (problem.resting()) {
       held[*problem.resting()] = true;
       VLOG(1) << ResidualKindName(kind) << " stage: holding " << ParameterName(*problem.resting())
               << " at its bound";
       continue;
     }
-    // A held parameter's bound stays active while the cost rises as it
-    // leaves the bound: d cost / d p_i >= 0 at p_i = 0.
-    std::vector<double> gradient;
-    bool released_any = false;
-    if (problem.CostGradient(&gradient)) {
-      for (int i = 0; i < kNumParameters; ++i) {
-        if (held[i] && !released[i] && gradient[i] < 0.0) {
-          held[i] = false;
-          released[i] = true;
-          released_any = true;
-        }
-      }
-    }
-    if (!released_any) break;
+    if (!ReleaseHeld(&problem, &held, &released)) break;
   }
   for (int i = 0; i < kNumParameters; ++i) {
     if (held[i]) stage.held_at_bound.push_back(i);
@@ -255,14 +336,17 @@ IdentificationResult Identify(const std::vector<const Sweep*>& fitted,
       PenaltyOptions quadratic = options.penalties;
       quadratic.bifurcation_range.exponent = 2;
       result.stages.push_back(RunStage(fitted, options, kind, quadratic, &result.parameters));
+      if (!result.stages.back().failure.empty()) break;
     }
     result.stages.push_back(RunStage(fitted, options, kind, options.penalties, &result.parameters));
+    if (!result.stages.back().failure.empty()) break;
   }
   for (const StageSummary& stage : result.stages)
     result.iterations += std::max(stage.iterations, 0);
   result.residual_blocks = result.stages.back().residual_blocks;
   result.final_cost = result.stages.back().final_cost;
   result.converged = result.stages.back().converged;
+  result.failure = result.stages.back().failure;
   return result;
 }
 

@@ -40,7 +40,11 @@ struct StageSummary {
   // Bounded parameters the stage ended holding on their bound (an active
   // set: see RunStage in identification.cc), ParameterIndex values.
   std::vector<int> held_at_bound;
-  std::string brief_report;    // ceres::Solver::Summary::BriefReport() of its last solve
+  std::string brief_report;  // ceres::Solver::Summary::BriefReport() of its last solve
+  // Why the stage could not solve: its cost could not be evaluated or was
+  // not finite (names the parameters and the first dwell at fault); "" when
+  // it solved. The stages after a failed one do not run.
+  std::string failure;
   ParameterVector parameters;  // where the stage ended
 };
 
@@ -51,6 +55,9 @@ struct IdentificationResult {
   double final_cost = 0.0;  // of the last stage
   int iterations = 0;       // over all stages
   bool converged = false;   // the last stage converged
+  // The failure of the stage that stopped the fit ("" when every stage
+  // solved): the result is then no estimate and must not be reported as one.
+  std::string failure;
 };
 
 ceres::Solver::Options MakeSolverOptions(const SolverSettings& settings);

@@ -35,9 +35,18 @@ std::string Format(const char* format, Args... args) {
   return text;
 }
 
-// min |a x - y|, by Eigen's column-pivoting Householder QR.
+// min |a x - y|, by Eigen's column-pivoting Householder QR on the columns
+// scaled to unit norm. Without the scaling the QR's rank threshold, relative
+// to the largest column, drops a column that is small only because of the
+// data's unit: the backbone's a_k^2 column beside its column of ones is 1e-24
+// of it for amplitudes of 1e-12 m, and its slope (alpha) came out 0.
 Eigen::VectorXd LeastSquares(const Eigen::MatrixXd& a, const Eigen::VectorXd& y) {
-  return a.colPivHouseholderQr().solve(y);
+  Eigen::VectorXd norms = a.colwise().norm().transpose();
+  for (Eigen::Index j = 0; j < norms.size(); ++j) {
+    if (!(norms(j) > 0.0)) norms(j) = 1.0;
+  }
+  const Eigen::MatrixXd scaled = a * norms.cwiseInverse().asDiagonal();
+  return scaled.colPivHouseholderQr().solve(y).cwiseQuotient(norms);
 }
 
 // y ~ intercept + slope x by least squares; a given intercept or slope is held.

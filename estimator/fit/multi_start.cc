@@ -12,8 +12,9 @@
 namespace dwellfit {
 
 bool MultiStartOptions::IsValid(std::string* error) const {
-  if (starts < 1) {
-    *error = "multi_start.starts must be at least 1";
+  if (starts < 1 || starts > kMaxStarts) {
+    *error = "multi_start.starts must be from 1 to " + std::to_string(kMaxStarts) +
+             " (each start is a whole fit)";
     return false;
   }
   if (!(spread > 1.0) || !std::isfinite(spread)) {
@@ -82,20 +83,26 @@ MultiStartResult IdentifyMultiStart(const std::vector<const Sweep*>& fitted,
   worker();
   for (std::thread& thread : pool) thread.join();
 
+  int best_usable = -1;
   for (int i = 0; i < n; ++i) {
     result.final_costs.push_back(fits[i].final_cost);
     result.converged.push_back(fits[i].converged);
-    const bool finite = std::all_of(fits[i].parameters.begin(), fits[i].parameters.end(),
-                                    [](double v) { return std::isfinite(v); });
-    // Lowest cost wins; ties go to the earlier start, so the result does not
-    // depend on scheduling.
-    if (finite && (i == 0 || !(fits[i].final_cost >= fits[result.best_start].final_cost))) {
-      result.best_start = i;
+    const bool usable =
+        fits[i].failure.empty() && std::all_of(fits[i].parameters.begin(), fits[i].parameters.end(),
+                                               [](double v) { return std::isfinite(v); });
+    if (!usable) {
+      ++result.failed;
+      continue;
     }
+    // Lowest cost wins; ties go to the earlier start, so the result does not
+    // depend on scheduling. A failed start is never the best, unless every
+    // start failed (then the best is start 0 and carries its failure).
+    if (best_usable < 0 || fits[i].final_cost < fits[best_usable].final_cost) best_usable = i;
   }
+  result.best_start = std::max(best_usable, 0);
   result.best = fits[result.best_start];
   for (int i = 0; i < n; ++i) {
-    bool same = true;
+    bool same = fits[i].failure.empty();
     for (int j = 0; j < kNumParameters && same; ++j) {
       if (options.fixed[j]) continue;
       const double reference = std::abs(result.best.parameters[j]) > 0.0

@@ -19,8 +19,15 @@
 
 namespace dwellfit {
 
+// The most starts a run may ask for. Each start is a whole fit (0.01-0.2 s
+// on the bundled data on two cores), so 1000 starts take minutes at most,
+// while a factor-3 box in six parameters is sampled densely long before that
+// (the bundled cases reach their best from a handful of starts); a larger
+// count is a typo or a wrong unit, and would run for hours.
+inline constexpr int kMaxStarts = 1000;
+
 struct MultiStartOptions {
-  int starts = 1;       // total number of fits, >= 1
+  int starts = 1;       // total number of fits, 1 to kMaxStarts
   double spread = 3.0;  // s: random starts within a factor s either way, > 1
   std::uint64_t seed = 1;
   int threads = 2;  // >= 1
@@ -34,6 +41,9 @@ struct MultiStartResult {
   std::vector<double> final_costs;      // of each start
   std::vector<bool> converged;          // of each start
   int reached_best = 0;                 // starts whose estimate matches the best's
+  // Starts whose fit failed (IdentificationResult::failure, or parameters
+  // that are not finite): never the best unless all failed.
+  int failed = 0;
 };
 
 // The starting points MultiStart uses (exposed for tests and reports).

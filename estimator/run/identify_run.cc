@@ -62,6 +62,57 @@ std::vector<const Sweep*> SelectSweeps(const std::vector<Sweep>& sweeps,
   return selected;
 }
 
+namespace {
+
+// Throws when the fitted sweeps hold no more dwells than there are free
+// parameters: such a fit interpolates (or is underdetermined) and has no
+// degree of freedom left to estimate the noise, so no usable result.
+void CheckEnoughDwells(const IdentifyConfig& config, const std::vector<const Sweep*>& fitted) {
+  std::size_t dwells = 0;
+  for (const Sweep* sweep : fitted) dwells += sweep->points.size();
+  const auto free = static_cast<std::size_t>(
+      std::count(config.identification.fixed.begin(), config.identification.fixed.end(), false));
+  if (dwells > free) return;
+  std::string names;
+  for (const Sweep* sweep : fitted) {
+    names += (names.empty() ? "" : ", ") + sweep->Name() + " (" +
+             std::to_string(sweep->points.size()) + ")";
+  }
+  throw InputError(config.config_path, 0, "fit",
+                   "the fitted sweeps hold " + std::to_string(dwells) + " measured dwell(s) (" +
+                       names + ") for " + std::to_string(free) +
+                       " free parameters; a fit needs more dwells than free parameters: fit more "
+                       "sweeps, or fix parameters (fixed: with their initial_guess)");
+}
+
+// Throws when the best start is no usable estimate: a stage could not
+// evaluate its cost (every start failed), or the estimate is not finite.
+void CheckUsable(const IdentifyConfig& config, const MultiStartResult& multi_start) {
+  const IdentificationResult& result = multi_start.best;
+  if (!result.failure.empty()) {
+    throw InputError(
+        config.config_path, 0, "initial_guess",
+        "the fit cannot proceed: " + result.failure +
+            (multi_start.starts.size() > 1 ? " (and every other start failed too)" : "") +
+            "; give initial guesses closer to the data (initial_guess, config/README.md), or "
+            "check the dwells named");
+  }
+  if (multi_start.failed > 0) {
+    LOG(WARNING) << multi_start.failed << " of " << multi_start.starts.size()
+                 << " starts failed (their cost could not be evaluated); the best of the others "
+                    "is kept";
+  }
+  for (double value : result.parameters) {
+    if (!std::isfinite(value)) {
+      throw InputError(config.config_path, 0, "initial_guess",
+                       "the solver returned no usable solution; start closer to the data "
+                       "(see config/README.md, initial_guess)");
+    }
+  }
+}
+
+}  // namespace
+
 ConfiguredSweeps LoadConfiguredSweeps(const IdentifyConfig& config) {
   ConfiguredSweeps configured;
   configured.sweeps = LoadLabelledSweeps(config.data_files, config.jump_detection);
@@ -69,6 +120,7 @@ ConfiguredSweeps LoadConfiguredSweeps(const IdentifyConfig& config) {
   configured.fitted = SelectSweeps(configured.sweeps, config.fit_sweeps, config.config_path, "fit");
   configured.validation =
       SelectSweeps(configured.sweeps, config.validate_sweeps, config.config_path, "validate");
+  CheckEnoughDwells(config, configured.fitted);
   return configured;
 }
 
@@ -120,13 +172,7 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
   const MultiStartResult multi_start =
       IdentifyMultiStart(fitted, options, automatic, config.multi_start);
   const IdentificationResult& result = multi_start.best;
-  for (double value : result.parameters) {
-    if (!std::isfinite(value)) {
-      throw InputError(config.config_path, 0, "initial_guess",
-                       "the solver returned no usable solution; start closer to the data "
-                       "(see config/README.md, initial_guess)");
-    }
-  }
+  CheckUsable(config, multi_start);
   options.initial = multi_start.starts[multi_start.best_start];
   outcome->report =
       MakeIdentificationReport(config.config_path, options, result,

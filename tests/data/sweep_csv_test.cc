@@ -8,6 +8,7 @@
 #include <fstream>
 #include <mutex>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "dwellfit/estimator/common/input_error.h"
@@ -246,6 +247,91 @@ TEST(SweepCsvTest, DirectoryIsRejected) {
   }
 }
 
+TEST(SweepCsvTest, CharacterDeviceIsRejectedForWhatItIs) {
+  try {
+    LoadSweepsCsv("/dev/null");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "/dev/null: is a character device, not a file; give the path of a sweeps CSV "
+                 "file");
+  }
+}
+
+TEST(SweepCsvTest, AcceptsTheRangeBoundsAndSmallSiAmplitudes) {
+  // The bounds themselves, and amplitudes of a small vibration in metres.
+  const std::string path = WriteCsv("bounds",
+                                    "sweep,direction,freq_hz,a_base,a,sigma\n"
+                                    "F,up,1e-6,1e-20,1e-20,1e-20\n"
+                                    "F,up,40,1e-20,1e-12,1e-14\n"
+                                    "F,up,1e9,1e-20,1e20,1e20\n"
+                                    "G,down,41.5,1e20,1e3,1\n"
+                                    "G,down,41.5,9.81,1e-12,1e-14\n");
+  const LoadedSweeps loaded = LoadSweepsCsv(path);
+  ASSERT_EQ(loaded.sweeps.size(), 2u);
+  ASSERT_EQ(loaded.sweeps[0].points.size(), 3u);
+  EXPECT_DOUBLE_EQ(loaded.sweeps[0].points[0].drive_frequency_rad_s, HzToRadPerSecond(1e-6));
+  EXPECT_DOUBLE_EQ(loaded.sweeps[0].points[1].amplitude, 1e-12);
+  EXPECT_DOUBLE_EQ(loaded.sweeps[0].points[2].amplitude, 1e20);
+  EXPECT_EQ(loaded.sweeps[1].kind, SweepKind::kAmplitude);
+  EXPECT_DOUBLE_EQ(loaded.sweeps[1].points[0].a_base, 1e20);
+}
+
+TEST(SweepCsvTest, RepeatedControlsAndMissingRowsKeepTheOrder) {
+  // Repeats are allowed in either direction; a missing row is checked too.
+  const std::string path = WriteCsv("repeats",
+                                    "sweep,direction,freq_hz,a_base,a\n"
+                                    "F,down,42,0.01,1e-3\n"
+                                    "F,down,42,0.01,1.1e-3\n"
+                                    "F,down,41,0.01,0\n"
+                                    "F,down,41,0.01,2e-3\n"
+                                    "F,down,40,0.01,3e-3\n");
+  const LoadedSweeps loaded = LoadSweepsCsv(path);
+  ASSERT_EQ(loaded.sweeps.size(), 1u);
+  EXPECT_EQ(loaded.sweeps[0].points.size(), 4u);
+  EXPECT_EQ(loaded.sweeps[0].dropped_nonpositive, 1);
+}
+
+TEST(SweepCsvTest, ByteOrderMarkBeforeTheHeaderIsSkipped) {
+  const std::string path = WriteCsv("bom",
+                                    "\xEF\xBB\xBFsweep,direction,freq_hz,a_base,a\r\n"
+                                    "F,up,40,0.01,1e-3\r\n"
+                                    "F,up,41,0.01,2e-3\r\n");
+  const LoadedSweeps loaded = LoadSweepsCsv(path);
+  ASSERT_EQ(loaded.sweeps.size(), 1u);
+  EXPECT_EQ(loaded.sweeps[0].id, "F");
+  EXPECT_EQ(loaded.sweeps[0].points.size(), 2u);
+}
+
+TEST(SweepCsvTest, ALineLongerThan16MegabytesIsRejectedWithoutEchoingIt) {
+  // A 50 MB line fails the same way as one just past the reader's limit of 2^24 - 1.
+  const std::string path = WriteCsv("long_line", "sweep,direction,freq_hz,a_base,a\nF,up,40,0.01," +
+                                                     std::string((1 << 24) + 16, '7') + "\n");
+  try {
+    LoadSweepsCsv(path);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              path +
+                  ":2: the line is longer than 2^24 - 1 bytes, which no row of a sweeps CSV is; "
+                  "check that this is the sweeps file");
+  }
+}
+
+TEST(SweepCsvTest, BundledDatasetsAreInMeasurementOrder) {
+  // The loader rejects sweeps out of order; both datasets load, all their rows.
+  for (const auto& [dataset, sweeps, rows] :
+       {std::tuple<const char*, std::size_t, int>{"thesis-numerical", 8, 456},
+        std::tuple<const char*, std::size_t, int>{"clamped-beam-27C", 24, 24576}}) {
+    const LoadedSweeps loaded =
+        LoadSweepsCsv(std::string(DWELLFIT_SOURCE_DIR) + "/datasets/" + dataset + "/sweeps.csv");
+    EXPECT_EQ(loaded.sweeps.size(), sweeps) << dataset;
+    int loaded_rows = loaded.dropped_nonpositive;
+    for (const Sweep& sweep : loaded.sweeps) loaded_rows += sweep.points.size();
+    EXPECT_EQ(loaded_rows, rows) << dataset;
+  }
+}
+
 // One malformed file: where the error must point and what it must say.
 struct BadCsvCase {
   const char* name;
@@ -344,7 +430,111 @@ INSTANTIATE_TEST_SUITE_P(
         BadCsvCase{"too_many_fields", "sweep,direction,freq_hz,a_base,a\nF,up,40,0.01,1e-3,7\n", 2,
                    "", "more fields than the header"},
         BadCsvCase{"unclosed_quote", "sweep,direction,freq_hz,a_base,a\n\"F,up,40,0.01,1e-3\n", 2,
-                   "", "not closed"}),
+                   "", "not closed"},
+        // Values outside the accepted ranges (sweep_csv.h): huge, or subnormal.
+        BadCsvCase{"amplitude_huge", "sweep,direction,freq_hz,a_base,a\nF,up,40,0.01,1e308\n", 2,
+                   "a",
+                   "the amplitude a 1e308 is outside the accepted range [1e-20, 1e+20], beyond "
+                   "which the model's powers (a^6) and squared residuals overflow or underflow; "
+                   "give a in a unit that puts it inside the range, or write 0 for a missing "
+                   "measurement"},
+        BadCsvCase{"amplitude_subnormal", "sweep,direction,freq_hz,a_base,a\nF,up,40,0.01,1e-320\n",
+                   2, "a", "the amplitude a 1e-320 is outside the accepted range [1e-20, 1e+20]"},
+        BadCsvCase{"frequency_huge", "sweep,direction,freq_hz,a_base,a\nF,up,1e308,0.01,1e-3\n", 2,
+                   "freq_hz",
+                   "the drive frequency [Hz] 1e308 is outside the accepted range [1e-06, 1e+09], "
+                   "beyond which the model's powers (Omega^4) and squared residuals overflow or "
+                   "underflow; freq_hz is in Hz (not rad/s or kHz)"},
+        BadCsvCase{"frequency_subnormal",
+                   "sweep,direction,freq_hz,a_base,a\nF,up,1e-320,0.01,1e-3\n", 2, "freq_hz",
+                   "the drive frequency [Hz] 1e-320 is outside the accepted range [1e-06, 1e+09]"},
+        BadCsvCase{"a_base_huge", "sweep,direction,freq_hz,a_base,a\nF,up,40,2e20,1e-3\n", 2,
+                   "a_base", "the base level a_base 2e20 is outside the accepted range"},
+        BadCsvCase{"sigma_subnormal",
+                   "sweep,direction,freq_hz,a_base,a,sigma\nF,up,40,0.01,1e-3,1e-320\n", 2, "sigma",
+                   "the standard deviation sigma 1e-320 is outside the accepted range [1e-20, "
+                   "1e+20]"},
+        // Rows out of measurement order: never sorted, the first such row named.
+        BadCsvCase{"up_sweep_shuffled",
+                   "sweep,direction,freq_hz,a_base,a\n"
+                   "F,up,40,0.01,1e-3\n"
+                   "F,up,42,0.01,3e-3\n"
+                   "F,up,41,0.01,2e-3\n"
+                   "F,up,43,0.01,4e-3\n",
+                   4, "freq_hz",
+                   "sweep 'F/up' is an up-sweep, but freq_hz falls from 42 (line 3) to 41; rows "
+                   "must be in measurement order, the control rising in an up-sweep and falling "
+                   "in a down-sweep (repeats allowed). The order places the jumps, so it is not "
+                   "repaired: restore the measured order (a shuffled, reversed or twice-appended "
+                   "file shows this), or give a second pass its own sweep id"},
+        BadCsvCase{"down_sweep_reversed",
+                   "sweep,direction,freq_hz,a_base,a\n"
+                   "F,down,40,0.01,1e-3\n"
+                   "F,down,41,0.01,2e-3\n",
+                   3, "freq_hz",
+                   "sweep 'F/down' is a down-sweep, but freq_hz rises from 40 (line 2) to 41"},
+        BadCsvCase{"amplitude_sweep_out_of_order",
+                   "sweep,direction,freq_hz,a_base,a\n"
+                   "A,up,41.5,0.01,1e-3\n"
+                   "A,up,41.5,0.02,2e-3\n"
+                   "A,up,41.5,0.02,2.1e-3\n"
+                   "A,up,41.5,0.015,1.5e-3\n",
+                   5, "a_base",
+                   "sweep 'A/up' is an up-sweep, but a_base falls from 0.02 (line 4) to 0.015"},
+        BadCsvCase{"appended_to_itself",
+                   "sweep,direction,freq_hz,a_base,a\n"
+                   "F,up,40,0.01,1e-3\nF,up,41,0.01,2e-3\nF,down,41,0.01,2e-3\n"
+                   "F,down,40,0.01,1e-3\n"
+                   "F,up,40,0.01,1e-3\nF,up,41,0.01,2e-3\nF,down,41,0.01,2e-3\n"
+                   "F,down,40,0.01,1e-3\n",
+                   6, "freq_hz",
+                   "sweep 'F/up' is an up-sweep, but freq_hz falls from 41 (line 3) to 40"},
+        BadCsvCase{"missing_row_out_of_order",
+                   "sweep,direction,freq_hz,a_base,a\nF,up,40,0.01,1e-3\nF,up,41,0.01,0\n"
+                   "F,up,39,0.01,0\n",
+                   4, "freq_hz", "freq_hz falls from 41 (line 3) to 39"},
+        BadCsvCase{"copied_row",
+                   "sweep,direction,freq_hz,a_base,a\nF,up,40,0.01,1e-3\nF,up,41,0.01,2e-3\n"
+                   "F,up,41,0.01,2e-3\n",
+                   4, "",
+                   "row repeats line 3 value for value (sweep 'F/up'): a copied row counts one "
+                   "dwell twice and understates the uncertainty; remove it"},
+        // Files that are not comma-separated with LF or CRLF line ends.
+        BadCsvCase{"semicolon_separated", "sweep;direction;freq_hz;a_base;a\nF;up;40,5;0,01;1e-3\n",
+                   1, "sweep;direction;freq_hz;a_base;a",
+                   "unknown column; allowed columns are sweep, direction, freq_hz, a_base, a "
+                   "(required) and phase_deg or phase_rad, sigma (optional); the header reads as "
+                   "one column: this file seems to separate fields by ';', but a sweeps CSV "
+                   "separates them by commas (and writes numbers with a '.' decimal point): save "
+                   "it as comma-separated"},
+        BadCsvCase{"tab_separated", "sweep\tdirection\tfreq_hz\ta_base\ta\nF\tup\t40\t0.01\t1e-3\n",
+                   1, "sweep\\tdirection\\tfreq_hz\\ta_base\\ta",
+                   "this file seems to separate fields by tabs"},
+        BadCsvCase{"carriage_return_line_ends",
+                   "sweep,direction,freq_hz,a_base,a\rF,up,40,0.01,1e-3\rF,up,41,0.01,2e-3\r", 1,
+                   "a\\rF",
+                   "the lines of this file end in a carriage return alone (\\r, old Mac style): "
+                   "save it with LF or CRLF line ends"},
+        BadCsvCase{"decimal_comma", "sweep,direction,freq_hz,a_base,a\nF,up,40,5,0.01,1e-3\n", 2,
+                   "",
+                   "row has more fields than the header; give one value per header column (a "
+                   "decimal comma splits a number in two: write 40.5, not 40,5)"},
+        BadCsvCase{"quoted_decimal_comma",
+                   "sweep,direction,freq_hz,a_base,a\nF,up,\"40,5\",0.01,1e-3\n", 2, "freq_hz",
+                   "value '40,5' is not a number; write numbers with a decimal point, not a comma "
+                   "(40.5, not 40,5)"},
+        // Raw bytes are escaped and long values cut in messages.
+        BadCsvCase{"binary_bytes",
+                   "sweep,direction,freq_hz,a_base,a\nF,up,40,0.01,1\x01\x02\x7f\xff\n", 2, "a",
+                   "value '1\\x01\\x02\\x7F\\xFF' is not a number"},
+        BadCsvCase{"binary_direction", "sweep,direction,freq_hz,a_base,a\nF,u\rp,40,0.01,1e-3\n", 2,
+                   "direction", "value 'u\\rp' must be 'up' or 'down'"},
+        BadCsvCase{"long_value",
+                   "sweep,direction,freq_hz,a_base,a\nF,up,40,0.01,"
+                   "x123456789x123456789x123456789x123456789x123456789x123456789\n",
+                   2, "a",
+                   "value 'x123456789x123456789x123456789x123456789... (60 bytes in all)' is not a "
+                   "number"}),
     [](const ::testing::TestParamInfo<BadCsvCase>& info) { return std::string(info.param.name); });
 
 }  // namespace

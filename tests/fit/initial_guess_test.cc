@@ -101,6 +101,29 @@ TEST_F(InitialGuessThesis, NoiseFreeGuessIsWithinAFactorTwoWithOmegaKnownAndUnkn
   ExpectWithinFactorTwo(without.guess, "omega unknown");
 }
 
+TEST_F(InitialGuessThesis, GuessDoesNotDependOnTheAmplitudeUnit) {
+  // The same sweeps with the amplitude a in a unit 1e9 times larger (a of
+  // 1e-13..5e-12, as in metres for a small vibration) and 1e9 times smaller:
+  // a parameter of unit length^k scales by s^k (eta_e: length per a_base).
+  const InitialGuessReport reference = AutomaticInitialGuess(fitted_, KnownParameters{});
+  for (double s : {1e-9, 1e9}) {
+    std::vector<Sweep> scaled = sweeps_;
+    for (Sweep& sweep : scaled) {
+      for (DwellPoint& point : sweep.points) point.amplitude *= s;
+    }
+    const InitialGuessReport guess =
+        AutomaticInitialGuess(Select(scaled, {"F0.01", "A41.5"}), KnownParameters{});
+    const ParameterVector expected = {
+        reference.guess[kEtaE] * s,        reference.guess[kMu1],
+        reference.guess[kMu2] / s,         reference.guess[kDelta] / (s * s),
+        reference.guess[kAlpha] / (s * s), reference.guess[kOmega]};
+    for (int i = 0; i < kNumParameters; ++i) {
+      EXPECT_NEAR(guess.guess[i], expected[i], 1e-6 * std::abs(expected[i]))
+          << ParameterName(i) << " at unit scale " << s;
+    }
+  }
+}
+
 TEST_F(InitialGuessThesis, IdentifyFromTheGuessReachesTheTruth) {
   for (bool omega_known : {true, false}) {
     const InitialGuessReport report =
