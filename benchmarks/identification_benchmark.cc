@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "benchmark/benchmark.h"
-#include "config/identify_config.h"
-#include "estimator/identification.h"
-#include "estimator/identify_run.h"
-#include "estimator/problem_builder.h"
+#include "dwellfit/config/identify_config.h"
+#include "dwellfit/estimator/fit/identification.h"
+#include "dwellfit/estimator/run/identify_run.h"
+#include "dwellfit/estimator/fit/problem_builder.h"
 
 namespace dwellfit {
 namespace {

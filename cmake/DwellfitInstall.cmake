@@ -1,23 +1,22 @@
 # Installation and export.
 #
-#   <prefix>/include/dwellfit/{residuals,estimator,config}/*.h
-#   <prefix>/lib/libdwellfit.a
+#   <prefix>/include/dwellfit/{residuals,estimator,config}/<stage>/*.h
+#   <prefix>/lib/libdwellfit_<stage>.a (one archive per stage of the data path)
 #   <prefix>/lib/cmake/dwellfit/dwellfit{Config,ConfigVersion,Targets}.cmake
 #   <prefix>/bin/dwellfit-identify, dwellfit-simulate-dwell
 #
-# Outside code: find_package(dwellfit) and link dwellfit::dwellfit (the
-# estimator library) or dwellfit::residuals (the header-only functors). Headers
-# are included as "residuals/...", "estimator/...", "config/...".
+# Outside code: find_package(dwellfit) and link dwellfit::dwellfit (all of
+# the library) or one stage (dwellfit::residuals, the header-only functors;
+# dwellfit::fit, ...). Headers are included as "dwellfit/residuals/...",
+# "dwellfit/estimator/...", "dwellfit/config/...".
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
 set(DWELLFIT_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/dwellfit"
     CACHE STRING "Where dwellfitConfig.cmake is installed, relative to the prefix")
 
-set_target_properties(dwellfit_residuals PROPERTIES EXPORT_NAME residuals)
-set_target_properties(dwellfit PROPERTIES EXPORT_NAME dwellfit)
-
-install(TARGETS dwellfit_residuals dwellfit
+get_property(dwellfit_library_targets GLOBAL PROPERTY DWELLFIT_LIBRARY_TARGETS)
+install(TARGETS ${dwellfit_library_targets} dwellfit
   EXPORT dwellfitTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}

@@ -1,6 +1,6 @@
-#include "config/config_override.h"
+#include "dwellfit/config/config_override.h"
 
-#include "estimator/input_error.h"
+#include "dwellfit/estimator/common/input_error.h"
 
 namespace dwellfit {
 namespace {

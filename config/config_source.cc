@@ -1,4 +1,4 @@
-#include "config/config_source.h"
+#include "dwellfit/config/config_source.h"
 
 #include <algorithm>
 #include <filesystem>

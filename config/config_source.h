@@ -9,8 +9,8 @@
 #include <utility>
 #include <vector>
 
-#include "config/config_override.h"
-#include "estimator/input_error.h"
+#include "dwellfit/config/config_override.h"
+#include "dwellfit/estimator/common/input_error.h"
 #include "yaml-cpp/yaml.h"
 
 namespace dwellfit {

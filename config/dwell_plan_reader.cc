@@ -1,13 +1,13 @@
-#include "config/dwell_plan_reader.h"
+#include "dwellfit/config/dwell_plan_reader.h"
 
 #include <array>
 #include <optional>
 #include <vector>
 
-#include "config/config_source.h"
-#include "config/strict_yaml.h"
-#include "estimator/input_error.h"
-#include "estimator/sweep.h"
+#include "dwellfit/config/config_source.h"
+#include "dwellfit/config/strict_yaml.h"
+#include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/data/sweep.h"
 
 namespace dwellfit {
 namespace {

@@ -1,4 +1,4 @@
-// Reading a DwellPlan (estimator/dwell_simulator.h) from YAML.
+// Reading a DwellPlan (estimator/simulation/dwell_simulator.h) from YAML.
 //
 //   truth:                  # all six required
 //     eta_e: 100            # forcing effectiveness
@@ -35,7 +35,7 @@
 
 #include <string>
 
-#include "estimator/dwell_simulator.h"
+#include "dwellfit/estimator/simulation/dwell_simulator.h"
 
 namespace dwellfit {
 

@@ -1,4 +1,4 @@
-#include "config/identify_config.h"
+#include "dwellfit/config/identify_config.h"
 
 #include <algorithm>
 #include <array>
@@ -7,9 +7,9 @@
 #include <system_error>
 #include <utility>
 
-#include "config/config_source.h"
-#include "config/strict_yaml.h"
-#include "estimator/sweep_csv.h"
+#include "dwellfit/config/config_source.h"
+#include "dwellfit/config/strict_yaml.h"
+#include "dwellfit/estimator/data/sweep_csv.h"
 
 namespace dwellfit {
 namespace {

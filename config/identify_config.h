@@ -11,12 +11,12 @@
 #include <string>
 #include <vector>
 
-#include "config/config_override.h"
-#include "config/sweep_selection.h"
-#include "estimator/identification_options.h"
-#include "estimator/initial_guess.h"
-#include "estimator/jump_detection.h"
-#include "estimator/multi_start.h"
+#include "dwellfit/config/config_override.h"
+#include "dwellfit/config/sweep_selection.h"
+#include "dwellfit/estimator/fit/identification_options.h"
+#include "dwellfit/estimator/fit/initial_guess.h"
+#include "dwellfit/estimator/data/jump_detection.h"
+#include "dwellfit/estimator/fit/multi_start.h"
 
 namespace dwellfit {
 

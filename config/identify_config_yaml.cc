@@ -3,7 +3,7 @@
 #include <string>
 #include <vector>
 
-#include "config/identify_config.h"
+#include "dwellfit/config/identify_config.h"
 #include "yaml-cpp/yaml.h"
 
 namespace dwellfit {

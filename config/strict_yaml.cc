@@ -1,4 +1,4 @@
-#include "config/strict_yaml.h"
+#include "dwellfit/config/strict_yaml.h"
 
 #include <algorithm>
 #include <charconv>

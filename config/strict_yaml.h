@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "config/config_source.h"
+#include "dwellfit/config/config_source.h"
 #include "yaml-cpp/yaml.h"
 
 namespace dwellfit {

@@ -1,4 +1,4 @@
-#include "config/sweep_selection.h"
+#include "dwellfit/config/sweep_selection.h"
 
 namespace dwellfit {
 

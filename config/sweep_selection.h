@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "estimator/sweep.h"
+#include "dwellfit/estimator/data/sweep.h"
 
 namespace dwellfit {
 

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <string>
 
-#include "config/identify_config.h"
-#include "estimator/input_error.h"
+#include "dwellfit/config/identify_config.h"
+#include "dwellfit/estimator/common/input_error.h"
 #include "gtest/gtest.h"
 
 namespace dwellfit {

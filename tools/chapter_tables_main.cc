@@ -4,11 +4,11 @@
 #include <iostream>
 #include <string>
 
-#include "config/dwell_plan_reader.h"
-#include "config/identify_config.h"
-#include "estimator/chapter_tables.h"
-#include "estimator/input_error.h"
-#include "estimator/output_files.h"
+#include "dwellfit/config/dwell_plan_reader.h"
+#include "dwellfit/config/identify_config.h"
+#include "dwellfit/estimator/studies/chapter_tables.h"
+#include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/run/output_files.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 

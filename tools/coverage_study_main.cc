@@ -5,13 +5,13 @@
 //
 // Fits `replicas` noisy simulations of the plan with the config and prints,
 // per free parameter and for the effective nonlinearity, how often the 95 %
-// interval covers the truth (estimator/coverage_study.h).
+// interval covers the truth (estimator/studies/coverage_study.h).
 #include <iostream>
 
-#include "config/dwell_plan_reader.h"
-#include "config/identify_config.h"
-#include "estimator/coverage_study.h"
-#include "estimator/input_error.h"
+#include "dwellfit/config/dwell_plan_reader.h"
+#include "dwellfit/config/identify_config.h"
+#include "dwellfit/estimator/studies/coverage_study.h"
+#include "dwellfit/estimator/common/input_error.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 

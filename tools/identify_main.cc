@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "config/identify_config.h"
-#include "estimator/identify_run.h"
-#include "estimator/input_error.h"
+#include "dwellfit/config/identify_config.h"
+#include "dwellfit/estimator/run/identify_run.h"
+#include "dwellfit/estimator/common/input_error.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 

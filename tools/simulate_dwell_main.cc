@@ -7,10 +7,10 @@
 // sweeps and the noise; the plan in effect and each sweep's jumps are printed.
 #include <iostream>
 
-#include "config/dwell_plan_reader.h"
-#include "estimator/dwell_simulator.h"
-#include "estimator/input_error.h"
-#include "estimator/sweep_csv_writer.h"
+#include "dwellfit/config/dwell_plan_reader.h"
+#include "dwellfit/estimator/simulation/dwell_simulator.h"
+#include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/data/sweep_csv_writer.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 

@@ -6,9 +6,9 @@
 #include <cstdio>
 
 #include "ceres/ceres.h"
-#include "estimator/problem_builder.h"
-#include "estimator/sweep.h"
-#include "residuals/stable_root.h"
+#include "dwellfit/estimator/fit/problem_builder.h"
+#include "dwellfit/estimator/data/sweep.h"
+#include "dwellfit/residuals/model/stable_root.h"
 
 int main() {
   const dwellfit::ParameterVector truth = {100.0, 0.2, 300.0, 1e4, 9e8,

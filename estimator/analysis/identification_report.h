@@ -1,0 +1,54 @@
+// What an identification run reports: the estimates, how the solver ended,
+// and the model beside every measured dwell of the fitted and validation
+// sweeps, as result.yaml, predictions.csv and a printed summary.
+#ifndef DWELLFIT_ESTIMATOR_ANALYSIS_IDENTIFICATION_REPORT_H_
+#define DWELLFIT_ESTIMATOR_ANALYSIS_IDENTIFICATION_REPORT_H_
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "dwellfit/estimator/fit/identification.h"
+#include "dwellfit/estimator/fit/identification_options.h"
+#include "dwellfit/estimator/fit/multi_start.h"
+#include "dwellfit/estimator/analysis/parameter_uncertainty.h"
+#include "dwellfit/estimator/analysis/sweep_prediction.h"
+
+namespace dwellfit {
+
+struct IdentificationReport {
+  std::string config_path;
+  IdentificationOptions options;  // the start and the fixed parameters
+  IdentificationResult result;
+  double omega_ref_rad_s = 0.0;              // reference of the effective nonlinearity
+  std::vector<SweepPrediction> predictions;  // fitted sweeps first, then validation
+  // How the automatic starting point was found (empty: every guess given).
+  std::vector<std::string> initial_guess_steps;
+  // The starts and how many reached the best (one start: trivially 1 of 1).
+  MultiStartResult multi_start;
+  ParameterUncertainty uncertainty;
+};
+
+// Builds the report: predicts every sweep at the identified parameters.
+// `omega_ref_rad_s` <= 0 means: the identified natural frequency.
+IdentificationReport MakeIdentificationReport(const std::string& config_path,
+                                              const IdentificationOptions& options,
+                                              const IdentificationResult& result,
+                                              double omega_ref_rad_s,
+                                              const std::vector<const Sweep*>& fitted,
+                                              const std::vector<const Sweep*>& validation);
+
+// result.yaml: parameters (omega in rad/s), effective nonlinearity and its
+// Omega_ref, final_cost, iterations, converged, stages, per-sweep errors and
+// measured jump brackets.
+std::string ReportToYaml(const IdentificationReport& report);
+
+// predictions.csv: one row per measured dwell with the model's amplitude.
+std::string ReportToPredictionsCsv(const IdentificationReport& report);
+
+// The human summary: solver line per stage, table of estimates, per-sweep RMS.
+void PrintReport(const IdentificationReport& report, std::ostream& out);
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_ESTIMATOR_ANALYSIS_IDENTIFICATION_REPORT_H_

@@ -1,0 +1,78 @@
+#include "dwellfit/estimator/analysis/sweep_prediction.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "dwellfit/residuals/model/fold_point.h"
+
+namespace dwellfit {
+
+namespace {
+
+PredictedJump PredictJump(const ParameterVector& p, const Sweep& sweep, JumpKind kind,
+                          double guess_control) {
+  PredictedJump predicted;
+  predicted.kind = kind;
+  const FoldKind fold_kind =
+      kind == JumpKind::kJumpUp ? FoldKind::kLowerBranchEnd : FoldKind::kUpperBranchEnd;
+  const DwellPoint& first = sweep.points.front();
+  FoldPoint fold;
+  if (sweep.kind == SweepKind::kFrequency) {
+    fold =
+        SolveFrequencyFold(p.data(), first.a_base, fold_kind, guess_control, 1e-3 * guess_control);
+  } else {
+    fold = SolveAmplitudeFold(p.data(), first.drive_frequency_rad_s, fold_kind);
+  }
+  predicted.exists = fold.exists;
+  predicted.control = fold.control;
+  return predicted;
+}
+
+}  // namespace
+
+std::vector<PredictedJump> PredictJumps(const ParameterVector& parameters, const Sweep& sweep) {
+  std::vector<PredictedJump> predicted;
+  if (sweep.points.empty()) return predicted;
+  for (const JumpBracket& jump : sweep.jumps) {
+    PredictedJump p = PredictJump(parameters, sweep, jump.kind, jump.centre());
+    p.measured = true;
+    p.bracket = jump;
+    p.inside = p.exists && std::abs(p.control - jump.centre()) <= jump.half_width();
+    predicted.push_back(p);
+  }
+  if (sweep.jumps.empty()) {
+    const auto peak = std::max_element(
+        sweep.points.begin(), sweep.points.end(),
+        [](const DwellPoint& a, const DwellPoint& b) { return a.amplitude < b.amplitude; });
+    for (JumpKind kind : {JumpKind::kJumpUp, JumpKind::kJumpDown}) {
+      predicted.push_back(PredictJump(parameters, sweep, kind, peak->drive_frequency_rad_s));
+    }
+  }
+  return predicted;
+}
+
+SweepPrediction PredictSweep(const ParameterVector& parameters, const Sweep& sweep, bool fitted) {
+  SweepPrediction prediction;
+  prediction.sweep = &sweep;
+  prediction.fitted = fitted;
+  double sum_squared = 0.0;
+  double sum_squared_relative = 0.0;
+  for (const DwellPoint& point : sweep.points) {
+    const StableRoot root = ModelAmplitude(parameters, point.drive_frequency_rad_s, point.a_base,
+                                           point.branch, point.amplitude);
+    prediction.model.push_back(root);
+    if (root.status == RootStatus::kBranchEnd) ++prediction.points_off_branch;
+    const double error = root.a - point.amplitude;
+    sum_squared += error * error;
+    sum_squared_relative += (error / point.amplitude) * (error / point.amplitude);
+  }
+  prediction.jumps = PredictJumps(parameters, sweep);
+  const double n = static_cast<double>(sweep.points.size());
+  if (n > 0) {
+    prediction.rms_error = std::sqrt(sum_squared / n);
+    prediction.relative_rms_error = std::sqrt(sum_squared_relative / n);
+  }
+  return prediction;
+}
+
+}  // namespace dwellfit

@@ -1,0 +1,161 @@
+// Jumps in measured sweeps and the stable branch of every dwell.
+//
+// In a stepped dwell test of the single-mode model (docs/model.md, "Stability and
+// folds") a sweep passes at most one saddle-node fold, so it shows at most one
+// jump: a step between consecutive dwells where the response leaves one stable
+// branch for the other. The detected jump brackets the fold between its two
+// control values and splits the sweep into the branch before and after it.
+//
+// A jump can also be stated in the config (`jumps:`, config/README.md): a
+// JumpOverride replaces what detection found for one sweep.
+#ifndef DWELLFIT_ESTIMATOR_DATA_JUMP_DETECTION_H_
+#define DWELLFIT_ESTIMATOR_DATA_JUMP_DETECTION_H_
+
+#include <string>
+#include <vector>
+
+#include "dwellfit/estimator/data/sweep.h"
+
+namespace dwellfit {
+
+// Jump detection in measured sweeps (the test and the numbers behind these
+// defaults are below).
+struct JumpDetectionOptions {
+  // A jump's step between consecutive dwells must change the amplitude by
+  // more than this ratio, either way (in an amplitude sweep: beyond the
+  // sweep's power-law trend in a_base) ...
+  double min_ratio = 1.07;
+  // ... its larger side must reach this fraction of the sweep's largest
+  // amplitude (ignores hops in the noise floor far from resonance) ...
+  double min_relative_amplitude = 0.2;
+  // ... and its log ratio must exceed this many robust standard deviations
+  // of the sweep's steps (0: no noise test).
+  double noise_multiple = 6.0;
+  // Sweeps with fewer candidate steps (above the amplitude gate) get no
+  // detected jump: too few steps to tell a jump from noise.
+  int min_candidate_steps = 5;
+  bool IsValid(std::string* error) const;
+};
+
+
+// What DetectJumps weighs in one sweep (for logs, reports and tests).
+//
+// Steps: r_i = ln(a_{i+1} / a_i) between consecutive dwells i, i+1.
+// Candidates: steps whose larger side reaches options.min_relative_amplitude
+// times the sweep's largest amplitude and whose two controls differ (a fold
+// cannot lie between equal controls).
+// Excess: e_i = r_i - p ln(c_{i+1} / c_i). In an amplitude sweep the response
+// grows like a power of the base level, a ~ a_base^p (p = 1 for a linear
+// response, about 1/3 on a hardening backbone), and a_base is stepped
+// linearly, so r_i shrinks along the sweep by itself; p is the median of
+// r_i / ln(c_{i+1} / c_i) over the candidates. A frequency sweep has no such
+// trend (the slope changes sign at the peak): p = 0 and e_i = r_i.
+// Noise: sigma = 1.4826 MAD(e) over the candidates, the robust standard
+// deviation of a step. Over the candidates, not the whole sweep: the noise
+// floor far from resonance is noisier in ln(a) than the response near it
+// (measured beam, down-sweeps: 0.019-0.032 over all steps, 0.010-0.017 over
+// the candidates). The MAD ignores the jump itself and a smeared transition
+// of a few steps. It measures the sweep's own step-to-step change (noise and
+// slope), so a jump is a step that stands out from both.
+struct JumpEvidence {
+  int candidate_steps = 0;
+  int step = -1;             // the candidate with the largest |e_i| (-1: none)
+  double log_ratio = 0.0;    // r of that step
+  double log_excess = 0.0;   // e of that step
+  double trend_slope = 0.0;  // p (0 for a frequency sweep)
+  double noise_sigma = 0.0;  // 1.4826 MAD(e) over the candidates
+  // max(ln(min_ratio), noise_multiple * noise_sigma): the step is a jump when
+  // |log_excess| exceeds it and candidate_steps >= min_candidate_steps.
+  double threshold = 0.0;
+  bool accepted = false;
+};
+
+// The evidence for a jump between dwells of `sweep` (see JumpEvidence).
+// `options` must be valid; every amplitude must be positive.
+JumpEvidence WeighJumpEvidence(const JumpDetectionOptions& options, const Sweep& sweep);
+
+// Finds at most one jump in `sweep` and labels every point's branch.
+//
+// The jump is the step WeighJumpEvidence accepts: amplitude rising across it
+// is a jump up, falling a jump down. The defaults (identification_options.h)
+// were set on two data sets, |e| / threshold being the margin:
+// - the measured clamped beam (datasets/clamped-beam-27C): the up-sweeps of
+//   0.040-0.085 g drop by a factor 39-148 (1170-5560 sigma, margin 54-74);
+//   the down-sweeps' jump up is smeared over several dwells, its largest step
+//   a factor 1.10-1.43 only (7.4-29.6 sigma, margin 1.24-4.6), found at most
+//   two dwells before the top of the transition; steps more than 10 dwells
+//   away from the jump reach at most 0.80 of the threshold;
+// - the thesis-numerical plan, noise-free and with 1 % noise (100 seeds):
+//   exactly the true jump in every sweep, margin at least 2.7; frequency
+//   sweeps below the onset of hysteresis reach at most 0.3 of the threshold,
+//   amplitude sweeps without a fold (39 and 40 Hz) at most 0.83.
+// Limits: a smooth but nearly vertical flank just below the onset of
+// hysteresis, or a sharp peak sampled by a handful of dwells, can pass for a
+// jump or hide one; state such sweeps in the config (`jumps:`).
+//
+// Jump into missing data: when no step is accepted, the rows after the last
+// dwell were all recorded as missing (Sweep::missing) and the last dwell
+// reaches min_relative_amplitude of the largest amplitude, the response left
+// the branch it was on and the instrument recorded nothing: a jump down
+// between the last dwell and the first missing row (after it, at another
+// control), marked into_missing_data. The measured beam's 0.090 and 0.095 g
+// up-sweeps end so: their largest step is a factor 1.016 (margin 0.24), then
+// zeros.
+//
+// Labels: before a jump down Branch::kUpper and after it kLower; before a jump
+// up kLower and after it kUpper; no jump: every point kOnly. Replaces any
+// previous `sweep->jumps`. `options` must be valid (IsValid).
+void DetectJumps(const JumpDetectionOptions& options, Sweep* sweep);
+
+// DetectJumps on each sweep.
+void DetectJumps(const JumpDetectionOptions& options, std::vector<Sweep>* sweeps);
+
+// A jump (or its absence) stated for one sweep, replacing detection.
+struct JumpOverride {
+  std::string sweep;  // one direction, as Sweep::Name(): "L0.060g/down"
+  bool none = false;  // the sweep has no jump: every dwell on the only branch
+  JumpKind kind = JumpKind::kJumpUp;
+  // Which control the bracket is given in: the drive frequency (rad/s here;
+  // the config's between_hz) for a frequency sweep, a_base for an amplitude one.
+  SweepKind control = SweepKind::kFrequency;
+  // The bracket in measurement order (rad/s or a_base).
+  double control_before = 0.0;
+  double control_after = 0.0;
+  // Where the config states it, for errors: its line (0: unknown, e.g. set on
+  // the command line) and key path ("jumps[0]").
+  int line = 0;
+  std::string field = "jumps";
+};
+
+// Replaces the jumps of `sweep` with `jump_override` and relabels its branches
+// as DetectJumps would. The bracket must lie between two consecutive dwells:
+// index_before is the last dwell on the `before` side (up to control_before),
+// and the next dwell must lie on the `after` side (from control_after on).
+// Throws InputError naming `config_path` and the sweep when the bracket's
+// control does not match the sweep's kind, runs against the sweep's
+// direction, or does not lie between consecutive dwells.
+void ApplyJumpOverride(const JumpOverride& jump_override, const std::string& config_path,
+                       Sweep* sweep);
+
+// ApplyJumpOverride for each override, on the sweep it names. Throws
+// InputError naming `config_path` and listing the available sweeps when an
+// override names a sweep not in `sweeps`.
+void ApplyJumpOverrides(const std::vector<JumpOverride>& overrides, const std::string& config_path,
+                        std::vector<Sweep>* sweeps);
+
+// One line per sweep for logs and reports, frequencies in Hz, e.g.
+//   "F/up: jump_down between 42.20 and 42.30 Hz (a 4.7e-3 -> 2.8e-4)"
+//   "A/up: jump_up between a_base 0.0350 and 0.0360 (a 1.2e-3 -> 4.1e-3)"
+//   "F/down: no jump (41 dwells, largest a 1.0e-3)"
+//   "L/up: jump_down between 213.055 and 213.118 Hz into missing data
+//    (a 1.2e-3 -> not measured)"
+// A jump stated in the config ends in " [config]". A jump whose direction
+// does not fit a hardening response (frequency sweeps: a jump up going up or a
+// jump down going down, which fits softening) or the model at all (amplitude
+// sweeps: a jump down as a_base rises, a jump up as it falls) gets a note; it
+// is kept all the same.
+std::string DescribeJumps(const Sweep& sweep);
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_ESTIMATOR_DATA_JUMP_DETECTION_H_

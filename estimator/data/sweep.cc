@@ -1,0 +1,35 @@
+#include "dwellfit/estimator/data/sweep.h"
+
+#include <cmath>
+
+namespace dwellfit {
+
+const char* SweepKindName(SweepKind kind) {
+  return kind == SweepKind::kFrequency ? "frequency" : "amplitude";
+}
+
+const char* SweepDirectionName(SweepDirection direction) {
+  return direction == SweepDirection::kUp ? "up" : "down";
+}
+
+bool SweepDirectionFromName(const std::string& name, SweepDirection* direction) {
+  if (name == "up") {
+    *direction = SweepDirection::kUp;
+    return true;
+  }
+  if (name == "down") {
+    *direction = SweepDirection::kDown;
+    return true;
+  }
+  return false;
+}
+
+const char* JumpKindName(JumpKind kind) {
+  return kind == JumpKind::kJumpUp ? "jump_up" : "jump_down";
+}
+
+double JumpBracket::half_width() const { return 0.5 * std::abs(control_after - control_before); }
+
+std::string Sweep::Name() const { return id + "/" + SweepDirectionName(direction); }
+
+}  // namespace dwellfit

@@ -1,0 +1,488 @@
+#include "dwellfit/estimator/data/sweep_csv.h"
+
+#include <glog/logging.h>
+#include <libfccp/csv.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+#include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/residuals/model/model_parameters.h"
+
+namespace dwellfit {
+namespace {
+
+constexpr char kSweepColumn[] = "sweep";
+constexpr char kDirectionColumn[] = "direction";
+constexpr char kFrequencyColumn[] = "freq_hz";
+constexpr char kABaseColumn[] = "a_base";
+constexpr char kAmplitudeColumn[] = "a";
+constexpr char kPhaseDegColumn[] = "phase_deg";
+constexpr char kPhaseRadColumn[] = "phase_rad";
+constexpr char kSigmaColumn[] = "sigma";
+constexpr int kNumColumns = 8;
+
+constexpr char kAllowedColumns[] =
+    "allowed columns are sweep, direction, freq_hz, a_base, a (required) and phase_deg or "
+    "phase_rad, sigma (optional)";
+
+constexpr double kRadiansPerDegree = kTwoPi / 360.0;
+
+// Blank lines are skipped; fields are trimmed and may be double-quoted.
+using CsvReader =
+    io::CSVReader<kNumColumns, io::trim_chars<' ', '\t'>, io::double_quote_escape<',', '"'>,
+                  io::throw_on_overflow, io::empty_line_comment>;
+
+// One data row, as text; a column absent from the header stays nullptr.
+struct RowFields {
+  char* sweep = nullptr;
+  char* direction = nullptr;
+  char* freq_hz = nullptr;
+  char* a_base = nullptr;
+  char* a = nullptr;
+  char* phase_deg = nullptr;
+  char* phase_rad = nullptr;
+  char* sigma = nullptr;
+};
+
+// Where in the file a value came from, for error messages.
+struct Location {
+  const std::string& file;
+  int line;
+};
+
+// The accepted values of a column (see the header for why these bounds).
+struct Range {
+  double min;
+  double max;
+  const char* meaning;  // "the drive frequency"
+  const char* power;    // the highest power the model takes of it
+  const char* advice;   // what a value outside the range usually means
+};
+
+const Range kFrequencyRange = {kMinFrequencyHz, kMaxFrequencyHz, "the drive frequency [Hz]",
+                               "Omega^4", "freq_hz is in Hz (not rad/s or kHz)"};
+const Range kABaseRange = {kMinMagnitude, kMaxMagnitude, "the base level a_base", "a_base^2",
+                           "give a_base in a unit that puts it inside the range"};
+const Range kAmplitudeRange = {
+    kMinMagnitude, kMaxMagnitude, "the amplitude a", "a^6",
+    "give a in a unit that puts it inside the range, or write 0 for a missing measurement"};
+const Range kSigmaRange = {kMinMagnitude, kMaxMagnitude, "the standard deviation sigma", "sigma^2",
+                           "sigma is in the unit of a"};
+
+// The shortest text that reads back as `value`.
+std::string FormatNumber(double value) {
+  char text[32];
+  const auto [end, error] = std::to_chars(text, text + sizeof(text), value);
+  return error == std::errc() ? std::string(text, end) : std::to_string(value);
+}
+
+// Parses the whole of `text` as a finite double, locale-independently.
+double ParseNumber(const Location& where, const char* column, const char* text) {
+  const char* begin = text;
+  const char* end = text + std::strlen(text);
+  if (begin == end) {
+    throw InputError(where.file, where.line, column, "value is empty; expected a number");
+  }
+  const std::string shown = "value '" + EscapeForMessage(text) + "'";
+  if (*begin == '+' && end - begin > 1 && begin[1] != '-') ++begin;  // from_chars rejects '+'
+  double value = 0.0;
+  const auto [stop, error] = std::from_chars(begin, end, value);
+  if (error == std::errc::result_out_of_range) {
+    throw InputError(where.file, where.line, column, shown + " is out of the range of a double");
+  }
+  if (error != std::errc() || stop != end) {
+    const bool comma = std::strchr(text, ',') != nullptr;
+    throw InputError(where.file, where.line, column,
+                     shown + " is not a number" +
+                         (comma ? "; write numbers with a decimal point, not a comma (40.5, "
+                                  "not 40,5)"
+                                : ""));
+  }
+  if (!std::isfinite(value)) {
+    throw InputError(where.file, where.line, column,
+                     shown +
+                         " is not finite (NaN or infinity); give a measured number or drop "
+                         "the row");
+  }
+  return value;
+}
+
+// A number > 0 inside `range`.
+double ParseInRange(const Location& where, const char* column, const char* text,
+                    const Range& range) {
+  const double value = ParseNumber(where, column, text);
+  if (!(value > 0.0)) {
+    throw InputError(where.file, where.line, column,
+                     std::string(range.meaning) + " must be > 0, got " + EscapeForMessage(text));
+  }
+  if (value < range.min || value > range.max) {
+    throw InputError(where.file, where.line, column,
+                     std::string(range.meaning) + " " + EscapeForMessage(text) +
+                         " is outside the accepted range [" + FormatNumber(range.min) + ", " +
+                         FormatNumber(range.max) + "], beyond which the model's powers (" +
+                         range.power + ") and squared residuals overflow or underflow; " +
+                         range.advice);
+  }
+  return value;
+}
+
+// What an unknown column's name suggests went wrong, as advice.
+std::string UnknownColumnAdvice(const std::string& name) {
+  if (name.find(';') != std::string::npos || name.find('\t') != std::string::npos) {
+    const char* separator = name.find(';') != std::string::npos ? "';'" : "tabs";
+    return std::string(
+               "; the header reads as one column: this file seems to separate fields "
+               "by ") +
+           separator +
+           ", but a sweeps CSV separates them by commas (and writes numbers with a '.' decimal "
+           "point): save it as comma-separated";
+  }
+  if (name.find('\r') != std::string::npos) {
+    return "; the lines of this file end in a carriage return alone (\\r, old Mac style): save "
+           "it with LF or CRLF line ends";
+  }
+  return "; the first line must be the header naming the columns";
+}
+
+// The message of a line longer than the reader's limit.
+std::string LineTooLong() {
+  return "the line is longer than 2^24 - 1 bytes, which no row of a sweeps CSV is; check that "
+         "this is the sweeps file";
+}
+
+// Reads the header and checks the column set; returns the header's line.
+int ReadHeader(const std::string& path, CsvReader* reader) {
+  try {
+    reader->read_header(io::ignore_missing_column, kSweepColumn, kDirectionColumn, kFrequencyColumn,
+                        kABaseColumn, kAmplitudeColumn, kPhaseDegColumn, kPhaseRadColumn,
+                        kSigmaColumn);
+  } catch (const io::error::header_missing&) {
+    throw InputError(path, 1, "",
+                     "the file is empty; expected a header row naming the columns (" +
+                         std::string(kAllowedColumns) + ")");
+  } catch (const io::error::extra_column_in_header& e) {
+    throw InputError(
+        path, static_cast<int>(reader->get_file_line()), EscapeForMessage(e.column_name),
+        std::string("unknown column; ") + kAllowedColumns + UnknownColumnAdvice(e.column_name));
+  } catch (const io::error::duplicated_column_in_header& e) {
+    throw InputError(path, static_cast<int>(reader->get_file_line()),
+                     EscapeForMessage(e.column_name),
+                     "column appears twice in the header; keep one");
+  } catch (const io::error::line_length_limit_exceeded& e) {
+    throw InputError(path, static_cast<int>(e.file_line), "", LineTooLong());
+  } catch (const io::error::base& e) {
+    throw InputError(path, static_cast<int>(reader->get_file_line()), "",
+                     std::string("cannot read the header: ") + e.what());
+  }
+  const int header_line = static_cast<int>(reader->get_file_line());
+  for (const char* column :
+       {kSweepColumn, kDirectionColumn, kFrequencyColumn, kABaseColumn, kAmplitudeColumn}) {
+    if (!reader->has_column(column)) {
+      throw InputError(
+          path, header_line, column,
+          std::string("required column is missing from the header; ") + kAllowedColumns);
+    }
+  }
+  if (reader->has_column(kPhaseDegColumn) && reader->has_column(kPhaseRadColumn)) {
+    throw InputError(path, header_line, kPhaseRadColumn,
+                     "the header has both phase_deg and phase_rad; keep one of them");
+  }
+  return header_line;
+}
+
+// Reads the next data row; false at the end of the file.
+bool ReadRow(const std::string& path, CsvReader* reader, RowFields* row) {
+  *row = RowFields();
+  try {
+    return reader->read_row(row->sweep, row->direction, row->freq_hz, row->a_base, row->a,
+                            row->phase_deg, row->phase_rad, row->sigma);
+  } catch (const io::error::too_few_columns&) {
+    throw InputError(path, static_cast<int>(reader->get_file_line()), "",
+                     "row has fewer fields than the header; give one value per header column");
+  } catch (const io::error::too_many_columns&) {
+    throw InputError(path, static_cast<int>(reader->get_file_line()), "",
+                     "row has more fields than the header; give one value per header column "
+                     "(a decimal comma splits a number in two: write 40.5, not 40,5)");
+  } catch (const io::error::escaped_string_not_closed&) {
+    throw InputError(path, static_cast<int>(reader->get_file_line()), "",
+                     "a quoted field is not closed; add the closing '\"'");
+  } catch (const io::error::line_length_limit_exceeded& e) {
+    throw InputError(path, static_cast<int>(e.file_line), "", LineTooLong());
+  } catch (const io::error::base& e) {
+    throw InputError(path, static_cast<int>(reader->get_file_line()), "",
+                     std::string("cannot read the row: ") + e.what());
+  }
+}
+
+// Which optional columns the header has.
+struct OptionalColumns {
+  bool phase_deg = false;
+  bool phase_rad = false;
+  bool sigma = false;
+};
+
+// One row's values, parsed and checked one by one.
+struct RowValues {
+  int line = 0;
+  std::string id;
+  SweepDirection direction = SweepDirection::kUp;
+  double freq_hz = 0.0;
+  double a_base = 0.0;
+  double amplitude = 0.0;  // <= 0: a missing measurement
+  std::optional<double> phase_rad;
+  std::optional<double> sigma;
+};
+
+RowValues ParseRow(const Location& where, const RowFields& row, const OptionalColumns& columns) {
+  RowValues values;
+  values.line = where.line;
+  values.id = row.sweep;
+  if (values.id.empty()) {
+    throw InputError(where.file, where.line, kSweepColumn,
+                     "sweep id is empty; give every row the id of its sweep");
+  }
+  if (!SweepDirectionFromName(row.direction, &values.direction)) {
+    throw InputError(where.file, where.line, kDirectionColumn,
+                     "value '" + EscapeForMessage(row.direction) + "' must be 'up' or 'down'");
+  }
+  values.freq_hz = ParseInRange(where, kFrequencyColumn, row.freq_hz, kFrequencyRange);
+  values.a_base = ParseInRange(where, kABaseColumn, row.a_base, kABaseRange);
+  values.amplitude = ParseNumber(where, kAmplitudeColumn, row.a);
+  if (values.amplitude > 0.0) {
+    values.amplitude = ParseInRange(where, kAmplitudeColumn, row.a, kAmplitudeRange);
+  }
+  if (columns.phase_deg) {
+    values.phase_rad = kRadiansPerDegree * ParseNumber(where, kPhaseDegColumn, row.phase_deg);
+  } else if (columns.phase_rad) {
+    values.phase_rad = ParseNumber(where, kPhaseRadColumn, row.phase_rad);
+  }
+  if (columns.sigma) values.sigma = ParseInRange(where, kSigmaColumn, row.sigma, kSigmaRange);
+  return values;
+}
+
+// One sweep being assembled, with what is needed to decide its kind.
+struct SweepBuilder {
+  Sweep sweep;
+  int num_rows = 0;
+  double first_freq_hz = 0.0;
+  double first_a_base = 0.0;
+  int freq_change_line = 0;    // first line whose freq_hz differs from the first row's
+  int a_base_change_line = 0;  // likewise for a_base
+  RowValues last;              // the sweep's previous row
+};
+
+// Records a row's controls; throws when the second control starts to vary.
+void TrackControls(const Location& where, double freq_hz, double a_base, SweepBuilder* builder) {
+  if (builder->num_rows++ == 0) {
+    builder->first_freq_hz = freq_hz;
+    builder->first_a_base = a_base;
+    return;
+  }
+  if (builder->freq_change_line == 0 && freq_hz != builder->first_freq_hz) {
+    builder->freq_change_line = where.line;
+  }
+  if (builder->a_base_change_line == 0 && a_base != builder->first_a_base) {
+    builder->a_base_change_line = where.line;
+  }
+  if (builder->freq_change_line > 0 && builder->a_base_change_line > 0) {
+    const bool a_base_second = builder->a_base_change_line >= builder->freq_change_line;
+    throw InputError(where.file, where.line, a_base_second ? kABaseColumn : kFrequencyColumn,
+                     "sweep '" + EscapeForMessage(builder->sweep.Name()) +
+                         "' varies both freq_hz (first change at line " +
+                         std::to_string(builder->freq_change_line) +
+                         ") and a_base (first change at line " +
+                         std::to_string(builder->a_base_change_line) +
+                         "); a sweep varies one control only: give each setting of the other "
+                         "its own sweep id");
+  }
+}
+
+// Throws when `row` moves its sweep's control against the sweep's direction
+// (a frequency sweep's freq_hz, an amplitude sweep's a_base; only one varies).
+void CheckOrder(const Location& where, const RowValues& row, const SweepBuilder& builder) {
+  const RowValues& last = builder.last;
+  const bool frequency = row.freq_hz != last.freq_hz;
+  const double before = frequency ? last.freq_hz : last.a_base;
+  const double now = frequency ? row.freq_hz : row.a_base;
+  const bool up = row.direction == SweepDirection::kUp;
+  if (up ? now >= before : now <= before) return;
+  const char* column = frequency ? kFrequencyColumn : kABaseColumn;
+  throw InputError(
+      where.file, where.line, column,
+      "sweep '" + EscapeForMessage(builder.sweep.Name()) + "' is " + (up ? "an up" : "a down") +
+          "-sweep, but " + column + (up ? " falls" : " rises") + " from " + FormatNumber(before) +
+          " (line " + std::to_string(last.line) + ") to " + FormatNumber(now) +
+          "; rows must be in measurement order, the control rising in an up-sweep and falling in "
+          "a down-sweep (repeats allowed). The order places the jumps, so it is not repaired: "
+          "restore the measured order (a shuffled, reversed or twice-appended file shows this), "
+          "or give a second pass its own sweep id");
+}
+
+// Throws when `row` repeats its sweep's previous row value for value.
+void CheckNotACopy(const Location& where, const RowValues& row, const SweepBuilder& builder) {
+  const RowValues& last = builder.last;
+  if (!(row.amplitude > 0.0) || row.amplitude != last.amplitude || row.freq_hz != last.freq_hz ||
+      row.a_base != last.a_base || row.phase_rad != last.phase_rad || row.sigma != last.sigma) {
+    return;
+  }
+  throw InputError(where.file, where.line, "",
+                   "row repeats line " + std::to_string(last.line) + " value for value (sweep '" +
+                       EscapeForMessage(builder.sweep.Name()) +
+                       "'): a copied row counts one dwell twice and understates the "
+                       "uncertainty; remove it (a dwell measured again gives its own reading; "
+                       "if two readings really agree, keep one row)");
+}
+
+// Adds a checked row to its sweep: a dwell, or a missing measurement (a <= 0).
+void AddRow(const Location& where, const RowValues& row, SweepBuilder* builder) {
+  TrackControls(where, row.freq_hz, row.a_base, builder);
+  if (builder->num_rows > 1) {
+    CheckOrder(where, row, *builder);
+    CheckNotACopy(where, row, *builder);
+  }
+  builder->last = row;
+  Sweep& sweep = builder->sweep;
+  if (!(row.amplitude > 0.0)) {
+    ++sweep.dropped_nonpositive;
+    MissingDwell missing;
+    missing.drive_frequency_rad_s = HzToRadPerSecond(row.freq_hz);
+    missing.a_base = row.a_base;
+    missing.points_before = static_cast<int>(sweep.points.size());
+    missing.source_line = row.line;
+    sweep.missing.push_back(missing);
+    return;
+  }
+  DwellPoint point;
+  point.drive_frequency_rad_s = HzToRadPerSecond(row.freq_hz);
+  point.a_base = row.a_base;
+  point.amplitude = row.amplitude;
+  point.phase_rad = row.phase_rad;
+  point.sigma = row.sigma;
+  point.source_line = row.line;
+  sweep.points.push_back(point);
+}
+
+void WarnAboutDroppedRows(const std::string& path, const std::vector<SweepBuilder>& builders) {
+  for (const SweepBuilder& builder : builders) {
+    const Sweep& sweep = builder.sweep;
+    if (sweep.dropped_nonpositive == 0) continue;
+    if (sweep.points.empty()) {
+      LOG(WARNING) << path << ": sweep " << sweep.Name() << ": all " << builder.num_rows
+                   << " rows have a <= 0 (missing measurements); the sweep is left out";
+    } else {
+      int trailing = 0;
+      for (const MissingDwell& row : sweep.missing) {
+        trailing += row.points_before == static_cast<int>(sweep.points.size());
+      }
+      LOG(WARNING) << path << ": sweep " << sweep.Name() << ": dropped "
+                   << sweep.dropped_nonpositive << " of " << builder.num_rows
+                   << " rows with a <= 0 (missing measurements"
+                   << (trailing > 0 ? ", " + std::to_string(trailing) +
+                                          " of them after the last "
+                                          "measured row"
+                                    : std::string())
+                   << ")";
+    }
+  }
+}
+
+// Opens `path` for reading; throws InputError when it is no readable file.
+void OpenCsv(const std::string& path, std::optional<CsvReader>* reader) {
+  const std::string not_a_file = NotARegularFile(path);
+  if (!not_a_file.empty()) {
+    throw InputError(path, 0, "", not_a_file + "; give the path of a sweeps CSV file");
+  }
+  try {
+    reader->emplace(path);
+  } catch (const io::error::can_not_open_file& e) {
+    std::string reason = e.errno_value != 0 ? std::strerror(e.errno_value) : "unknown reason";
+    throw InputError(path, 0, "",
+                     "cannot open the file (" + reason + "); check the path and permissions");
+  }
+}
+
+// The loaded sweeps, in order of first appearance, less those without a dwell.
+LoadedSweeps Collect(std::vector<SweepBuilder>* builders) {
+  LoadedSweeps loaded;
+  for (SweepBuilder& builder : *builders) {
+    Sweep& sweep = builder.sweep;
+    loaded.dropped_nonpositive += sweep.dropped_nonpositive;
+    if (sweep.points.empty()) {
+      loaded.all_dropped.push_back(sweep.Name());
+      continue;
+    }
+    // Neither control varying (repeated dwells) counts as a frequency sweep.
+    sweep.kind = builder.a_base_change_line > 0 ? SweepKind::kAmplitude : SweepKind::kFrequency;
+    loaded.sweeps.push_back(std::move(sweep));
+  }
+  return loaded;
+}
+
+}  // namespace
+
+std::string NotARegularFile(const std::string& path) {
+  std::error_code error;
+  const std::filesystem::file_status status = std::filesystem::status(path, error);
+  if (error || !std::filesystem::exists(status) || std::filesystem::is_regular_file(status)) {
+    return "";
+  }
+  switch (status.type()) {
+    case std::filesystem::file_type::directory:
+      return "is a directory";
+    case std::filesystem::file_type::character:
+      return "is a character device, not a file";
+    case std::filesystem::file_type::block:
+      return "is a block device, not a file";
+    case std::filesystem::file_type::fifo:
+      return "is a named pipe (FIFO), not a file";
+    case std::filesystem::file_type::socket:
+      return "is a socket, not a file";
+    default:
+      return "is not a regular file";
+  }
+}
+
+LoadedSweeps LoadSweepsCsv(const std::string& path) {
+  std::optional<CsvReader> reader;
+  OpenCsv(path, &reader);
+  const int header_line = ReadHeader(path, &*reader);
+  OptionalColumns columns;
+  columns.phase_deg = reader->has_column(kPhaseDegColumn);
+  columns.phase_rad = reader->has_column(kPhaseRadColumn);
+  columns.sigma = reader->has_column(kSigmaColumn);
+
+  std::vector<SweepBuilder> builders;
+  std::map<std::pair<std::string, SweepDirection>, size_t> index_of;
+  RowFields fields;
+  while (ReadRow(path, &*reader, &fields)) {
+    const Location where{path, static_cast<int>(reader->get_file_line())};
+    const RowValues row = ParseRow(where, fields, columns);
+    const auto key = std::make_pair(row.id, row.direction);
+    auto found = index_of.find(key);
+    if (found == index_of.end()) {
+      found = index_of.emplace(key, builders.size()).first;
+      builders.emplace_back();
+      builders.back().sweep.id = row.id;
+      builders.back().sweep.direction = row.direction;
+      builders.back().sweep.source_file = path;
+    }
+    AddRow(where, row, &builders[found->second]);
+  }
+  if (builders.empty()) {
+    throw InputError(path, header_line, "",
+                     "the file has a header but no data rows; add one row per dwell");
+  }
+  WarnAboutDroppedRows(path, builders);
+  return Collect(&builders);
+}
+
+}  // namespace dwellfit

@@ -1,0 +1,78 @@
+#include "dwellfit/estimator/data/sweep_csv_writer.h"
+
+#include <charconv>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "dwellfit/estimator/common/input_error.h"
+#include "glog/logging.h"
+#include "dwellfit/residuals/model/model_parameters.h"
+
+namespace dwellfit {
+
+std::string FormatRoundTrip(double value) {
+  char buffer[64];
+  const std::to_chars_result result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  CHECK(result.ec == std::errc()) << "64 characters hold any double";
+  return std::string(buffer, result.ptr);
+}
+
+std::string FormatFrequencyHz(double omega_rad_s) {
+  const double hz = RadPerSecondToHz(omega_rad_s);
+  char buffer[64];
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buffer, sizeof(buffer), "%.*g", digits, hz);
+    const double candidate = std::strtod(buffer, nullptr);
+    if (HzToRadPerSecond(candidate) == omega_rad_s) return FormatRoundTrip(candidate);
+  }
+  return FormatRoundTrip(hz);
+}
+
+void WriteSweepsCsv(const std::vector<Sweep>& sweeps, std::ostream* out) {
+  int with_sigma = 0;
+  int points = 0;
+  for (const Sweep& sweep : sweeps) {
+    if (sweep.id.empty() || sweep.id.find_first_of(",\"\r\n") != std::string::npos) {
+      throw InputError("sweep id '" + sweep.id +
+                       "' cannot be written as a CSV field; use non-empty plain text without "
+                       "commas, quotes or line breaks");
+    }
+    for (const DwellPoint& point : sweep.points) {
+      ++points;
+      if (point.sigma.has_value()) ++with_sigma;
+    }
+  }
+  if (with_sigma != 0 && with_sigma != points) {
+    throw InputError(std::to_string(with_sigma) + " of " + std::to_string(points) +
+                     " dwells carry a sigma; give every dwell a sigma or none");
+  }
+  const bool sigma_column = with_sigma > 0;
+  *out << "sweep,direction,freq_hz,a_base,a" << (sigma_column ? ",sigma" : "") << "\n";
+  for (const Sweep& sweep : sweeps) {
+    const char* direction = SweepDirectionName(sweep.direction);
+    for (const DwellPoint& point : sweep.points) {
+      *out << sweep.id << ',' << direction << ',' << FormatFrequencyHz(point.drive_frequency_rad_s)
+           << ',' << FormatRoundTrip(point.a_base) << ',' << FormatRoundTrip(point.amplitude);
+      if (sigma_column) *out << ',' << FormatRoundTrip(*point.sigma);
+      *out << '\n';
+    }
+  }
+}
+
+void WriteSweepsCsvFile(const std::vector<Sweep>& sweeps, const std::string& path) {
+  std::ostringstream text;
+  WriteSweepsCsv(sweeps, &text);
+  std::ofstream file(path, std::ios::binary | std::ios::trunc);
+  if (!file) {
+    throw InputError(path, 0, "",
+                     "cannot open the file for writing; check that its folder "
+                     "exists and is writable");
+  }
+  file << text.str();
+  file.close();
+  if (!file) throw InputError(path, 0, "", "writing the file failed (disk full?)");
+}
+
+}  // namespace dwellfit

@@ -1,0 +1,118 @@
+// Options of one identification run, one struct per component, each with
+// defaults in the body and `bool IsValid(std::string* error) const`.
+#ifndef DWELLFIT_ESTIMATOR_FIT_IDENTIFICATION_OPTIONS_H_
+#define DWELLFIT_ESTIMATOR_FIT_IDENTIFICATION_OPTIONS_H_
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "dwellfit/residuals/model/model_parameters.h"
+#include "dwellfit/residuals/functors/vertical_error_residual.h"
+
+namespace dwellfit {
+
+// Which residual a fit stage minimises.
+enum class ResidualKind {
+  kAlgebraic,  // (G(a_i) - a_base_i^2) / a_base_i^2, eq. (3.11): smooth, branch-free
+  kVertical,   // a_i - a_model(Omega_i, a_base_i) on the point's stable branch
+};
+const char* ResidualKindName(ResidualKind kind);
+bool ResidualKindFromName(const std::string& name, ResidualKind* kind);
+
+const char* ErrorMeasureName(ErrorMeasure measure);
+bool ErrorMeasureFromName(const std::string& name, ErrorMeasure* measure);
+
+struct ResidualOptions {
+  ErrorMeasure error = ErrorMeasure::kAbsolute;
+  // Divide each point's residual by its `sigma` column when the data has one.
+  bool use_point_sigma = true;
+  // f of the relative error ln(a_i + f) - ln(a_model + f), in the data's
+  // amplitude unit: the measurement's noise floor (0: purely relative).
+  double amplitude_floor = 0.0;
+};
+
+struct SolverSettings {
+  int max_iterations = 200;
+  // Convergence tests of ceres::Solver::Options. The gradient and parameter
+  // tests are off in effect: parameters span nine orders of magnitude (see
+  // ProblemBuilder). A relative cost change of 1e-8 resolves a fit far below
+  // its statistics (noise moves the cost by about 1/N of itself), and exact
+  // data still converge to round-off, their cost falling by decades a step;
+  // tighter, measured data only creep along their weakly determined
+  // directions (the beam's delta-alpha valley).
+  double function_tolerance = 1e-8;
+  double gradient_tolerance = 1e-30;
+  double parameter_tolerance = 1e-20;
+  // Threads that evaluate the residual blocks (ParallelResidualEvaluator),
+  // 0 for one per processor this process may run on. Results do not depend
+  // on it.
+  int num_threads = 0;
+  // Let the trust region accept steps that raise the cost for a while
+  // (ceres::Solver::Options::use_nonmonotonic_steps): faster along the
+  // narrow valleys of measured data with penalties.
+  bool nonmonotonic_steps = false;
+  bool IsValid(std::string* error) const;
+};
+
+// The jumps a bifurcation-range penalty can enforce: the sweep kind and
+// which fold (jump-up: the lower branch ends; jump-down: the upper one ends).
+enum class JumpTarget {
+  kFrequencyJumpUp,
+  kFrequencyJumpDown,
+  kAmplitudeJumpUp,
+  kAmplitudeJumpDown,
+};
+const char* JumpTargetName(JumpTarget target);  // "frequency_jump_down", ...
+bool JumpTargetFromName(const std::string& name, JumpTarget* target);
+
+// Eq. (3.17): each enforced measured jump adds the cost
+//   weight s^2 ((c_model - c_centre) / c_halfwidth)^exponent
+// (s^2: the data's mean squared residual where the fit stage starts)
+// where c is the jump's control (Omega [rad/s] or a_base) and c_model the
+// model's fold for that bracket.
+struct BifurcationRangeOptions {
+  bool enabled = false;
+  int exponent = 10;  // n of eq. (3.17): even, >= 2
+  double weight = 1.0;
+  // The chapter enforces the frequency sweep's jump-down and the amplitude
+  // sweep's jump-up.
+  std::vector<JumpTarget> enforce = {JumpTarget::kFrequencyJumpDown, JumpTarget::kAmplitudeJumpUp};
+  bool IsValid(std::string* error) const;
+};
+
+// Eq. (3.19): each dwell measured on the upper branch adds the cost
+//   weight s^2 exp(Lambda (a_fold - a_i)),
+// a_fold the amplitude where the upper branch ends at the dwell's frequency
+// (mirror for the lower branch: weight exp(Lambda (a_i - a_fold))), with
+// Lambda = lambda / (largest measured amplitude of the sweep).
+struct BranchStabilityOptions {
+  bool enabled = false;
+  double lambda = 50.0;  // dimensionless: Lambda times the sweep's amplitude scale
+  double weight = 1.0;
+  bool IsValid(std::string* error) const;
+};
+
+struct PenaltyOptions {
+  BifurcationRangeOptions bifurcation_range;
+  BranchStabilityOptions branch_stability;
+  bool IsValid(std::string* error) const;
+};
+
+struct IdentificationOptions {
+  // Starting point, ParameterIndex order, physical units (omega in rad/s).
+  ParameterVector initial = {0, 0, 0, 0, 0, 0};
+  // Parameters held at their initial value.
+  std::array<bool, kNumParameters> fixed = {false, false, false, false, false, false};
+  // Fit stages run in order, each starting where the previous one ended.
+  std::vector<ResidualKind> stages = {ResidualKind::kAlgebraic, ResidualKind::kVertical};
+  ResidualOptions residual;
+  // Soft constraints added to every vertical-error stage.
+  PenaltyOptions penalties;
+  SolverSettings solver;
+  bool IsValid(std::string* error) const;
+};
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_ESTIMATOR_FIT_IDENTIFICATION_OPTIONS_H_

@@ -1,0 +1,118 @@
+#include "dwellfit/estimator/fit/multi_start.h"
+
+#include <algorithm>
+#include <atomic>
+#include <boost/random/uniform_real_distribution.hpp>
+#include <cmath>
+#include <random>
+#include <thread>
+
+#include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
+
+namespace dwellfit {
+
+bool MultiStartOptions::IsValid(std::string* error) const {
+  if (starts < 1 || starts > kMaxStarts) {
+    *error = "multi_start.starts must be from 1 to " + std::to_string(kMaxStarts) +
+             " (each start is a whole fit)";
+    return false;
+  }
+  if (!(spread > 1.0) || !std::isfinite(spread)) {
+    *error = "multi_start.spread must be a factor greater than 1";
+    return false;
+  }
+  if (threads < 1) {
+    *error = "multi_start.threads must be at least 1";
+    return false;
+  }
+  return true;
+}
+
+std::vector<ParameterVector> MultiStartPoints(const IdentificationOptions& options,
+                                              const std::optional<ParameterVector>& automatic,
+                                              const MultiStartOptions& multi_start) {
+  std::vector<ParameterVector> starts = {options.initial};
+  if (automatic && static_cast<int>(starts.size()) < multi_start.starts &&
+      *automatic != options.initial) {
+    ParameterVector start = *automatic;
+    for (int i = 0; i < kNumParameters; ++i) {
+      if (options.fixed[i]) start[i] = options.initial[i];
+    }
+    starts.push_back(start);
+  }
+  // Boost.Random's distribution is one implementation everywhere, so a seed
+  // gives the same starts on every platform.
+  std::mt19937_64 generator(multi_start.seed);
+  boost::random::uniform_real_distribution<double> log_factor(-std::log(multi_start.spread),
+                                                              std::log(multi_start.spread));
+  while (static_cast<int>(starts.size()) < multi_start.starts) {
+    ParameterVector start = options.initial;
+    for (int i = 0; i < kNumParameters; ++i) {
+      const double factor = std::exp(log_factor(generator));  // drawn for every entry
+      if (!options.fixed[i]) start[i] *= factor;
+    }
+    starts.push_back(start);
+  }
+  return starts;
+}
+
+MultiStartResult IdentifyMultiStart(const std::vector<const Sweep*>& fitted,
+                                    const IdentificationOptions& options,
+                                    const std::optional<ParameterVector>& automatic,
+                                    const MultiStartOptions& multi_start) {
+  MultiStartResult result;
+  result.starts = MultiStartPoints(options, automatic, multi_start);
+  const int n = static_cast<int>(result.starts.size());
+  std::vector<IdentificationResult> fits(n);
+  const int parallel_starts = std::min(multi_start.threads, n);
+  // The starts share the machine's threads (the result does not depend on
+  // how many evaluate each start's residuals).
+  IdentificationOptions per_start = options;
+  per_start.solver.num_threads =
+      std::max(1, ResolveThreadCount(options.solver.num_threads) / std::max(parallel_starts, 1));
+  std::atomic<int> next{0};
+  auto worker = [&]() {
+    for (int i = next++; i < n; i = next++) {
+      IdentificationOptions start = per_start;
+      start.initial = result.starts[i];
+      fits[i] = Identify(fitted, start);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < parallel_starts; ++t) pool.emplace_back(worker);
+  worker();
+  for (std::thread& thread : pool) thread.join();
+
+  int best_usable = -1;
+  for (int i = 0; i < n; ++i) {
+    result.final_costs.push_back(fits[i].final_cost);
+    result.converged.push_back(fits[i].converged);
+    const bool usable =
+        fits[i].failure.empty() && std::all_of(fits[i].parameters.begin(), fits[i].parameters.end(),
+                                               [](double v) { return std::isfinite(v); });
+    if (!usable) {
+      ++result.failed;
+      continue;
+    }
+    // Lowest cost wins; ties go to the earlier start, so the result does not
+    // depend on scheduling. A failed start is never the best, unless every
+    // start failed (then the best is start 0 and carries its failure).
+    if (best_usable < 0 || fits[i].final_cost < fits[best_usable].final_cost) best_usable = i;
+  }
+  result.best_start = std::max(best_usable, 0);
+  result.best = fits[result.best_start];
+  for (int i = 0; i < n; ++i) {
+    bool same = fits[i].failure.empty();
+    for (int j = 0; j < kNumParameters && same; ++j) {
+      if (options.fixed[j]) continue;
+      const double reference = std::abs(result.best.parameters[j]) > 0.0
+                                   ? std::abs(result.best.parameters[j])
+                                   : std::max(std::abs(options.initial[j]), 1.0);
+      same = std::abs(fits[i].parameters[j] - result.best.parameters[j]) <= 1e-5 * reference;
+    }
+    result.reached_best += same;
+  }
+  return result;
+}
+
+}  // namespace dwellfit

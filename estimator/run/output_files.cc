@@ -1,0 +1,171 @@
+#include "dwellfit/estimator/run/output_files.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cstring>
+#include <filesystem>
+#include <sstream>
+
+#include "dwellfit/estimator/common/input_error.h"
+
+namespace dwellfit {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr char kStagingPrefix[] = ".dwellfit-staging-";
+constexpr char kLegacyPartialMarker[] = ".partial-";
+constexpr char kLockFileName[] = ".dwellfit-lock";
+
+[[noreturn]] void ThrowOutputError(const fs::path& path, const std::string& what) {
+  throw InputError(path.string(), 0, "output_dir", what + "; choose a writable output_dir");
+}
+
+// The process id that ends `name` after `marker`, or 0 when there is none.
+pid_t PidAfter(const std::string& name, const std::string& marker) {
+  const std::size_t at = name.rfind(marker);
+  if (at == std::string::npos) return 0;
+  const char* begin = name.data() + at + marker.size();
+  const char* end = name.data() + name.size();
+  pid_t pid = 0;
+  const auto [stop, error] = std::from_chars(begin, end, pid);
+  return error == std::errc() && stop == end && pid > 0 ? pid : 0;
+}
+
+bool ProcessIsGone(pid_t pid) { return ::kill(pid, 0) == -1 && errno == ESRCH; }
+
+// Removes staging folders and partial files whose writing process is gone.
+void RemoveStaleStaging(const fs::path& directory) {
+  std::error_code error;
+  for (const fs::directory_entry& entry : fs::directory_iterator(directory, error)) {
+    const std::string name = entry.path().filename().string();
+    const bool staging = name.rfind(kStagingPrefix, 0) == 0;
+    const pid_t pid = PidAfter(name, staging ? kStagingPrefix : kLegacyPartialMarker);
+    if (pid == 0 || pid == ::getpid() || !ProcessIsGone(pid)) continue;
+    std::error_code ignored;
+    fs::remove_all(entry.path(), ignored);
+  }
+}
+
+// Writes `content` to `path` and flushes it to the disk.
+void WriteDurably(const fs::path& path, const std::string& content) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) ThrowOutputError(path, std::string("cannot write (") + std::strerror(errno) + ")");
+  std::size_t done = 0;
+  while (done < content.size()) {
+    const ssize_t n = ::write(fd, content.data() + done, content.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    done += static_cast<std::size_t>(n);
+  }
+  const int saved_errno = errno;
+  const bool synced = done == content.size() && ::fsync(fd) == 0;
+  ::close(fd);
+  if (!synced) {
+    ThrowOutputError(path, std::string("cannot write (") + std::strerror(saved_errno) + ")");
+  }
+}
+
+std::string Manifest(const std::vector<std::pair<std::string, std::string>>& files) {
+  std::ostringstream out;
+  out << "# The files of one complete dwellfit run; written after all of them.\n"
+      << "dwellfit_version: " << DWELLFIT_VERSION << "\nfiles:\n";
+  for (const auto& [name, content] : files) {
+    out << "  - {name: " << name << ", bytes: " << content.size() << "}\n";
+  }
+  return out.str();
+}
+
+// Holds an exclusive lock on the directory's lock file while alive, so that
+// two runs into one directory publish one after the other.
+class DirectoryLock {
+ public:
+  explicit DirectoryLock(const fs::path& directory) {
+    const fs::path path = directory / kLockFileName;
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0 || ::flock(fd_, LOCK_EX) != 0) {
+      const std::string reason = std::strerror(errno);
+      if (fd_ >= 0) ::close(fd_);
+      ThrowOutputError(path, "cannot lock the output directory (" + reason + ")");
+    }
+  }
+  ~DirectoryLock() { ::close(fd_); }
+  DirectoryLock(const DirectoryLock&) = delete;
+  DirectoryLock& operator=(const DirectoryLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+// Renames the staged files, then the manifest, into `directory`.
+void MoveIntoPlace(const fs::path& staging, const fs::path& directory,
+                   const std::vector<std::pair<std::string, std::string>>& files) {
+  std::error_code error;
+  fs::remove(directory / kManifestFileName, error);
+  if (error)
+    ThrowOutputError(directory / kManifestFileName, "cannot replace (" + error.message() + ")");
+  for (const auto& [name, content] : files) {
+    fs::rename(staging / name, directory / name, error);
+    if (error) {
+      ThrowOutputError(directory / name,
+                       "cannot move the result into place (" + error.message() + ")");
+    }
+  }
+  fs::rename(staging / kManifestFileName, directory / kManifestFileName, error);
+  if (error) {
+    ThrowOutputError(directory / kManifestFileName,
+                     "cannot move the manifest into place (" + error.message() + ")");
+  }
+}
+
+}  // namespace
+
+void CheckOutputDirectory(const std::string& directory, const std::string& field) {
+  std::error_code error;
+  fs::path path = fs::absolute(directory, error);
+  if (error) path = directory;
+  const fs::path requested = path;
+  while (!fs::exists(path, error) && path.has_relative_path()) path = path.parent_path();
+  const auto fail = [&](const std::string& what) {
+    throw InputError(requested.string(), 0, field, what + "; choose another output_dir");
+  };
+  if (!fs::is_directory(path, error)) {
+    fail("'" + path.string() + "' is not a directory, so the results cannot be written there");
+  }
+  if (::access(path.c_str(), W_OK | X_OK) != 0) {
+    fail("the directory '" + path.string() + "' is not writable (" + std::strerror(errno) + ")");
+  }
+}
+
+void WriteFilesAtomically(const std::string& directory,
+                          const std::vector<std::pair<std::string, std::string>>& files) {
+  std::error_code error;
+  fs::create_directories(directory, error);
+  if (error || !fs::is_directory(directory)) {
+    ThrowOutputError(directory, "cannot create the output directory (" +
+                                    (error ? error.message() : "not a directory") + ")");
+  }
+  const fs::path dir(directory);
+  RemoveStaleStaging(dir);
+  const fs::path staging = dir / (kStagingPrefix + std::to_string(::getpid()));
+  fs::remove_all(staging, error);
+  fs::create_directory(staging, error);
+  if (error) ThrowOutputError(staging, "cannot create a staging folder (" + error.message() + ")");
+  try {
+    for (const auto& [name, content] : files) WriteDurably(staging / name, content);
+    WriteDurably(staging / kManifestFileName, Manifest(files));
+    const DirectoryLock lock(dir);
+    MoveIntoPlace(staging, dir, files);
+  } catch (...) {
+    fs::remove_all(staging, error);
+    throw;
+  }
+  fs::remove_all(staging, error);
+}
+
+}  // namespace dwellfit

@@ -1,0 +1,45 @@
+// All-or-nothing output of a run into its output directory.
+//
+// Protocol (what a reader of the directory can rely on):
+//   1. Every file of the run is written and flushed to disk inside a staging
+//      folder `.dwellfit-staging-<pid>` of the output directory.
+//   2. The previous run's `manifest.yaml` is removed.
+//   3. Each file is renamed into the output directory (same file system, so
+//      each rename is atomic).
+//   4. `manifest.yaml`, listing every file of the run with its size in bytes,
+//      is renamed into place last; then the staging folder is removed.
+// So the files a manifest lists are always one run's complete files: a run
+// killed before step 4 leaves no manifest, and one killed before step 2
+// leaves the previous run's files and manifest untouched. Staging folders
+// (and `*.partial-<pid>` files of earlier versions) left by a killed process
+// are removed by the next run into the same directory.
+#ifndef DWELLFIT_ESTIMATOR_RUN_OUTPUT_FILES_H_
+#define DWELLFIT_ESTIMATOR_RUN_OUTPUT_FILES_H_
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace dwellfit {
+
+// The file that lists a complete run's files; written last.
+inline constexpr char kManifestFileName[] = "manifest.yaml";
+
+// Checks, without creating or writing anything, that `directory` is or can
+// become a writable directory: it is a directory (or does not exist yet) and
+// its nearest existing ancestor is a writable directory. Throws InputError
+// naming the path and `field` (the config key or flag that set it) otherwise.
+// Call it before a long computation whose result goes there.
+void CheckOutputDirectory(const std::string& directory, const std::string& field);
+
+// Creates `directory` if needed and publishes each (file name, content) pair
+// into it as the protocol above says. Throws InputError naming the path when
+// the directory or a file cannot be written; the directory then holds no file
+// of this call, and the previous run's files stay as they were unless the
+// failure came while renaming (then no manifest is left).
+void WriteFilesAtomically(const std::string& directory,
+                          const std::vector<std::pair<std::string, std::string>>& files);
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_ESTIMATOR_RUN_OUTPUT_FILES_H_

@@ -1,0 +1,325 @@
+#include "dwellfit/estimator/simulation/dwell_simulator.h"
+
+#include <algorithm>
+#include <boost/random/normal_distribution.hpp>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <set>
+
+#include "dwellfit/estimator/common/input_error.h"
+#include "glog/logging.h"
+#include "dwellfit/residuals/model/bracketed_newton.h"
+#include "dwellfit/residuals/model/response_model.h"
+
+namespace dwellfit {
+namespace {
+
+constexpr int kMaxGridSteps = 1000000;
+// A grid must close on `to` to this fraction of the span: (to - from) / step
+// is an integer up to rounding of the decimal inputs.
+constexpr double kGridClosureTolerance = 1e-9;
+
+std::string Printf(const char* format, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), format, value);
+  return buffer;
+}
+
+std::string G12(double value) { return Printf("%.12g", value); }
+
+// The unstable middle root of G(a) = a_base^2, between the turning points;
+// requires both stable branches to exist there (G(a_lower_end) > a_base^2 >
+// G(a_upper_end)).
+double MiddleRoot(const ResponseCoefficients<double>& k, const TurningPoints& tp, double a_base) {
+  const double target = a_base * a_base;
+  auto residual = [&k, target](double a, double* value, double* slope) {
+    *value = k.G(a) - target;
+    *slope = k.dG(a);
+  };
+  return BracketedNewton(residual, tp.a_lower_end, tp.a_upper_end,
+                         0.5 * (tp.a_lower_end + tp.a_upper_end));
+}
+
+Branch OtherBranch(Branch side) { return side == Branch::kLower ? Branch::kUpper : Branch::kLower; }
+
+struct JumpAt {
+  int sweep = 0;        // index into the output sweeps
+  int index_after = 0;  // first dwell on the new branch
+  Branch from = Branch::kLower;
+};
+
+}  // namespace
+
+double RoundToSignificantDigits(double value, int digits) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.*g", digits, value);
+  return std::strtod(buffer, nullptr);
+}
+
+int SweepPlan::NumSteps() const {
+  if (!std::isfinite(from) || !std::isfinite(to) || !std::isfinite(step) || !(step > 0.0) ||
+      !(to > from)) {
+    return -1;
+  }
+  const double steps = (to - from) / step;
+  if (!(steps <= kMaxGridSteps)) return -1;
+  const long n = std::lround(steps);
+  if (n < 1) return -1;
+  if (std::abs(from + static_cast<double>(n) * step - to) > kGridClosureTolerance * (to - from)) {
+    return -1;
+  }
+  return static_cast<int>(n);
+}
+
+bool SweepPlan::IsValid(std::string* error) const {
+  auto fail = [error](const std::string& what) {
+    *error = what;
+    return false;
+  };
+  if (id.empty()) return fail("the sweep id is empty; give every sweep an id");
+  if (id.find_first_of(",\"\r\n") != std::string::npos) {
+    return fail("sweep id '" + id + "' holds a comma, quote or line break; use plain text");
+  }
+  const bool frequency = kind == SweepKind::kFrequency;
+  const double held = frequency ? held_a_base : held_frequency_hz;
+  if (!(held > 0.0) || !std::isfinite(held)) {
+    return fail(std::string(frequency ? "the held a_base" : "the held frequency [Hz]") +
+                " must be a positive number, got " + G12(held));
+  }
+  // Named as in a plan file (config/dwell_plan_reader.h).
+  const std::string from_key = frequency ? "from_hz" : "a_base_from";
+  const std::string to_key = frequency ? "to_hz" : "a_base_to";
+  const std::string step_key = frequency ? "step_hz" : "a_base_step";
+  if (!(from > 0.0) || !std::isfinite(from)) {
+    return fail(from_key + " must be positive, got " + G12(from));
+  }
+  if (!(to > from) || !std::isfinite(to)) {
+    return fail(to_key + " (" + G12(to) + ") must be larger than " + from_key + " (" + G12(from) +
+                ")");
+  }
+  if (!(step > 0.0) || !std::isfinite(step)) {
+    return fail(step_key + " must be positive, got " + G12(step));
+  }
+  if (NumSteps() < 0) {
+    return fail(to_key + " - " + from_key + " (" + G12(to - from) +
+                ") must be a whole number of steps of " + step_key + " (" + G12(step) +
+                "), at most " + std::to_string(kMaxGridSteps) + "; adjust " + to_key + " or " +
+                step_key);
+  }
+  if (directions.empty()) return fail("no directions; give [up], [down] or [up, down]");
+  std::set<SweepDirection> seen;
+  for (SweepDirection direction : directions) {
+    if (!seen.insert(direction).second) {
+      return fail(std::string("direction '") + SweepDirectionName(direction) +
+                  "' is given twice; each direction runs once");
+    }
+  }
+  if (start_branch == Branch::kOnly) {
+    return fail("the start branch must be 'lower' or 'upper'");
+  }
+  return true;
+}
+
+bool DwellPlan::IsValid(std::string* error) const {
+  for (int i = 0; i < kNumParameters; ++i) {
+    if (!std::isfinite(truth[i])) {
+      *error = std::string("truth parameter ") + ParameterName(i) + " is not finite";
+      return false;
+    }
+  }
+  if (!(truth[kEtaE] > 0.0)) {
+    *error = "truth eta_e must be positive, got " + G12(truth[kEtaE]);
+    return false;
+  }
+  if (!(truth[kOmega] > 0.0)) {
+    *error = "truth omega must be positive, got " + G12(truth[kOmega]) + " rad/s";
+    return false;
+  }
+  if (truth[kMu1] < 0.0 || truth[kMu2] < 0.0) {
+    *error = "truth damping mu1 and mu2 must not be negative";
+    return false;
+  }
+  if (sweeps.empty()) {
+    *error = "the plan has no sweeps";
+    return false;
+  }
+  std::set<std::string> ids;
+  for (const SweepPlan& sweep : sweeps) {
+    std::string why;
+    if (!sweep.IsValid(&why)) {
+      *error = "sweep '" + sweep.id + "': " + why;
+      return false;
+    }
+    if (!ids.insert(sweep.id).second) {
+      *error = "sweep id '" + sweep.id + "' is used twice; ids must be unique";
+      return false;
+    }
+  }
+  if (!(noise.relative_sigma >= 0.0 && noise.relative_sigma < 1.0)) {
+    *error = "noise relative_sigma must be in [0, 1), got " + G12(noise.relative_sigma);
+    return false;
+  }
+  return true;
+}
+
+std::vector<double> ControlGrid(const SweepPlan& sweep, SweepDirection direction) {
+  const int n = sweep.NumSteps();
+  CHECK_GE(n, 1) << "sweep '" << sweep.id << "' is not valid";
+  std::vector<double> grid(n + 1);
+  for (int i = 0; i <= n; ++i) {
+    grid[i] = RoundToSignificantDigits(sweep.from + static_cast<double>(i) * sweep.step,
+                                       kGridSignificantDigits);
+  }
+  if (direction == SweepDirection::kDown) std::reverse(grid.begin(), grid.end());
+  return grid;
+}
+
+SettledDwell SettleDwell(const ParameterVector& truth, double omega_drive_rad_s, double a_base,
+                         Branch side_before, double a_before) {
+  const bool from_rest = !(a_before > 0.0);
+  const double guess = from_rest ? 0.0 : a_before;
+  const StableRoot lower = ModelAmplitude(truth, omega_drive_rad_s, a_base, Branch::kLower, guess);
+  if (lower.status == RootStatus::kFailed) {
+    throw InputError("the model has no stable root at " + G12(RadPerSecondToHz(omega_drive_rad_s)) +
+                     " Hz, a_base " + G12(a_base) +
+                     "; check that the truth parameters are finite and eta_e > 0");
+  }
+  SettledDwell dwell;
+  if (lower.branch == Branch::kOnly) {  // G monotone: one root, no branches
+    dwell.amplitude = lower.a;
+    return dwell;
+  }
+  const StableRoot upper = ModelAmplitude(truth, omega_drive_rad_s, a_base, Branch::kUpper, guess);
+  CHECK(upper.status != RootStatus::kFailed);
+  const bool lower_exists = lower.status == RootStatus::kOnBranch;
+  const bool upper_exists = upper.status == RootStatus::kOnBranch;
+  CHECK(lower_exists || upper_exists) << "G always has a stable root";
+
+  Branch side = side_before;
+  if (side == Branch::kOnly) {
+    // Coming from a monotone G: stay on the side of the saddle the previous
+    // amplitude was on.
+    if (lower_exists && upper_exists) {
+      const auto k = ResponseCoefficients<double>::FromParameters(truth.data(), omega_drive_rad_s);
+      const double saddle = MiddleRoot(k, FindTurningPoints(k), a_base);
+      side = !from_rest && a_before > saddle ? Branch::kUpper : Branch::kLower;
+    } else {
+      side = lower_exists ? Branch::kLower : Branch::kUpper;
+    }
+  } else if ((side == Branch::kLower && !lower_exists) ||
+             (side == Branch::kUpper && !upper_exists)) {
+    side = OtherBranch(side);
+    dwell.jumped = !from_rest;
+  }
+  dwell.side = side;
+  dwell.amplitude = side == Branch::kLower ? lower.a : upper.a;
+  dwell.branch = lower_exists && upper_exists ? side : Branch::kOnly;
+  return dwell;
+}
+
+std::vector<Sweep> SimulateDwells(const DwellPlan& plan) {
+  std::string error;
+  if (!plan.IsValid(&error)) throw InputError("dwell plan: " + error);
+  std::vector<Sweep> sweeps;
+  std::vector<JumpAt> jumps;
+  for (const SweepPlan& sweep_plan : plan.sweeps) {
+    Branch side = sweep_plan.start_branch;
+    double a = 0.0;  // at rest before the first dwell
+    for (SweepDirection direction : sweep_plan.directions) {
+      Sweep sweep;
+      sweep.id = sweep_plan.id;
+      sweep.direction = direction;
+      sweep.kind = sweep_plan.kind;
+      const bool frequency = sweep_plan.kind == SweepKind::kFrequency;
+      for (double control : ControlGrid(sweep_plan, direction)) {
+        DwellPoint point;
+        point.drive_frequency_rad_s =
+            HzToRadPerSecond(frequency ? control : sweep_plan.held_frequency_hz);
+        point.a_base = frequency ? sweep_plan.held_a_base : control;
+        const SettledDwell dwell =
+            SettleDwell(plan.truth, point.drive_frequency_rad_s, point.a_base, side, a);
+        if (dwell.jumped && !sweep.points.empty()) {
+          jumps.push_back(
+              {static_cast<int>(sweeps.size()), static_cast<int>(sweep.points.size()), side});
+        }
+        side = dwell.side;
+        a = dwell.amplitude;
+        point.amplitude = dwell.amplitude;
+        point.branch = dwell.branch;
+        sweep.points.push_back(point);
+      }
+      sweeps.push_back(std::move(sweep));
+    }
+  }
+  if (plan.noise.relative_sigma > 0.0) {
+    // Boost.Random's normal distribution is one implementation everywhere
+    // (std::normal_distribution differs between standard libraries), so a
+    // seed gives the same data on every platform.
+    std::mt19937_64 rng(plan.noise.seed);
+    boost::random::normal_distribution<double> standard_normal(0.0, 1.0);
+    for (Sweep& sweep : sweeps) {
+      for (DwellPoint& point : sweep.points) {
+        point.amplitude *= 1.0 + plan.noise.relative_sigma * standard_normal(rng);
+      }
+    }
+  }
+  for (const JumpAt& jump : jumps) {
+    Sweep& sweep = sweeps[jump.sweep];
+    const DwellPoint& before = sweep.points[jump.index_after - 1];
+    const DwellPoint& after = sweep.points[jump.index_after];
+    JumpBracket bracket;
+    bracket.kind = jump.from == Branch::kLower ? JumpKind::kJumpUp : JumpKind::kJumpDown;
+    bracket.index_before = jump.index_after - 1;
+    bracket.control_before = sweep.Control(before);
+    bracket.control_after = sweep.Control(after);
+    bracket.amplitude_before = before.amplitude;
+    bracket.amplitude_after = after.amplitude;
+    sweep.jumps.push_back(bracket);
+  }
+  return sweeps;
+}
+
+void DescribeSimulation(const DwellPlan& plan, const std::vector<Sweep>& sweeps,
+                        std::ostream* out) {
+  const ParameterVector& p = plan.truth;
+  *out << "truth: eta_e " << G12(p[kEtaE]) << ", mu1 " << G12(p[kMu1]) << " 1/s, mu2 "
+       << G12(p[kMu2]) << ", delta " << G12(p[kDelta]) << ", alpha " << G12(p[kAlpha]) << ", w "
+       << G12(p[kOmega]) << " rad/s (" << G12(RadPerSecondToHz(p[kOmega])) << " Hz)\n";
+  if (plan.noise.relative_sigma > 0.0) {
+    *out << "noise: relative_sigma " << G12(plan.noise.relative_sigma) << ", seed "
+         << plan.noise.seed << "\n";
+  } else {
+    *out << "noise: none\n";
+  }
+  for (const Sweep& sweep : sweeps) {
+    const bool frequency = sweep.kind == SweepKind::kFrequency;
+    auto control = [frequency](double value) {
+      return frequency ? G12(RadPerSecondToHz(value)) + " Hz" : "a_base " + G12(value);
+    };
+    double a_min = sweep.points.front().amplitude;
+    double a_max = a_min;
+    for (const DwellPoint& point : sweep.points) {
+      a_min = std::min(a_min, point.amplitude);
+      a_max = std::max(a_max, point.amplitude);
+    }
+    const DwellPoint& first = sweep.points.front();
+    *out << sweep.Name() << ": " << SweepKindName(sweep.kind) << " sweep at "
+         << (frequency ? "a_base " + G12(first.a_base)
+                       : G12(RadPerSecondToHz(first.drive_frequency_rad_s)) + " Hz")
+         << ", " << control(sweep.Control(first)) << " -> "
+         << control(sweep.Control(sweep.points.back())) << ", " << sweep.points.size()
+         << " dwells, a " << Printf("%.4g", a_min) << " .. " << Printf("%.4g", a_max);
+    if (sweep.jumps.empty()) *out << ", no jump";
+    for (const JumpBracket& jump : sweep.jumps) {
+      *out << ", " << JumpKindName(jump.kind) << " between " << control(jump.control_before)
+           << " and " << control(jump.control_after) << " (a "
+           << Printf("%.4g", jump.amplitude_before) << " -> "
+           << Printf("%.4g", jump.amplitude_after) << ")";
+    }
+    *out << "\n";
+  }
+}
+
+}  // namespace dwellfit

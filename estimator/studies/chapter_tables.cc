@@ -1,0 +1,189 @@
+#include "dwellfit/estimator/studies/chapter_tables.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <vector>
+
+#include "dwellfit/estimator/fit/identification.h"
+#include "dwellfit/estimator/run/identify_run.h"
+#include "dwellfit/estimator/analysis/sweep_prediction.h"
+
+namespace dwellfit {
+namespace {
+
+struct PairedFit {
+  ConfiguredSweeps data;
+  IdentificationResult with_penalty;
+  IdentificationResult without_penalty;
+  double omega_ref_rad_s = 0.0;
+};
+
+PairedFit FitBothWays(const IdentifyConfig& config) {
+  PairedFit fit;
+  fit.data = LoadConfiguredSweeps(config);
+  IdentificationOptions with = config.identification;
+  with.penalties.bifurcation_range.enabled = true;
+  IdentificationOptions without = config.identification;
+  without.penalties.bifurcation_range.enabled = false;
+  without.penalties.branch_stability.enabled = false;
+  fit.with_penalty = Identify(fit.data.fitted, with);
+  fit.without_penalty = Identify(fit.data.fitted, without);
+  fit.omega_ref_rad_s = config.omega_ref_rad_s.value_or(fit.with_penalty.parameters[kOmega]);
+  return fit;
+}
+
+std::string Format(const char* format, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), format, value);
+  return buffer;
+}
+
+// The rows: the five model parameters, omega when it was fitted, and the
+// effective nonlinearity.
+struct Row {
+  std::string name;
+  double with_penalty;
+  double without_penalty;
+  double truth;
+};
+
+std::vector<Row> Rows(const PairedFit& fit, const IdentificationOptions& options,
+                      const ParameterVector& truth) {
+  std::vector<Row> rows;
+  for (int i = 0; i < kNumParameters; ++i) {
+    if (i == kOmega && options.fixed[kOmega]) continue;
+    const bool omega = i == kOmega;
+    rows.push_back(
+        {omega ? "w [Hz]" : ParameterName(i),
+         omega ? RadPerSecondToHz(fit.with_penalty.parameters[i]) : fit.with_penalty.parameters[i],
+         omega ? RadPerSecondToHz(fit.without_penalty.parameters[i])
+               : fit.without_penalty.parameters[i],
+         omega ? RadPerSecondToHz(truth[i]) : truth[i]});
+  }
+  rows.push_back(
+      {"effective nonlinearity at " + Format("%.4g", RadPerSecondToHz(fit.omega_ref_rad_s)) + " Hz",
+       EffectiveNonlinearity(fit.with_penalty.parameters, fit.omega_ref_rad_s),
+       EffectiveNonlinearity(fit.without_penalty.parameters, fit.omega_ref_rad_s),
+       EffectiveNonlinearity(truth, fit.omega_ref_rad_s)});
+  return rows;
+}
+
+std::string PercentError(double estimate, double reference) {
+  if (reference == 0.0) return estimate == 0.0 ? "0" : "-";
+  return Format("%.3g", 100.0 * std::abs(estimate - reference) / std::abs(reference));
+}
+
+void SolverLines(const PairedFit& fit, std::ostream& out) {
+  out << "- with penalty: final cost " << Format("%.6g", fit.with_penalty.final_cost) << ", "
+      << fit.with_penalty.iterations << " iterations, "
+      << (fit.with_penalty.converged ? "converged" : "not converged") << "\n";
+  out << "- without penalty: final cost " << Format("%.6g", fit.without_penalty.final_cost) << ", "
+      << fit.without_penalty.iterations << " iterations, "
+      << (fit.without_penalty.converged ? "converged" : "not converged") << "\n\n";
+}
+
+// Every measured jump: its bracket and both models' folds (Hz for frequency
+// sweeps, a_base for amplitude sweeps). The median is the measure:
+// the held-out frequency sweeps' jump-downs, a missing fold counting 100 %.
+void JumpTable(const PairedFit& fit, std::ostream& out) {
+  out << "| sweep | role | jump | measured between | with penalty | error % | without penalty | "
+         "error % |\n|---|---|---|---|---|---|---|---|\n";
+  std::vector<double> held_out_with, held_out_without;
+  for (const auto* group : {&fit.data.fitted, &fit.data.validation}) {
+    const bool fitted = group == &fit.data.fitted;
+    for (const Sweep* sweep : *group) {
+      const bool frequency = sweep->kind == SweepKind::kFrequency;
+      auto shown = [frequency](double control) {
+        return frequency ? Format("%.3f Hz", RadPerSecondToHz(control)) : Format("%.4g", control);
+      };
+      const std::vector<PredictedJump> with = PredictJumps(fit.with_penalty.parameters, *sweep);
+      const std::vector<PredictedJump> without =
+          PredictJumps(fit.without_penalty.parameters, *sweep);
+      for (size_t j = 0; j < with.size(); ++j) {
+        if (!with[j].measured) continue;
+        const bool counted = !fitted && frequency && with[j].kind == JumpKind::kJumpDown;
+        const double measured = with[j].bracket.centre();
+        auto cell = [&](const PredictedJump& jump, std::vector<double>* errors) {
+          const double error =
+              jump.exists ? 100.0 * std::abs(jump.control - measured) / measured : 100.0;
+          if (counted) errors->push_back(error);
+          if (!jump.exists) return std::string("no fold | -");
+          return shown(jump.control) + (jump.inside ? " (inside)" : "") + " | " +
+                 Format("%.2f", error);
+        };
+        out << "| " << sweep->Name() << " | " << (fitted ? "fitted" : "held out") << " | "
+            << JumpKindName(with[j].kind) << " | " << shown(with[j].bracket.control_before) << " - "
+            << shown(with[j].bracket.control_after) << " | " << cell(with[j], &held_out_with)
+            << " | " << cell(without[j], &held_out_without) << " |\n";
+      }
+    }
+  }
+  auto median = [](std::vector<double> values) {
+    if (values.empty()) return std::string("-");
+    std::sort(values.begin(), values.end());
+    const size_t n = values.size();
+    return Format("%.2f", n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]));
+  };
+  if (!held_out_with.empty()) {
+    out << "\nMedian error of the predicted jump-down frequency over the " << held_out_with.size()
+        << " held-out frequency sweeps (a missing fold counts 100 %): " << median(held_out_with)
+        << " % with the penalty, " << median(held_out_without) << " % without.\n";
+  }
+  out << "\n";
+}
+
+}  // namespace
+
+std::string ChapterTablesMarkdown(const IdentifyConfig& numerical, const ParameterVector& truth,
+                                  const IdentifyConfig& measured) {
+  std::ostringstream out;
+  out << "# The chapter's Tables 3.3 and 3.4, reproduced by dwellfit\n\n"
+      << "Generated by `build/tools/chapter_tables` (see docs/README.md); do not edit by hand.\n\n"
+      << "\"With penalty\": the vertical-error fit with the bifurcation-range penalty of eq. "
+         "(3.17) (and any other penalty the config enables); \"without\": no penalty. The "
+         "penalty's weight is in units of the data's sum of squared residuals where the fit "
+         "stage starts: on exact data it vanishes, so on the numerical case both columns are "
+         "exact (the chapter's penalised fit was off by up to 2.1 %), while on measured data it "
+         "holds each enforced jump inside its bracket.\n\n";
+
+  const PairedFit thesis = FitBothWays(numerical);
+  out << "## Table 3.3: numerical data (`"
+      << numerical.config_path.substr(numerical.config_path.rfind("datasets/") == std::string::npos
+                                          ? 0
+                                          : numerical.config_path.rfind("datasets/"))
+      << "`)\n\n"
+      << "| parameter | known value | with penalty | error % | without penalty | error % |\n"
+      << "|---|---|---|---|---|---|\n";
+  for (const Row& row : Rows(thesis, numerical.identification, truth)) {
+    out << "| " << row.name << " | " << Format("%.6g", row.truth) << " | "
+        << Format("%.8g", row.with_penalty) << " | " << PercentError(row.with_penalty, row.truth)
+        << " | " << Format("%.8g", row.without_penalty) << " | "
+        << PercentError(row.without_penalty, row.truth) << " |\n";
+  }
+  out << "\n";
+  SolverLines(thesis, out);
+  JumpTable(thesis, out);
+
+  const PairedFit beam = FitBothWays(measured);
+  out << "## Table 3.4: measured data (`"
+      << measured.config_path.substr(measured.config_path.rfind("datasets/") == std::string::npos
+                                         ? 0
+                                         : measured.config_path.rfind("datasets/"))
+      << "`)\n\n"
+      << "Percent comparison: |with - without| / |with|.\n\n"
+      << "| parameter | with penalty | without penalty | percent comparison |\n"
+      << "|---|---|---|---|\n";
+  for (const Row& row : Rows(beam, measured.identification, ParameterVector{})) {
+    out << "| " << row.name << " | " << Format("%.6g", row.with_penalty) << " | "
+        << Format("%.6g", row.without_penalty) << " | "
+        << PercentError(row.without_penalty, row.with_penalty) << " |\n";
+  }
+  out << "\n";
+  SolverLines(beam, out);
+  JumpTable(beam, out);
+  return out.str();
+}
+
+}  // namespace dwellfit

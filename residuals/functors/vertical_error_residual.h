@@ -1,0 +1,114 @@
+// VerticalErrorResidual: one sine-dwell point (Omega_i, a_base_i, a_i).
+//
+// Residual (section 3.2.4, the "vertical error" v of Figure 3.17):
+//   absolute:  r_i = s_i (a_i - a_model(Omega_i, a_base_i; p))
+//   relative:  r_i = s_i (ln(a_i + f) - ln(a_model(Omega_i, a_base_i; p) + f))
+// with f >= 0 an amplitude floor (the measurement's noise floor; 0: pure
+// relative error): dwells far below f weigh little, dwells far above it are
+// measured relatively.
+// where a_model is the stable root of the frequency-response equation (3.11)
+//   G(a; Omega_i, p) = a_base_i^2
+// on the branch the point was measured on (kLower: smallest positive root,
+// kUpper: largest, kOnly: the stable root nearest a_i), and s_i a weight
+// (1/sigma_i and/or a user weight).
+//
+// Parameter block: p = [eta_e, mu1, mu2, delta, alpha, omega] (model_parameters.h),
+// omega [rad/s]; Omega_i [rad/s].
+//
+// Root: Newton root refinement embedded in the functor. The root is solved in
+// double by a safeguarded Newton iteration started from the measured a_i on
+// the bracket of its stable branch (stable_root.h), so it cannot diverge nor
+// land on the unstable middle root. The Jet value is then one Newton step in
+// Jet arithmetic from the converged root, whose derivative part is exactly
+// da/dp = -(dG/dp) / (dG/da) (implicit function theorem). Where the measured
+// branch does not reach a_base_i at the current parameters, a_model is the
+// turning point where that branch ends (dG/da = 0), the continuous extension
+// of the branch, so the residual stays continuous as a fold moves past a point.
+//
+// Warm start: on a labelled branch (kLower, kUpper) the Newton iteration
+// starts from this dwell's root at its last evaluation (from a_i at the
+// first), which is near the new root while a solver steps. The start only
+// saves iterations: whether the root found is on the dwell's branch is decided
+// by a certificate (stable_root.h), and the value agrees with a cold start to
+// the last bits. A kOnly dwell always starts from a_i, since it takes the
+// stable root nearest a_i where there are two.
+#ifndef DWELLFIT_RESIDUALS_FUNCTORS_VERTICAL_ERROR_RESIDUAL_H_
+#define DWELLFIT_RESIDUALS_FUNCTORS_VERTICAL_ERROR_RESIDUAL_H_
+
+#include <atomic>
+#include <cmath>
+
+#include "ceres/autodiff_cost_function.h"
+#include "dwellfit/residuals/model/model_parameters.h"
+#include "dwellfit/residuals/model/response_model.h"
+#include "dwellfit/residuals/model/stable_root.h"
+
+namespace dwellfit {
+
+// How the vertical error is measured.
+enum class ErrorMeasure {
+  kAbsolute,  // a_i - a_model (the data's length unit)
+  kRelative,  // ln(a_i + f) - ln(a_model + f), f the amplitude floor
+};
+
+class VerticalErrorResidual {
+ public:
+  VerticalErrorResidual(double drive_frequency_rad_s, double a_base, double a_measured,
+                        Branch branch, ErrorMeasure error, double weight,
+                        double amplitude_floor = 0.0)
+      : drive_frequency_rad_s_(drive_frequency_rad_s),
+        a_base_(a_base),
+        a_measured_(a_measured),
+        branch_(branch),
+        error_(error),
+        weight_(weight),
+        amplitude_floor_(amplitude_floor) {}
+
+  template <typename T>
+  bool operator()(const T* const parameters, T* residual) const {
+    const auto k = ResponseCoefficients<T>::FromParameters(parameters, drive_frequency_rad_s_);
+    // kOnly picks the stable root nearest its guess: that stays a_i.
+    const double last_root = last_root_.load(std::memory_order_relaxed);
+    const double start = branch_ != Branch::kOnly && last_root > 0.0 ? last_root : a_measured_;
+    const StableRoot root = SolveStableRootNear(ScalarCoefficients(k), a_base_, branch_, start);
+    // Undefined evaluation: no finite root (non-finite parameters, eta_e = 0).
+    if (root.status == RootStatus::kFailed) return false;
+    if (root.status == RootStatus::kOnBranch) {
+      last_root_.store(root.a, std::memory_order_relaxed);
+    }
+    const T a_model = LiftRoot(k, a_base_, root);
+    if (error_ == ErrorMeasure::kAbsolute) {
+      residual[0] = weight_ * (a_measured_ - a_model);
+    } else {
+      if (!(ScalarPart(a_model) > 0.0)) return false;  // log undefined
+      residual[0] =
+          weight_ * (std::log(a_measured_ + amplitude_floor_) - log(a_model + amplitude_floor_));
+    }
+    // Undefined evaluation: a root that overflowed at an extreme trial step.
+    return std::isfinite(ScalarPart(residual[0]));
+  }
+
+  static ceres::CostFunction* Create(double drive_frequency_rad_s, double a_base, double a_measured,
+                                     Branch branch, ErrorMeasure error, double weight,
+                                     double amplitude_floor = 0.0) {
+    return new ceres::AutoDiffCostFunction<VerticalErrorResidual, 1, kNumParameters>(
+        new VerticalErrorResidual(drive_frequency_rad_s, a_base, a_measured, branch, error, weight,
+                                  amplitude_floor));
+  }
+
+ private:
+  const double drive_frequency_rad_s_;
+  const double a_base_;
+  const double a_measured_;
+  const Branch branch_;
+  const ErrorMeasure error_;
+  const double weight_;
+  const double amplitude_floor_;  // f, the data's amplitude unit
+  // The root at the last evaluation (0: none yet): the next Newton start.
+  // Atomic so that concurrent evaluations stay well defined.
+  mutable std::atomic<double> last_root_{0.0};
+};
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_RESIDUALS_FUNCTORS_VERTICAL_ERROR_RESIDUAL_H_

@@ -1,0 +1,169 @@
+// FoldPoint: where the model jumps, for a measured jump bracket
+// (docs/model.md, "Stability and folds"; section 3.2.4).
+//
+// A jump-up is where the lower stable branch ends (the local maximum of G at
+// a_lower_end); a jump-down is where the upper branch ends (the local minimum
+// of G at a_upper_end). Per sweep kind:
+//
+//   amplitude sweep at fixed Omega: a_base(a) = sqrt(G(a)) is explicit, and
+//     the fold level is a_base* = sqrt(G(a*)) with dG/da(a*) = 0.
+//   frequency sweep at fixed a_base: (a*, Omega*) solve
+//     G(a; Omega) = a_base^2,  dG/da(a; Omega) = 0,
+//     found as the root in Omega of phi(Omega) = G(a_turn(Omega); Omega) - a_base^2,
+//     a_turn(Omega) the turning point of the requested branch at Omega. By the
+//     envelope theorem (dG/da = 0 there) phi'(Omega) = dG/dOmega at fixed a.
+//
+// Roots are solved in double by safeguarded Newton iterations; the scalar-T
+// value (ceres::Jet) is one Newton step from the converged point, whose
+// derivative part is the implicit-function-theorem derivative:
+//   d a_base*/dp = (dG/dp) / (2 a_base*)          (amplitude sweep, dG/da = 0)
+//   d Omega*/dp  = -(dG/dp) / (dG/dOmega)         (frequency sweep, dG/da = 0)
+#ifndef DWELLFIT_RESIDUALS_MODEL_FOLD_POINT_H_
+#define DWELLFIT_RESIDUALS_MODEL_FOLD_POINT_H_
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "dwellfit/residuals/model/bracketed_newton.h"
+#include "dwellfit/residuals/model/response_model.h"
+#include "dwellfit/residuals/model/stable_root.h"
+
+namespace dwellfit {
+
+// Which branch ends at the fold.
+enum class FoldKind {
+  kLowerBranchEnd,  // jump-up: local maximum of G
+  kUpperBranchEnd,  // jump-down: local minimum of G
+};
+
+// dG/dOmega at fixed a, from dk1/dOmega = k1/Omega, dk2/dOmega = k2/Omega,
+// dk3/dOmega = -Omega/eta_e, dk4/dOmega = -delta Omega/(2 eta_e).
+template <typename T>
+T DerivativeOfGInDriveFrequency(const T* p, double omega_drive_rad_s,
+                                const ResponseCoefficients<T>& k, const T& a) {
+  const double omega = omega_drive_rad_s;
+  const T dp = (k.k1 + k.k2 * a) * a / omega;
+  const T dq = (-omega / p[kEtaE] - p[kDelta] * omega / (2.0 * p[kEtaE]) * a * a) * a;
+  return 2.0 * (k.P(a) * dp + k.Q(a) * dq);
+}
+
+inline double TurningAmplitude(const TurningPoints& tp, FoldKind kind) {
+  return kind == FoldKind::kLowerBranchEnd ? tp.a_lower_end : tp.a_upper_end;
+}
+
+struct FoldPoint {
+  bool exists = false;
+  double a = 0.0;        // response amplitude at the fold
+  double control = 0.0;  // a_base (amplitude sweep) or Omega [rad/s] (frequency sweep)
+};
+
+// Amplitude sweep at `omega_drive_rad_s`: the a_base where `kind` ends.
+inline FoldPoint SolveAmplitudeFold(const double* p, double omega_drive_rad_s, FoldKind kind) {
+  FoldPoint fold;
+  const auto k = ResponseCoefficients<double>::FromParameters(p, omega_drive_rad_s);
+  const TurningPoints tp = FindTurningPoints(k);
+  if (!tp.exist) return fold;
+  fold.a = TurningAmplitude(tp, kind);
+  fold.control = std::sqrt(k.G(fold.a));
+  fold.exists = std::isfinite(fold.control);
+  return fold;
+}
+
+// Lifts an amplitude-sweep fold to scalar T.
+template <typename T>
+T LiftAmplitudeFold(const T* p, double omega_drive_rad_s, const FoldPoint& fold) {
+  const auto k = ResponseCoefficients<T>::FromParameters(p, omega_drive_rad_s);
+  const T a0(fold.a);
+  const T a = a0 - k.dG(a0) / k.d2G(a0);
+  return sqrt(k.G(a));
+}
+
+// Frequency sweep at `a_base`: the Omega [rad/s] where `kind` ends, searched
+// outward from `omega_guess` (the measured bracket's centre) in steps that
+// start at `first_step` and double, within a factor 2 of the guess.
+inline FoldPoint SolveFrequencyFold(const double* p, double a_base, FoldKind kind,
+                                    double omega_guess, double first_step) {
+  FoldPoint fold;
+  const double target = a_base * a_base;
+  // phi(Omega) and phi'(Omega); false where the branch has no end at Omega.
+  auto phi = [&](double omega, double* value, double* slope, double* a) {
+    const auto k = ResponseCoefficients<double>::FromParameters(p, omega);
+    const TurningPoints tp = FindTurningPoints(k);
+    if (!tp.exist) return false;
+    *a = TurningAmplitude(tp, kind);
+    *value = k.G(*a) - target;
+    *slope = DerivativeOfGInDriveFrequency(p, omega, k, *a);
+    return std::isfinite(*value) && std::isfinite(*slope);
+  };
+  double value0, slope0, a0;
+  const bool at_guess = phi(omega_guess, &value0, &slope0, &a0);
+  if (at_guess && value0 == 0.0) return {true, a0, omega_guess};
+  // Step outward on both sides; a probe where the branch has no end (past
+  // the cusp) is bisected back towards the last probe where it has one, since
+  // the sign change may lie in between.
+  double step = first_step > 0.0 ? first_step : 1e-3 * omega_guess;
+  double last_valid[2] = {omega_guess, omega_guess};
+  bool side_done[2] = {false, false};
+  double lo = 0, hi = 0;
+  bool bracketed = false;
+  auto differs = [value0](double value) { return (value > 0.0) != (value0 > 0.0); };
+  for (int i = 0; i < 64 && step < omega_guess && !bracketed; ++i, step *= 2.0) {
+    for (int side = 0; side < 2 && !bracketed; ++side) {
+      if (side_done[side]) continue;
+      double omega = omega_guess + (side == 0 ? -step : step);
+      double value, slope, a;
+      if (phi(omega, &value, &slope, &a)) {
+        if (!at_guess) return SolveFrequencyFold(p, a_base, kind, omega, step / 4.0);
+        if (differs(value)) {
+          lo = std::min(omega, last_valid[side]);
+          hi = std::max(omega, last_valid[side]);
+          bracketed = true;
+        } else {
+          last_valid[side] = omega;
+        }
+        continue;
+      }
+      if (!at_guess) continue;
+      double invalid = omega;
+      for (int j = 0; j < 60 && !bracketed; ++j) {
+        const double mid = 0.5 * (last_valid[side] + invalid);
+        if (!phi(mid, &value, &slope, &a)) {
+          invalid = mid;
+        } else if (differs(value)) {
+          lo = std::min(mid, last_valid[side]);
+          hi = std::max(mid, last_valid[side]);
+          bracketed = true;
+        } else {
+          last_valid[side] = mid;
+        }
+      }
+      side_done[side] = true;
+    }
+  }
+  if (!bracketed) return fold;
+  auto phi_for_newton = [&](double omega, double* value, double* slope) {
+    double a;
+    if (!phi(omega, value, slope, &a)) {
+      *value = std::numeric_limits<double>::quiet_NaN();
+      *slope = 0.0;
+    }
+  };
+  fold.control = BracketedNewton(phi_for_newton, lo, hi, 0.5 * (lo + hi));
+  double value, slope;
+  fold.exists = std::isfinite(fold.control) && phi(fold.control, &value, &slope, &fold.a);
+  return fold;
+}
+
+// Lifts a frequency-sweep fold to scalar T.
+template <typename T>
+T LiftFrequencyFold(const T* p, double a_base, const FoldPoint& fold) {
+  const auto k = ResponseCoefficients<T>::FromParameters(p, fold.control);
+  const T a(fold.a);
+  return fold.control -
+         (k.G(a) - a_base * a_base) / DerivativeOfGInDriveFrequency(p, fold.control, k, a);
+}
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_RESIDUALS_MODEL_FOLD_POINT_H_

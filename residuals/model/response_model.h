@@ -1,0 +1,83 @@
+// The single-mode response model of the chapter, templated on the scalar so that
+// ceres::Jet values flow through (docs/model.md, "Fixed points").
+//
+// Fixed points (3.1)-(3.2), with u ~ a cos(Omega t - gamma):
+//   P(a) = k1 a + k2 a^2 = a_base sin(gamma)
+//   Q(a) = k3 a + k4 a^3 = a_base cos(gamma)
+// coefficients (3.3), Omega the drive frequency [rad/s]:
+//   k1 = Omega mu1 / eta_e
+//   k2 = 4 mu2 Omega / (3 pi eta_e)
+//   k3 = -(Omega^2 - w^2) / (2 eta_e)
+//   k4 = (3 alpha - 2 delta Omega^2) / (8 eta_e)
+// frequency-response function (3.11):
+//   G(a) = P(a)^2 + Q(a)^2,  and a fixed point satisfies G(a) = a_base^2.
+// Stability: a fixed point is stable iff dG/da > 0; folds (jumps) have dG/da = 0.
+#ifndef DWELLFIT_RESIDUALS_MODEL_RESPONSE_MODEL_H_
+#define DWELLFIT_RESIDUALS_MODEL_RESPONSE_MODEL_H_
+
+#include "dwellfit/residuals/model/model_parameters.h"
+
+namespace dwellfit {
+
+inline constexpr double kPi = 3.14159265358979323846264338327950;
+
+template <typename T>
+struct ResponseCoefficients {
+  T k1, k2, k3, k4;
+
+  // `p` is the parameter block (ParameterIndex layout); `omega_drive` in rad/s.
+  template <typename D>
+  static ResponseCoefficients FromParameters(const T* p, const D& omega_drive) {
+    ResponseCoefficients k;
+    const T& eta_e = p[kEtaE];
+    const T& w = p[kOmega];
+    k.k1 = omega_drive * p[kMu1] / eta_e;
+    k.k2 = (4.0 / (3.0 * kPi)) * p[kMu2] * omega_drive / eta_e;
+    k.k3 = -(omega_drive * omega_drive - w * w) / (2.0 * eta_e);
+    k.k4 = (3.0 * p[kAlpha] - 2.0 * p[kDelta] * omega_drive * omega_drive) / (8.0 * eta_e);
+    return k;
+  }
+
+  T P(const T& a) const { return (k1 + k2 * a) * a; }
+  T Q(const T& a) const { return (k3 + k4 * a * a) * a; }
+  T dP(const T& a) const { return k1 + 2.0 * k2 * a; }
+  T dQ(const T& a) const { return k3 + 3.0 * k4 * a * a; }
+
+  // G(a) of (3.11), evaluated as P^2 + Q^2 (better conditioned than the
+  // expanded sextic).
+  T G(const T& a) const {
+    const T p = P(a);
+    const T q = Q(a);
+    return p * p + q * q;
+  }
+  // dG/da = 2 (P P' + Q Q'); its sign is the stability of a fixed point.
+  T dG(const T& a) const { return 2.0 * (P(a) * dP(a) + Q(a) * dQ(a)); }
+  // d2G/da2 = 2 (P'^2 + P P'' + Q'^2 + Q Q'') with P'' = 2 k2, Q'' = 6 k4 a.
+  T d2G(const T& a) const {
+    const T dp = dP(a);
+    const T dq = dQ(a);
+    return 2.0 * (dp * dp + P(a) * (2.0 * k2) + dq * dq + Q(a) * (6.0 * k4 * a));
+  }
+
+  // h(a) = (dG/da) / a = 6 c6 a^4 + 4 c4 a^2 + 3 c3 a + 2 c2, written through
+  // P and Q for conditioning; its positive roots are the turning points of G.
+  T h(const T& a) const {
+    return 2.0 *
+           ((k1 + k2 * a) * (k1 + 2.0 * k2 * a) + (k3 + k4 * a * a) * (k3 + 3.0 * k4 * a * a));
+  }
+  T dh(const T& a) const {
+    return 2.0 *
+           (3.0 * k1 * k2 + 4.0 * k2 * k2 * a + 8.0 * k3 * k4 * a + 12.0 * k4 * k4 * a * a * a);
+  }
+  T d2h(const T& a) const { return 2.0 * (4.0 * k2 * k2 + 8.0 * k3 * k4 + 36.0 * k4 * k4 * a * a); }
+
+  // Coefficients of the sextic G = c6 a^6 + c4 a^4 + c3 a^3 + c2 a^2.
+  T c2() const { return k1 * k1 + k3 * k3; }
+  T c3() const { return 2.0 * k1 * k2; }
+  T c4() const { return k2 * k2 + 2.0 * k3 * k4; }
+  T c6() const { return k4 * k4; }
+};
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_RESIDUALS_MODEL_RESPONSE_MODEL_H_

@@ -1,0 +1,302 @@
+// The stable fixed point on a named branch, found in double precision, and its
+// lift to any scalar type by the implicit function theorem.
+//
+// Structure used (docs/model.md, "Stability and folds"): dG/da = a h(a) with the
+// quartic h(a) = 6 c6 a^4 + 4 c4 a^2 + 3 c3 a + 2 c2, c2, c3, c6 >= 0. By
+// Descartes' rule h has no positive root when c4 >= 0 and zero or two when
+// c4 < 0. So G has at most two turning points on a > 0: a local maximum at
+// a_lower_end (where the lower stable branch ends; the jump-up of an amplitude
+// sweep) and a local minimum at a_upper_end > a_lower_end (where the upper
+// branch ends). G is increasing on (0, a_lower_end) and on (a_upper_end, inf),
+// so each stable branch is a bracket on which G - a_base^2 is monotone, and the
+// safeguarded Newton iteration from the measured amplitude finds exactly the
+// root of that branch; the unstable middle root is never returned.
+#ifndef DWELLFIT_RESIDUALS_MODEL_STABLE_ROOT_H_
+#define DWELLFIT_RESIDUALS_MODEL_STABLE_ROOT_H_
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "dwellfit/residuals/model/bracketed_newton.h"
+#include "dwellfit/residuals/model/response_model.h"
+
+namespace dwellfit {
+
+// The stable branch a dwell point sits on. kLower is the smallest positive
+// root, kUpper the largest; kOnly marks a point measured where the response is
+// single-valued: if the model has two stable roots there, the one nearer the
+// measured amplitude is used.
+enum class Branch { kLower, kUpper, kOnly };
+
+inline const char* BranchName(Branch branch) {
+  switch (branch) {
+    case Branch::kLower:
+      return "lower";
+    case Branch::kUpper:
+      return "upper";
+    case Branch::kOnly:
+      return "only";
+  }
+  return "only";
+}
+
+inline bool BranchFromName(const std::string& name, Branch* branch) {
+  for (Branch b : {Branch::kLower, Branch::kUpper, Branch::kOnly}) {
+    if (name == BranchName(b)) {
+      *branch = b;
+      return true;
+    }
+  }
+  return false;
+}
+
+// Turning points of G(a) on a > 0 at one drive frequency.
+struct TurningPoints {
+  bool exist = false;
+  double a_lower_end = 0.0;  // local maximum of G: the lower branch ends here
+  double a_upper_end = 0.0;  // local minimum of G: the upper branch ends here
+};
+
+namespace internal {
+
+// Doubles `hi` until `positive(hi)` holds; returns NaN after too many tries.
+template <typename Predicate>
+double ExpandUntil(double hi, const Predicate& positive) {
+  for (int i = 0; i < 2100 && std::isfinite(hi); ++i) {
+    if (positive(hi)) return hi;
+    hi *= 2.0;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+}  // namespace internal
+
+inline TurningPoints FindTurningPoints(const ResponseCoefficients<double>& k) {
+  TurningPoints tp;
+  const double c4 = k.c4();
+  const double c6 = k.c6();
+  if (!(c6 > 0.0) || !(c4 < 0.0)) return tp;
+  auto h = [&k](double a, double* value, double* slope) {
+    *value = k.h(a);
+    *slope = k.dh(a);
+  };
+  // h' has its minimum on a >= 0 at a_inflection.
+  auto dh = [&k](double a, double* value, double* slope) {
+    *value = k.dh(a);
+    *slope = k.d2h(a);
+  };
+  const double a_inflection = std::sqrt(-c4 / (9.0 * c6));
+  double v, s;
+  dh(a_inflection, &v, &s);
+  if (v >= 0.0) return tp;  // h increasing from h(0) = 2 c2 >= 0: G monotone
+  const double dh_hi = internal::ExpandUntil(2.0 * a_inflection, [&](double a) {
+    dh(a, &v, &s);
+    return v > 0.0;
+  });
+  if (!std::isfinite(dh_hi)) return tp;
+  const double a_h_min = BracketedNewton(dh, a_inflection, dh_hi, dh_hi);
+  h(a_h_min, &v, &s);
+  if (!(v < 0.0)) return tp;  // h >= 0 everywhere: no fold at this frequency
+  const double h_hi = internal::ExpandUntil(2.0 * a_h_min, [&](double a) {
+    h(a, &v, &s);
+    return v > 0.0;
+  });
+  if (!std::isfinite(h_hi)) return tp;
+  tp.a_lower_end = BracketedNewton(h, 0.0, a_h_min, 0.5 * a_h_min);
+  tp.a_upper_end = BracketedNewton(h, a_h_min, h_hi, h_hi);
+  tp.exist = std::isfinite(tp.a_lower_end) && std::isfinite(tp.a_upper_end);
+  return tp;
+}
+
+enum class RootStatus {
+  kOnBranch,   // a solves G(a) = a_base^2 on the requested branch
+  kBranchEnd,  // the requested branch does not reach a_base here; a is the
+               // turning point where it ends (a continuous extension)
+  kFailed,     // no root could be bracketed (parameters not finite, eta_e = 0)
+};
+
+struct StableRoot {
+  double a = 0.0;
+  RootStatus status = RootStatus::kFailed;
+  Branch branch = Branch::kOnly;  // the branch actually used (kOnly: G monotone)
+};
+
+// The stable root of G(a) = a_base^2 on `branch`, started from `a_guess`
+// (normally the measured amplitude).
+inline StableRoot SolveStableRoot(const ResponseCoefficients<double>& k, double a_base,
+                                  Branch branch, double a_guess) {
+  StableRoot root;
+  const double target = a_base * a_base;
+  if (!(target > 0.0) || !std::isfinite(k.k1 + k.k2 + k.k3 + k.k4)) return root;
+  auto residual = [&k, target](double a, double* value, double* slope) {
+    *value = k.G(a) - target;
+    *slope = k.dG(a);
+  };
+  auto upper_bracket_end = [&](double start) {
+    return internal::ExpandUntil(start, [&](double a) { return k.G(a) > target; });
+  };
+  const double guess = a_guess > 0.0 ? a_guess : std::numeric_limits<double>::quiet_NaN();
+  const TurningPoints tp = FindTurningPoints(k);
+  if (!tp.exist) {
+    const double hi = upper_bracket_end(guess > 0.0 ? guess : std::sqrt(a_base));
+    if (!std::isfinite(hi)) return root;
+    root.a = BracketedNewton(residual, 0.0, hi, guess);
+    root.status = std::isfinite(root.a) ? RootStatus::kOnBranch : RootStatus::kFailed;
+    return root;
+  }
+  const bool lower_exists = k.G(tp.a_lower_end) > target;
+  const bool upper_exists = k.G(tp.a_upper_end) < target;
+  auto lower = [&]() {
+    StableRoot r;
+    r.branch = Branch::kLower;
+    if (lower_exists) {
+      r.a = BracketedNewton(residual, 0.0, tp.a_lower_end, guess);
+      r.status = RootStatus::kOnBranch;
+    } else {
+      r.a = tp.a_lower_end;
+      r.status = RootStatus::kBranchEnd;
+    }
+    return r;
+  };
+  auto upper = [&]() {
+    StableRoot r;
+    r.branch = Branch::kUpper;
+    if (upper_exists) {
+      const double hi = upper_bracket_end(std::max(2.0 * tp.a_upper_end, guess));
+      if (!std::isfinite(hi)) return r;
+      r.a = BracketedNewton(residual, tp.a_upper_end, hi, guess);
+      r.status = RootStatus::kOnBranch;
+    } else {
+      r.a = tp.a_upper_end;
+      r.status = RootStatus::kBranchEnd;
+    }
+    return r;
+  };
+  switch (branch) {
+    case Branch::kLower:
+      root = lower();
+      break;
+    case Branch::kUpper:
+      root = upper();
+      break;
+    case Branch::kOnly:
+      if (lower_exists && upper_exists) {
+        const StableRoot l = lower();
+        const StableRoot u = upper();
+        root = std::abs(l.a - a_guess) <= std::abs(u.a - a_guess) ? l : u;
+      } else {
+        root = lower_exists ? lower() : upper();
+      }
+      break;
+  }
+  if (!std::isfinite(root.a)) root.status = RootStatus::kFailed;
+  return root;
+}
+
+namespace internal {
+
+// Certificate that a root r > 0 of G = a_base^2 lies on `branch`, from the
+// quartic h = (dG/da)/a = 6 c6 a^4 + 4 c4 a^2 + 3 c3 a + 2 c2 (c2, c6 >= 0).
+// Where c3 >= 0 (mu1 mu2 >= 0), h >= 2 c2 + 3 c3 a_min + min q over an
+// interval starting at a_min, q(a) = 6 c6 a^4 + 4 c4 a^2, whose minimum on
+// a >= 0 is -(2/3) c4^2 / c6 at a^2 = -c4 / (3 c6) when c4 < 0:
+//   upper: h > 0 on [r, inf) (bound with a_min = r), so G rises past r: r
+//     is the largest root, and stable. Failing that, h(r) > 0, h'(r) >= 0
+//     and h''(r) >= 0 also suffice: h'' = 72 c6 a^2 + 8 c4 grows with a, so
+//     h' and then h grow on [r, inf).
+//   lower: h > 0 on (0, r] (bound with a_min = 0), so G rises on (0, r]: r
+//     is the smallest root, and stable.
+inline bool CertifiedOnBranch(const ResponseCoefficients<double>& k, double r, Branch branch) {
+  if (branch != Branch::kUpper && branch != Branch::kLower) return false;
+  const double c2 = k.c2();
+  const double c3 = k.c3();
+  const double c4 = k.c4();
+  const double c6 = k.c6();
+  auto q = [c4, c6](double a) { return (6.0 * c6 * a * a + 4.0 * c4) * a * a; };
+  // a^2 where q has its minimum on a >= 0 (0 when q only grows).
+  const double a2_min = c4 < 0.0 && c6 > 0.0 ? -c4 / (3.0 * c6) : 0.0;
+  // (c6 = k4^2 = 0 makes c4 = k2^2 >= 0: q never falls without bound.)
+  if (branch == Branch::kUpper) {
+    if (c3 >= 0.0 && (c6 > 0.0 || c4 >= 0.0)) {
+      const double q_min = r * r >= a2_min ? q(r) : q(std::sqrt(a2_min));
+      if (2.0 * c2 + 3.0 * c3 * r + q_min > 0.0) return true;
+    }
+    return k.h(r) > 0.0 && k.dh(r) >= 0.0 && k.d2h(r) >= 0.0;
+  }
+  if (!(c3 >= 0.0) || !(c6 > 0.0 || c4 >= 0.0)) return false;
+  const double q_min = r * r <= a2_min ? q(r) : q(std::sqrt(a2_min));
+  return 2.0 * c2 + q_min > 0.0;
+}
+
+}  // namespace internal
+
+// The same root as SolveStableRoot, faster where the measured amplitude is
+// near its branch: plain Newton from `a_guess`, accepted only with a
+// certificate that the root lies on `branch` (internal::CertifiedOnBranch);
+// anything else falls back to SolveStableRoot. The returned `branch` is the
+// requested one even where G is monotone.
+inline StableRoot SolveStableRootNear(const ResponseCoefficients<double>& k, double a_base,
+                                      Branch branch, double a_guess) {
+  if (branch != Branch::kOnly && a_guess > 0.0) {
+    const double target = a_base * a_base;
+    double a = a_guess;
+    for (int i = 0; i < 30; ++i) {
+      const double slope = k.dG(a);
+      if (!(slope > 0.0)) break;
+      const double step = (k.G(a) - target) / slope;
+      a -= step;
+      if (!(a > 0.0) || !std::isfinite(a)) break;
+      if (std::abs(step) <= 4.0 * std::numeric_limits<double>::epsilon() * a) {
+        if (internal::CertifiedOnBranch(k, a, branch)) {
+          StableRoot root;
+          root.a = a;
+          root.status = RootStatus::kOnBranch;
+          root.branch = branch;
+          return root;
+        }
+        break;
+      }
+    }
+  }
+  return SolveStableRoot(k, a_base, branch, a_guess);
+}
+
+// Lifts a root found in double to scalar T (double or ceres::Jet) by one Newton
+// step in T arithmetic from the converged root: the value gains one more
+// Newton step, and the derivative part is exactly -F_p / F_a, the implicit
+// function theorem for F(a; p) = 0. On a branch, F = G - a_base^2; at a branch
+// end, F = dG/da (the turning point moves with the parameters).
+template <typename T>
+T LiftRoot(const ResponseCoefficients<T>& k, double a_base, const StableRoot& root) {
+  const T a0(root.a);
+  if (root.status == RootStatus::kBranchEnd) return a0 - k.dG(a0) / k.d2G(a0);
+  return a0 - (k.G(a0) - a_base * a_base) / k.dG(a0);
+}
+
+inline double ScalarPart(double x) { return x; }
+template <typename J>
+auto ScalarPart(const J& x) -> decltype(x.a) {
+  return x.a;
+}
+
+inline ResponseCoefficients<double> ScalarCoefficients(const ResponseCoefficients<double>& k) {
+  return k;
+}
+template <typename T>
+ResponseCoefficients<double> ScalarCoefficients(const ResponseCoefficients<T>& k) {
+  return {ScalarPart(k.k1), ScalarPart(k.k2), ScalarPart(k.k3), ScalarPart(k.k4)};
+}
+
+// The model's amplitude at one dwell (double precision convenience).
+inline StableRoot ModelAmplitude(const ParameterVector& p, double omega_drive_rad_s, double a_base,
+                                 Branch branch, double a_guess) {
+  const auto k = ResponseCoefficients<double>::FromParameters(p.data(), omega_drive_rad_s);
+  StableRoot root = SolveStableRoot(k, a_base, branch, a_guess);
+  if (root.status != RootStatus::kFailed) root.a = LiftRoot(k, a_base, root);
+  return root;
+}
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_RESIDUALS_MODEL_STABLE_ROOT_H_

@@ -1,0 +1,47 @@
+#include "dwellfit/config/strict_yaml.h"
+
+#include <string>
+
+#include "dwellfit/config/config_source.h"
+#include "dwellfit/estimator/common/input_error.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+
+namespace dwellfit {
+namespace {
+
+using ::testing::HasSubstr;
+
+// StrictMap keeps each key's position after the iteration that read it. The
+// key node must be held by value: yaml-cpp's iterators hand out their
+// (key, value) pair as a temporary, and a reference into it dangles
+// (stack-use-after-scope under AddressSanitizer).
+TEST(StrictMap, KeepsEveryKeyAndItsLineAfterReading) {
+  const ConfigSource source =
+      ConfigSource::Parse("block.yaml", "first: 1\nsecond: two\nthird:\n  nested: 3\n");
+  const StrictMap map(DocumentValue(source), source, {"first", "second", "third"});
+  const auto first = map.Optional("first");
+  const auto second = map.Optional("second");
+  const auto third = map.Optional("third");
+  ASSERT_TRUE(first && second && third);
+  EXPECT_EQ(first->mark.line, 0);
+  EXPECT_EQ(second->mark.line, 1);
+  EXPECT_EQ(third->mark.line, 2);
+  EXPECT_EQ(ReadInt(*first, source), 1);
+  EXPECT_EQ(ReadNonEmptyString(*second, source), "two");
+  EXPECT_EQ(third->path, "third");
+}
+
+TEST(StrictMap, AnUnknownKeyIsNamedWithItsLine) {
+  const ConfigSource source = ConfigSource::Parse("block.yaml", "first: 1\nsecnd: 2\n");
+  try {
+    StrictMap map(DocumentValue(source), source, {"first", "second"});
+    FAIL() << "an unknown key was accepted";
+  } catch (const InputError& error) {
+    EXPECT_THAT(error.what(), HasSubstr("block.yaml:2: field 'secnd'"));
+    EXPECT_THAT(error.what(), HasSubstr("did you mean 'second'"));
+  }
+}
+
+}  // namespace
+}  // namespace dwellfit

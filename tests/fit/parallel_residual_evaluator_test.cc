@@ -1,0 +1,370 @@
+#include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <thread>
+#include <vector>
+
+#include "ceres/autodiff_cost_function.h"
+#include "ceres/problem.h"
+#include "ceres/sized_cost_function.h"
+#include "ceres/solver.h"
+#include "gtest/gtest.h"
+
+namespace dwellfit {
+namespace {
+
+using Parameters = std::array<double, 3>;
+
+const Parameters kTruth = {2.0, 0.3, 1.5};  // y = a exp(-b t) cos(c t)
+const Parameters kStart = {0.5, 1.0, 1.3};  // far enough for rejected steps
+constexpr int kNumSamples = 2400;           // enough blocks for three threads
+
+struct Sample {
+  double t = 0.0;
+  double y = 0.0;
+};
+
+// y = a exp(-b t) cos(c t) at kTruth plus a fixed pseudo-noise.
+std::vector<Sample> SyntheticData(int n) {
+  std::vector<Sample> data(n);
+  for (int i = 0; i < n; ++i) {
+    data[i].t = 10.0 * i / n;
+    data[i].y = kTruth[0] * std::exp(-kTruth[1] * data[i].t) * std::cos(kTruth[2] * data[i].t) +
+                0.01 * std::sin(12.9898 * i + 0.5);
+  }
+  return data;
+}
+
+struct DecayingCosine {
+  explicit DecayingCosine(const Sample& sample) : t(sample.t), y(sample.y) {}
+  template <typename T>
+  bool operator()(const T* const p, T* residual) const {
+    using std::cos;
+    using std::exp;
+    residual[0] = p[0] * exp(-p[1] * t) * cos(p[2] * t) - y;
+    return true;
+  }
+  double t;
+  double y;
+};
+
+ceres::CostFunction* NewDecayingCosine(const Sample& sample) {
+  return new ceres::AutoDiffCostFunction<DecayingCosine, 1, 3>(new DecayingCosine(sample));
+}
+
+ceres::Solver::Options FitOptions() {
+  ceres::Solver::Options options;
+  options.minimizer_type = ceres::TRUST_REGION;
+  options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  options.linear_solver_type = ceres::DENSE_QR;
+  options.num_threads = 1;
+  options.max_num_iterations = 100;
+  options.function_tolerance = 1e-12;
+  options.gradient_tolerance = 1e-12;
+  options.parameter_tolerance = 1e-12;
+  options.logging_type = ceres::SILENT;
+  return options;
+}
+
+struct Fit {
+  Parameters parameters{};
+  ceres::Solver::Summary summary;
+  std::int64_t replayed = 0;
+  std::int64_t evaluated_directly = 0;
+};
+
+// Fits the data from kStart with every block wrapped by an evaluator on
+// `num_threads` threads.
+Fit FitWithEvaluator(const std::vector<Sample>& data, int num_threads) {
+  Fit fit;
+  fit.parameters = kStart;
+  ParallelResidualEvaluator evaluator(fit.parameters.data(), 3, num_threads);
+  ceres::Problem::Options problem_options;
+  problem_options.evaluation_callback = &evaluator;
+  ceres::Problem problem(problem_options);
+  for (const Sample& sample : data) {
+    problem.AddResidualBlock(evaluator.Wrap(NewDecayingCosine(sample)), nullptr,
+                             fit.parameters.data());
+  }
+  ceres::Solve(FitOptions(), &problem, &fit.summary);
+  fit.replayed = evaluator.replayed();
+  fit.evaluated_directly = evaluator.evaluated_directly();
+  return fit;
+}
+
+// The same fit with Ceres calling the cost functions itself.
+Fit FitWithoutEvaluator(const std::vector<Sample>& data) {
+  Fit fit;
+  fit.parameters = kStart;
+  ceres::Problem problem;
+  for (const Sample& sample : data) {
+    problem.AddResidualBlock(NewDecayingCosine(sample), nullptr, fit.parameters.data());
+  }
+  ceres::Solve(FitOptions(), &problem, &fit.summary);
+  return fit;
+}
+
+// Records the threads it is evaluated on, and otherwise is DecayingCosine.
+class ThreadRecordingCost : public ceres::SizedCostFunction<1, 3> {
+ public:
+  ThreadRecordingCost(const Sample& sample, std::mutex* mutex, std::set<std::thread::id>* threads)
+      : cost_(NewDecayingCosine(sample)), mutex_(mutex), threads_(threads) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    {
+      std::lock_guard<std::mutex> lock(*mutex_);
+      threads_->insert(std::this_thread::get_id());
+    }
+    return cost_->Evaluate(parameters, residuals, jacobians);
+  }
+
+ private:
+  const std::unique_ptr<ceres::CostFunction> cost_;
+  std::mutex* const mutex_;
+  std::set<std::thread::id>* const threads_;
+};
+
+// The distinct threads that evaluate `blocks` wrapped blocks in one
+// CostGradient with `num_threads` threads.
+int ThreadsUsed(int blocks, int num_threads) {
+  const std::vector<Sample> data = SyntheticData(blocks);
+  std::mutex mutex;
+  std::set<std::thread::id> threads;
+  Parameters parameters = kStart;
+  ParallelResidualEvaluator evaluator(parameters.data(), 3, num_threads);
+  std::vector<std::unique_ptr<ceres::CostFunction>> wrappers;
+  for (const Sample& sample : data) {
+    wrappers.emplace_back(evaluator.Wrap(new ThreadRecordingCost(sample, &mutex, &threads)));
+  }
+  std::vector<double> gradient;
+  EXPECT_TRUE(evaluator.CostGradient(parameters.data(), &gradient));
+  return static_cast<int>(threads.size());
+}
+
+// r = sqrt(x - shift), which fails to evaluate for x < shift.
+class SqrtCost : public ceres::SizedCostFunction<1, 1> {
+ public:
+  explicit SqrtCost(double shift) : shift_(shift) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double d = parameters[0][0] - shift_;
+    if (d < 0.0) return false;
+    residuals[0] = std::sqrt(d);
+    if (jacobians != nullptr && jacobians[0] != nullptr) jacobians[0][0] = 0.5 / std::sqrt(d);
+    return true;
+  }
+
+ private:
+  const double shift_;
+};
+
+// The threads the other tests rely on are really used: one per chunk of at
+// least 256 blocks, up to the number asked for.
+TEST(ParallelResidualEvaluator, PrecomputesOnTheRequestedThreads) {
+  EXPECT_EQ(ThreadsUsed(kNumSamples, 1), 1);
+  EXPECT_EQ(ThreadsUsed(kNumSamples, 3), 3);
+  EXPECT_EQ(ThreadsUsed(600, 3), 2);
+  EXPECT_EQ(ThreadsUsed(300, 3), 1);
+}
+
+// The solve does not depend on the number of threads: the final parameters
+// and cost are bitwise the same on 1, 2 and 3 threads, and agree with a solve
+// in which Ceres evaluates the cost functions itself.
+TEST(ParallelResidualEvaluator, SolveIsBitwiseIndependentOfThreadCount) {
+  const std::vector<Sample> data = SyntheticData(kNumSamples);
+  const Fit one = FitWithEvaluator(data, 1);
+  ASSERT_EQ(one.summary.termination_type, ceres::CONVERGENCE) << one.summary.FullReport();
+  ASSERT_GT(one.summary.num_successful_steps, 2);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(one.parameters[i], kTruth[i], 1e-2) << i;
+
+  for (int threads : {2, 3}) {
+    const Fit many = FitWithEvaluator(data, threads);
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(many.parameters[i], one.parameters[i]) << threads;
+    EXPECT_EQ(many.summary.final_cost, one.summary.final_cost) << threads;
+    EXPECT_EQ(many.summary.iterations.size(), one.summary.iterations.size()) << threads;
+  }
+
+  const Fit plain = FitWithoutEvaluator(data);
+  ASSERT_EQ(plain.summary.termination_type, ceres::CONVERGENCE);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(one.parameters[i], plain.parameters[i], 1e-9 * std::abs(plain.parameters[i])) << i;
+  }
+  EXPECT_NEAR(one.summary.final_cost, plain.summary.final_cost, 1e-9 * plain.summary.final_cost);
+}
+
+// During a solve every wrapper call Ceres makes is answered from the values
+// the callback precomputed: one call per block per Ceres evaluation (residual
+// or Jacobian), none of them evaluated directly, rejected steps included.
+TEST(ParallelResidualEvaluator, SolveReplaysEveryEvaluation) {
+  const std::vector<Sample> data = SyntheticData(kNumSamples);
+  for (int threads : {1, 3}) {
+    const Fit fit = FitWithEvaluator(data, threads);
+    ASSERT_EQ(fit.summary.termination_type, ceres::CONVERGENCE);
+    // Rejected steps too: Ceres goes back to a point it evaluated before.
+    ASSERT_GT(fit.summary.num_unsuccessful_steps, 0);
+    EXPECT_GT(fit.replayed, 0) << threads;
+    EXPECT_EQ(fit.evaluated_directly, 0) << threads;
+    const std::int64_t evaluations =
+        fit.summary.num_residual_evaluations + fit.summary.num_jacobian_evaluations;
+    EXPECT_EQ(fit.replayed + fit.evaluated_directly, evaluations * kNumSamples) << threads;
+  }
+}
+
+// CostGradient is J^T r at the point it is given (not the block's current
+// values), as Ceres computes it for a problem without the evaluator.
+TEST(ParallelResidualEvaluator, CostGradientMatchesCeresGradient) {
+  const std::vector<Sample> data = SyntheticData(kNumSamples);
+  const Parameters point = {1.7, 0.45, 1.4};
+
+  Parameters at_point = point;
+  ceres::Problem plain;
+  for (const Sample& sample : data) {
+    plain.AddResidualBlock(NewDecayingCosine(sample), nullptr, at_point.data());
+  }
+  double cost = 0.0;
+  std::vector<double> expected;
+  ASSERT_TRUE(
+      plain.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, &expected, nullptr));
+  ASSERT_EQ(expected.size(), 3u);
+  const double scale = std::hypot(expected[0], expected[1], expected[2]);
+  ASSERT_GT(scale, 1.0);  // far enough from the minimum to mean something
+
+  for (int threads : {1, 3}) {
+    Parameters block = kStart;  // deliberately not `point`
+    ParallelResidualEvaluator evaluator(block.data(), 3, threads);
+    std::vector<std::unique_ptr<ceres::CostFunction>> wrappers;
+    for (const Sample& sample : data)
+      wrappers.emplace_back(evaluator.Wrap(NewDecayingCosine(sample)));
+    std::vector<double> gradient;
+    ASSERT_TRUE(evaluator.CostGradient(point.data(), &gradient));
+    ASSERT_EQ(gradient.size(), 3u);
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_NEAR(gradient[i], expected[i], 1e-12 * std::abs(expected[i])) << threads << " " << i;
+    }
+    EXPECT_EQ(block, kStart);  // the block itself is left alone
+  }
+}
+
+// A wrapper asked about a point the callback has not seen evaluates the
+// wrapped function there (counted as direct); at the point it has seen it
+// replays the same values (counted as replayed).
+TEST(ParallelResidualEvaluator, UnseenPointIsEvaluatedDirectly) {
+  const Sample sample = SyntheticData(kNumSamples)[777];
+  const std::unique_ptr<ceres::CostFunction> reference(NewDecayingCosine(sample));
+  auto evaluate = [](const ceres::CostFunction& cost, const Parameters& p, double* residual,
+                     Parameters* jacobian) {
+    const double* blocks[] = {p.data()};
+    double* jacobians[] = {jacobian->data()};
+    return cost.Evaluate(blocks, residual, jacobians);
+  };
+
+  Parameters block = kStart;
+  ParallelResidualEvaluator evaluator(block.data(), 3, 1);
+  const std::unique_ptr<ceres::CostFunction> wrapper(evaluator.Wrap(NewDecayingCosine(sample)));
+  EXPECT_EQ(wrapper->num_residuals(), 1);
+  EXPECT_EQ(wrapper->parameter_block_sizes(), std::vector<int32_t>{3});
+
+  const Parameters unseen = {1.9, 0.25, 1.55};
+  double expected_residual = 0.0;
+  Parameters expected_jacobian{};
+  ASSERT_TRUE(evaluate(*reference, unseen, &expected_residual, &expected_jacobian));
+
+  // Before the callback has run at all.
+  double residual = 0.0;
+  Parameters jacobian{};
+  ASSERT_TRUE(evaluate(*wrapper, unseen, &residual, &jacobian));
+  EXPECT_EQ(residual, expected_residual);
+  EXPECT_EQ(jacobian, expected_jacobian);
+  EXPECT_EQ(evaluator.evaluated_directly(), 1);
+  EXPECT_EQ(evaluator.replayed(), 0);
+
+  // After it has precomputed the values at kStart.
+  evaluator.PrepareForEvaluation(true, true);
+  residual = 0.0;
+  jacobian = {};
+  ASSERT_TRUE(evaluate(*wrapper, unseen, &residual, &jacobian));
+  EXPECT_EQ(residual, expected_residual);
+  EXPECT_EQ(jacobian, expected_jacobian);
+  EXPECT_EQ(evaluator.evaluated_directly(), 2);
+  EXPECT_EQ(evaluator.replayed(), 0);
+
+  // At kStart itself: replayed, and the same values as the reference there.
+  ASSERT_TRUE(evaluate(*reference, kStart, &expected_residual, &expected_jacobian));
+  ASSERT_NE(expected_residual, residual);  // the two points differ
+  ASSERT_TRUE(evaluate(*wrapper, kStart, &residual, &jacobian));
+  EXPECT_EQ(residual, expected_residual);
+  EXPECT_EQ(jacobian, expected_jacobian);
+  const double* blocks[] = {kStart.data()};
+  residual = 0.0;
+  ASSERT_TRUE(wrapper->Evaluate(blocks, &residual, nullptr));  // residual only
+  EXPECT_EQ(residual, expected_residual);
+  EXPECT_EQ(evaluator.evaluated_directly(), 2);
+  EXPECT_EQ(evaluator.replayed(), 2);
+}
+
+// A wrapped function that fails makes its replaying wrapper fail at that
+// point, CostGradient fail, and a Ceres evaluation of the problem fail; the
+// other blocks and other points are unaffected.
+TEST(ParallelResidualEvaluator, FailureOfAWrappedFunctionIsReplayed) {
+  constexpr int kBlocks = 1000;
+  constexpr int kFailing = 700;  // in the third thread's chunk
+  double x = 2.0;
+  ParallelResidualEvaluator evaluator(&x, 1, 3);
+  ceres::Problem::Options problem_options;
+  problem_options.evaluation_callback = &evaluator;
+  ceres::Problem problem(problem_options);
+  std::vector<ceres::CostFunction*> wrappers;  // owned by the problem
+  for (int i = 0; i < kBlocks; ++i) {
+    wrappers.push_back(evaluator.Wrap(new SqrtCost(i == kFailing ? 1.0 : 0.0)));
+    problem.AddResidualBlock(wrappers.back(), nullptr, &x);
+  }
+
+  // x = 2: every block evaluates; each adds (1/2)/sqrt(d) * sqrt(d) = 1/2.
+  std::vector<double> gradient;
+  ASSERT_TRUE(evaluator.CostGradient(&x, &gradient));
+  ASSERT_EQ(gradient.size(), 1u);
+  EXPECT_NEAR(gradient[0], 0.5 * kBlocks, 1e-9);
+
+  // x = 0.5: block kFailing fails.
+  const double half = 0.5;
+  EXPECT_FALSE(evaluator.CostGradient(&half, &gradient));
+  const double* blocks[] = {&half};
+  double residual = 0.0;
+  double jacobian = 0.0;
+  double* jacobians[] = {&jacobian};
+  const std::int64_t replayed = evaluator.replayed();
+  EXPECT_FALSE(wrappers[kFailing]->Evaluate(blocks, &residual, jacobians));
+  EXPECT_FALSE(wrappers[kFailing]->Evaluate(blocks, &residual, nullptr));
+  EXPECT_TRUE(wrappers[0]->Evaluate(blocks, &residual, jacobians));
+  EXPECT_EQ(residual, std::sqrt(0.5));
+  EXPECT_EQ(evaluator.replayed(), replayed + 3);
+  EXPECT_EQ(evaluator.evaluated_directly(), 0);
+
+  // Through Ceres, with the evaluator as the problem's callback.
+  double cost = 0.0;
+  x = 0.5;
+  EXPECT_FALSE(
+      problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr));
+  x = 2.0;
+  ASSERT_TRUE(
+      problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr));
+  EXPECT_NEAR(cost, 0.5 * (2.0 * (kBlocks - 1) + 1.0), 1e-9);
+  EXPECT_EQ(evaluator.evaluated_directly(), 0);
+}
+
+// A positive thread count is itself; 0 is one per processor available, at least 1.
+TEST(ParallelResidualEvaluator, ResolveThreadCount) {
+  EXPECT_EQ(ResolveThreadCount(3), 3);
+  EXPECT_EQ(ResolveThreadCount(1), 1);
+  EXPECT_GE(ResolveThreadCount(0), 1);
+}
+
+}  // namespace
+}  // namespace dwellfit

@@ -1,0 +1,146 @@
+#include "dwellfit/estimator/fit/problem_builder.h"
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "ceres/manifold_test_utils.h"
+#include "ceres/solver.h"
+#include "dwellfit/estimator/fit/identification.h"
+#include "dwellfit/estimator/fit/scaled_subset_manifold.h"
+#include "gtest/gtest.h"
+
+namespace dwellfit {
+namespace {
+
+const ParameterVector kTruth = {100.0, 0.2, 300.0, 1e4, 9e8, HzToRadPerSecond(40.0)};
+
+// A noise-free amplitude sweep at 41.5 Hz on its lower branch (below the
+// jump-up level) and a frequency sweep far below resonance.
+std::vector<Sweep> TwoSweeps() {
+  Sweep amplitude;
+  amplitude.id = "A";
+  amplitude.kind = SweepKind::kAmplitude;
+  for (double a_base = 0.002; a_base < 0.03; a_base += 0.002) {
+    DwellPoint point;
+    point.drive_frequency_rad_s = HzToRadPerSecond(41.5);
+    point.a_base = a_base;
+    point.branch = Branch::kLower;
+    point.amplitude =
+        ModelAmplitude(kTruth, point.drive_frequency_rad_s, a_base, Branch::kLower, 1e-4).a;
+    amplitude.points.push_back(point);
+  }
+  Sweep frequency;
+  frequency.id = "F";
+  for (double hz = 36.0; hz < 40.5; hz += 0.5) {
+    DwellPoint point;
+    point.drive_frequency_rad_s = HzToRadPerSecond(hz);
+    point.a_base = 0.01;
+    point.amplitude =
+        ModelAmplitude(kTruth, point.drive_frequency_rad_s, 0.01, Branch::kOnly, 1e-3).a;
+    frequency.points.push_back(point);
+  }
+  return {amplitude, frequency};
+}
+
+TEST(ScaledSubsetManifold, SatisfiesCeresManifoldInvariants) {
+  const ScaledSubsetManifold manifold(kTruth, {false, false, false, true, false, true});
+  EXPECT_EQ(manifold.TangentSize(), 4);
+  const Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(kTruth.data(), kNumParameters);
+  Eigen::VectorXd y = x;
+  y[kEtaE] *= 1.1;
+  y[kAlpha] *= 0.9;
+  using namespace ceres;  // NOLINT: the macro names ceres' matchers unqualified
+  EXPECT_THAT_MANIFOLD_INVARIANTS_HOLD(manifold, x, Eigen::Vector4d(0.1, -0.2, 0.05, 0.3), y,
+                                       1e-10);
+}
+
+TEST(ScaledSubsetManifold, StepsAreRelativeAndFixedEntriesNeverMove) {
+  const ScaledSubsetManifold manifold(kTruth, {false, false, false, true, false, true});
+  const double delta[] = {0.01, 0.0, 0.0, 0.0};  // +1 % of eta_e
+  ParameterVector moved;
+  ASSERT_TRUE(manifold.Plus(kTruth.data(), delta, moved.data()));
+  EXPECT_DOUBLE_EQ(moved[kEtaE], 101.0);
+  EXPECT_EQ(moved[kDelta], kTruth[kDelta]);
+  EXPECT_EQ(moved[kOmega], kTruth[kOmega]);
+}
+
+TEST(ProblemBuilder, EmbedsInACallerOwnedProblemAndBlock) {
+  const std::vector<Sweep> sweeps = TwoSweeps();
+  ProblemBuilderOptions options;
+  options.fixed[kOmega] = true;
+  options.fixed[kDelta] = true;
+  const ProblemBuilder builder(options);
+  ceres::Problem problem;  // the caller's, which may hold other blocks too
+  double other_block[1] = {3.0};
+  problem.AddParameterBlock(other_block, 1);
+  ParameterVector p = kTruth;
+  p[kEtaE] = 102.0;
+  p[kMu1] = 0.19;
+  p[kMu2] = 310.0;
+  p[kAlpha] = 9.2e8;
+  int blocks = 0;
+  for (const Sweep& sweep : sweeps) blocks += builder.AddSweep(sweep, p.data(), &problem);
+  builder.ConfigureParameters(p.data(), &problem);
+  EXPECT_EQ(blocks, static_cast<int>(sweeps[0].points.size() + sweeps[1].points.size()));
+  EXPECT_EQ(problem.NumResidualBlocks(), blocks);
+  EXPECT_EQ(problem.ParameterBlockTangentSize(p.data()), 4);
+  EXPECT_EQ(problem.GetParameterLowerBound(p.data(), kMu1), 0.0);
+  EXPECT_EQ(problem.GetParameterLowerBound(p.data(), kDelta), -std::numeric_limits<double>::max());
+
+  ceres::Solver::Summary summary;
+  EXPECT_TRUE(SolveProblem(SolverSettings{}, &problem, &summary));
+  EXPECT_LT(summary.final_cost, 1e-12 * summary.initial_cost);
+  EXPECT_EQ(p[kDelta], kTruth[kDelta]);  // fixed
+  EXPECT_EQ(p[kOmega], kTruth[kOmega]);  // fixed
+  EXPECT_NEAR(p[kEtaE] / kTruth[kEtaE], 1.0, 1e-6);
+  EXPECT_NEAR(p[kAlpha] / kTruth[kAlpha], 1.0, 1e-6);
+  EXPECT_EQ(other_block[0], 3.0);
+}
+
+TEST(ProblemBuilder, AllFixedHoldsTheBlockConstant) {
+  ProblemBuilderOptions options;
+  options.fixed.fill(true);
+  const ProblemBuilder builder(options);
+  ceres::Problem problem;
+  ParameterVector p = kTruth;
+  builder.AddSweep(TwoSweeps()[0], p.data(), &problem);
+  builder.ConfigureParameters(p.data(), &problem);
+  EXPECT_TRUE(problem.IsParameterBlockConstant(p.data()));
+}
+
+TEST(ProblemBuilder, PointSigmaWeightsTheVerticalResidual) {
+  Sweep sweep = TwoSweeps()[1];
+  sweep.points.resize(1);
+  sweep.points[0].amplitude *= 1.02;
+  sweep.points[0].sigma = 1e-5;
+  const ProblemBuilder builder(ProblemBuilderOptions{});
+  std::unique_ptr<ceres::CostFunction> weighted(builder.MakeResidual(sweep.points[0]));
+  sweep.points[0].sigma.reset();
+  std::unique_ptr<ceres::CostFunction> plain(builder.MakeResidual(sweep.points[0]));
+  const double* blocks[] = {kTruth.data()};
+  double r_weighted, r_plain;
+  ASSERT_TRUE(weighted->Evaluate(blocks, &r_weighted, nullptr));
+  ASSERT_TRUE(plain->Evaluate(blocks, &r_plain, nullptr));
+  EXPECT_NEAR(r_weighted, r_plain / 1e-5, 1e-9 * std::abs(r_weighted));
+}
+
+TEST(ReflectDampingIntoPhysicalRange, MapsTheAlgebraicTwinToThePhysicalOne) {
+  ParameterVector twin = kTruth;
+  twin[kEtaE] = -100.0;
+  twin[kMu1] = -0.2;
+  twin[kMu2] = -300.0;
+  EXPECT_TRUE(ReflectDampingIntoPhysicalRange(&twin));
+  EXPECT_EQ(twin, kTruth);
+  ParameterVector physical = kTruth;
+  EXPECT_FALSE(ReflectDampingIntoPhysicalRange(&physical));
+  ParameterVector mixed = kTruth;
+  mixed[kMu2] = -5.0;
+  EXPECT_TRUE(ReflectDampingIntoPhysicalRange(&mixed));
+  EXPECT_EQ(mixed[kMu1], 0.2);
+  EXPECT_EQ(mixed[kMu2], 0.0);
+}
+
+}  // namespace
+}  // namespace dwellfit

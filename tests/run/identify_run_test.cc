@@ -1,0 +1,125 @@
+#include "dwellfit/estimator/run/identify_run.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "dwellfit/config/identify_config.h"
+#include "dwellfit/estimator/common/input_error.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "yaml-cpp/yaml.h"
+
+namespace dwellfit {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+const std::string kConfig =
+    std::string(DWELLFIT_SOURCE_DIR) + "/datasets/thesis-numerical/beam.yaml";
+
+std::string FreshDir(const std::string& name) {
+  const fs::path dir = fs::path(::testing::TempDir()) / ("identify_run_" + name);
+  fs::remove_all(dir);
+  return dir.string();
+}
+
+std::string ReadFile(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+TEST(RunIdentify, WritesResultYamlAndPredictionsForTheThesisCase) {
+  const std::string out_dir = FreshDir("thesis");
+  const IdentifyConfig config = LoadIdentifyConfig(kConfig, {{"output_dir", out_dir, "--test"}});
+  std::ostringstream printed;
+  RunIdentify(config, printed);
+
+  EXPECT_THAT(printed.str(), HasSubstr("# config in effect"));
+  EXPECT_THAT(printed.str(), HasSubstr("Ceres Solver Report"));
+  EXPECT_THAT(printed.str(), HasSubstr("F0.01/up: jump_down between 42.20 and 42.30 Hz"));
+
+  const YAML::Node result = YAML::LoadFile(out_dir + "/result.yaml");
+  EXPECT_NEAR(result["parameters"]["eta_e"]["value"].as<double>(), 100.0, 1e-4);
+  EXPECT_NEAR(result["parameters"]["mu1"]["value"].as<double>(), 0.2, 1e-7);
+  EXPECT_NEAR(result["parameters"]["mu2"]["value"].as<double>(), 300.0, 1e-3);
+  EXPECT_NEAR(result["parameters"]["delta"]["value"].as<double>(), 1e4, 1e-2);
+  EXPECT_NEAR(result["parameters"]["alpha"]["value"].as<double>(), 9e8, 1e3);
+  EXPECT_DOUBLE_EQ(result["parameters"]["omega"]["value"].as<double>(),
+                   HzToRadPerSecond(40.0));  // fixed, rad/s
+  const double omega_ref = result["effective_nonlinearity"]["omega_ref_rad_s"].as<double>();
+  EXPECT_NEAR(omega_ref, HzToRadPerSecond(41.5), 1e-9);
+  EXPECT_NEAR(result["effective_nonlinearity"]["value"].as<double>(),
+              9e8 - (2.0 / 3.0) * 1e4 * omega_ref * omega_ref, 1e3);
+  EXPECT_TRUE(result["converged"].as<bool>());
+  EXPECT_GT(result["iterations"].as<int>(), 0);
+  EXPECT_LT(result["final_cost"].as<double>(), 1e-20);
+  ASSERT_EQ(result["sweeps"].size(), 8u);
+  int validation = 0;
+  for (const YAML::Node& sweep : result["sweeps"]) {
+    EXPECT_LT(sweep["relative_rms_error"].as<double>(), 1e-6);
+    validation += sweep["role"].as<std::string>() == "validation";
+  }
+  EXPECT_EQ(validation, 4);
+
+  const std::string csv = ReadFile(fs::path(out_dir) / "predictions.csv");
+  EXPECT_THAT(csv, HasSubstr("sweep,direction,role,freq_hz,a_base,a,a_model,branch,model_status"));
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 2 * 81 + 6 * 49);
+
+  const YAML::Node manifest = YAML::LoadFile(out_dir + "/manifest.yaml");
+  ASSERT_EQ(manifest["files"].size(), 2u);
+  EXPECT_EQ(manifest["files"][1]["bytes"].as<std::size_t>(), csv.size());
+}
+
+TEST(RunIdentify, SameInputGivesTheSameFiles) {
+  std::string first[2];
+  for (int run = 0; run < 2; ++run) {
+    const std::string out_dir = FreshDir("repeat" + std::to_string(run));
+    std::ostringstream printed;
+    RunIdentify(LoadIdentifyConfig(kConfig, {{"output_dir", out_dir, "--test"}}), printed);
+    first[run] = ReadFile(fs::path(out_dir) / "result.yaml") +
+                 ReadFile(fs::path(out_dir) / "predictions.csv");
+  }
+  EXPECT_EQ(first[0], first[1]);
+}
+
+TEST(RunIdentify, AnUnknownSweepFailsBeforeAnythingIsWritten) {
+  const std::string out_dir = FreshDir("unknown_sweep");
+  const IdentifyConfig config =
+      LoadIdentifyConfig(kConfig, {{"output_dir", out_dir, "--test"}, {"fit", "[F9]", "--fit"}});
+  std::ostringstream printed;
+  try {
+    RunIdentify(config, printed);
+    FAIL() << "expected InputError";
+  } catch (const InputError& error) {
+    EXPECT_THAT(error.what(), HasSubstr("beam.yaml"));
+    EXPECT_THAT(error.what(), HasSubstr("'fit'"));
+    EXPECT_THAT(error.what(), HasSubstr("sweep 'F9' is not in the data; available: F0.01/up"));
+  }
+  EXPECT_FALSE(fs::exists(out_dir));
+}
+
+TEST(RunIdentify, AnUnwritableOutputDirLeavesNoPartialFile) {
+  const std::string parent = FreshDir("unwritable");
+  fs::create_directories(parent);
+  // A regular file where the output directory should be.
+  std::ofstream(parent + "/blocked") << "not a directory";
+  const IdentifyConfig config =
+      LoadIdentifyConfig(kConfig, {{"output_dir", parent + "/blocked/out", "--test"}});
+  std::ostringstream printed;
+  EXPECT_THROW(RunIdentify(config, printed), InputError);
+  // The directory is checked before the data are read and the fit runs.
+  EXPECT_THAT(printed.str(), Not(HasSubstr("fit ")));
+  EXPECT_THAT(printed.str(), Not(HasSubstr("Ceres Solver Report")));
+  for (const auto& entry : fs::recursive_directory_iterator(parent)) {
+    EXPECT_EQ(entry.path().filename(), "blocked") << entry.path();
+  }
+}
+
+}  // namespace
+}  // namespace dwellfit
