@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "dwellfit/estimator/analysis/parameter_uncertainty.h"
+#include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/fit/identification.h"
 #include "dwellfit/estimator/run/resolved_run.h"
 
@@ -108,7 +109,12 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
     const IdentificationResult result = FitRun(run).best;
     const ParameterUncertainty u =
         EstimateUncertainty(run.fitted, run.options, result.parameters, study.omega_ref_rad_s);
-    if (r == 0) study.degrees_of_freedom = u.degrees_of_freedom;
+    if (r == 0) {
+      study.degrees_of_freedom = u.degrees_of_freedom;
+      study.start_from_data = run.guessed_from_data;
+      for (const Sweep* sweep : run.fitted)
+        study.first_replica_jumps.push_back(DescribeJumps(*sweep));
+    }
     if (u.available) sum_noise_sigma += u.noise_sigma;
     AddReplica(result, u, rows, &sums, &study);
   }
@@ -126,6 +132,9 @@ void PrintCoverageStudy(const CoverageStudy& study, std::ostream& out) {
                 study.replicas, study.converged, study.available, study.degrees_of_freedom,
                 study.mean_noise_sigma, RadPerSecondToHz(study.omega_ref_rad_s), study.seconds);
   out << line;
+  out << "start: " << (study.start_from_data ? "found from each replica's data" : "the config's")
+      << "; replica 0's fitted sweeps:\n";
+  for (const std::string& jumps : study.first_replica_jumps) out << "  " << jumps << "\n";
   std::snprintf(line, sizeof(line), "%-9s %12s %10s %12s %12s %8s %9s %9s %17s\n", "parameter",
                 "truth", "coverage", "mean se", "empirical sd", "se/sd", "bias/sd", "on bound",
                 "smooth-fit cover");

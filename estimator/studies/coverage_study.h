@@ -64,7 +64,11 @@ struct CoverageStudy {
   int degrees_of_freedom = 0;         // of the first replica
   std::vector<CoverageRow> rows;      // free parameters in index order, then alpha_e
   std::vector<std::string> messages;  // distinct unavailability messages, if any
-  double seconds = 0.0;               // wall time of all replicas
+  // Whether some initial guess came from each replica's data.
+  bool start_from_data = false;
+  // Replica 0's fitted sweeps with their jumps (DescribeJumps).
+  std::vector<std::string> first_replica_jumps;
+  double seconds = 0.0;  // wall time of all replicas
 };
 
 // Runs the study on the config's fitted sweeps of `plan` (its noise is
