@@ -6,30 +6,32 @@
 #include <sstream>
 #include <vector>
 
-#include "dwellfit/estimator/fit/identification.h"
-#include "dwellfit/estimator/run/identify_run.h"
 #include "dwellfit/estimator/analysis/sweep_prediction.h"
+#include "dwellfit/estimator/fit/identification.h"
+#include "dwellfit/estimator/run/resolved_run.h"
 
 namespace dwellfit {
 namespace {
 
 struct PairedFit {
-  ConfiguredSweeps data;
+  ResolvedRun data;
   IdentificationResult with_penalty;
   IdentificationResult without_penalty;
   double omega_ref_rad_s = 0.0;
 };
 
+// The config resolved once and fitted twice: with its penalties and the
+// bifurcation-range penalty enabled, and with no penalty.
 PairedFit FitBothWays(const IdentifyConfig& config) {
   PairedFit fit;
-  fit.data = LoadConfiguredSweeps(config);
-  IdentificationOptions with = config.identification;
-  with.penalties.bifurcation_range.enabled = true;
-  IdentificationOptions without = config.identification;
-  without.penalties.bifurcation_range.enabled = false;
-  without.penalties.branch_stability.enabled = false;
-  fit.with_penalty = Identify(fit.data.fitted, with);
-  fit.without_penalty = Identify(fit.data.fitted, without);
+  fit.data = ResolveRun(config);
+  const PenaltyOptions configured = fit.data.options.penalties;
+  fit.data.options.penalties.bifurcation_range.enabled = true;
+  fit.with_penalty = FitRun(fit.data).best;
+  fit.data.options.penalties.bifurcation_range.enabled = false;
+  fit.data.options.penalties.branch_stability.enabled = false;
+  fit.without_penalty = FitRun(fit.data).best;
+  fit.data.options.penalties = configured;
   fit.omega_ref_rad_s = config.omega_ref_rad_s.value_or(fit.with_penalty.parameters[kOmega]);
   return fit;
 }
@@ -156,7 +158,7 @@ std::string ChapterTablesMarkdown(const IdentifyConfig& numerical, const Paramet
       << "`)\n\n"
       << "| parameter | known value | with penalty | error % | without penalty | error % |\n"
       << "|---|---|---|---|---|---|\n";
-  for (const Row& row : Rows(thesis, numerical.identification, truth)) {
+  for (const Row& row : Rows(thesis, thesis.data.options, truth)) {
     out << "| " << row.name << " | " << Format("%.6g", row.truth) << " | "
         << Format("%.8g", row.with_penalty) << " | " << PercentError(row.with_penalty, row.truth)
         << " | " << Format("%.8g", row.without_penalty) << " | "
@@ -175,7 +177,7 @@ std::string ChapterTablesMarkdown(const IdentifyConfig& numerical, const Paramet
       << "Percent comparison: |with - without| / |with|.\n\n"
       << "| parameter | with penalty | without penalty | percent comparison |\n"
       << "|---|---|---|---|\n";
-  for (const Row& row : Rows(beam, measured.identification, ParameterVector{})) {
+  for (const Row& row : Rows(beam, beam.data.options, ParameterVector{})) {
     out << "| " << row.name << " | " << Format("%.6g", row.with_penalty) << " | "
         << Format("%.6g", row.without_penalty) << " | "
         << PercentError(row.without_penalty, row.with_penalty) << " |\n";
