@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "dwellfit/estimator/analysis/parameter_uncertainty.h"
+#include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/fit/identification.h"
 #include "dwellfit/estimator/run/resolved_run.h"
@@ -125,31 +126,26 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
 }
 
 void PrintCoverageStudy(const CoverageStudy& study, std::ostream& out) {
-  char line[256];
-  std::snprintf(line, sizeof(line),
-                "%d replicas: %d converged, %d with a covariance; %d degrees of freedom; mean "
-                "noise sigma %.4g; alpha_e at Omega_ref = 2 pi %.4g Hz; %.2f s\n",
-                study.replicas, study.converged, study.available, study.degrees_of_freedom,
-                study.mean_noise_sigma, RadPerSecondToHz(study.omega_ref_rad_s), study.seconds);
-  out << line;
+  out << StringPrintf(
+      "%d replicas: %d converged, %d with a covariance; %d degrees of freedom; mean "
+      "noise sigma %.4g; alpha_e at Omega_ref = 2 pi %.4g Hz; %.2f s\n",
+      study.replicas, study.converged, study.available, study.degrees_of_freedom,
+      study.mean_noise_sigma, RadPerSecondToHz(study.omega_ref_rad_s), study.seconds);
   out << "start: " << (study.start_from_data ? "found from each replica's data" : "the config's")
       << "; replica 0's fitted sweeps:\n";
   for (const std::string& jumps : study.first_replica_jumps) out << "  " << jumps << "\n";
-  std::snprintf(line, sizeof(line), "%-9s %12s %10s %12s %12s %8s %9s %9s %17s\n", "parameter",
-                "truth", "coverage", "mean se", "empirical sd", "se/sd", "bias/sd", "on bound",
-                "smooth-fit cover");
-  out << line;
+  out << StringPrintf("%-9s %12s %10s %12s %12s %8s %9s %9s %17s\n", "parameter", "truth",
+                      "coverage", "mean se", "empirical sd", "se/sd", "bias/sd", "on bound",
+                      "smooth-fit cover");
   for (const CoverageRow& row : study.rows) {
     const double ratio =
         row.empirical_std > 0.0 ? row.mean_standard_error / row.empirical_std : 0.0;
     const double bias =
         row.empirical_std > 0.0 ? (row.mean_estimate - row.truth) / row.empirical_std : 0.0;
-    std::snprintf(line, sizeof(line),
-                  "%-9s %12.5g %9.1f%% %12.4g %12.4g %8.3f %9.3f %9d %7.1f%% of %4d\n",
-                  row.name.c_str(), row.truth, 100.0 * row.Coverage(), row.mean_standard_error,
-                  row.empirical_std, ratio, bias, row.on_bound, 100.0 * row.SmoothCoverage(),
-                  row.smooth_replicas);
-    out << line;
+    out << StringPrintf("%-9s %12.5g %9.1f%% %12.4g %12.4g %8.3f %9.3f %9d %7.1f%% of %4d\n",
+                        row.name.c_str(), row.truth, 100.0 * row.Coverage(),
+                        row.mean_standard_error, row.empirical_std, ratio, bias, row.on_bound,
+                        100.0 * row.SmoothCoverage(), row.smooth_replicas);
   }
   for (const std::string& message : study.messages) out << "no covariance: " << message << "\n";
 }
