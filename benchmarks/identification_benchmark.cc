@@ -11,43 +11,35 @@
 #include "benchmark/benchmark.h"
 #include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/fit/identification.h"
-#include "dwellfit/estimator/run/identify_run.h"
 #include "dwellfit/estimator/fit/problem_builder.h"
+#include "dwellfit/estimator/run/resolved_run.h"
 
 namespace dwellfit {
 namespace {
 
-// A committed dataset config, loaded once, and the sweeps it names.
-struct ConfiguredCase {
-  IdentifyConfig config;
-  ConfiguredSweeps data;
-};
-
-ConfiguredCase* LoadCase(const std::string& dataset) {
-  auto* c = new ConfiguredCase;
-  c->config =
-      LoadIdentifyConfig(std::string(DWELLFIT_SOURCE_DIR) + "/datasets/" + dataset + "/beam.yaml");
-  c->data = LoadConfiguredSweeps(c->config);
-  return c;
+// A committed dataset config, resolved once (data labelled and selected,
+// start found) as `identify` resolves it.
+ResolvedRun* LoadCase(const std::string& dataset) {
+  return new ResolvedRun(ResolveRun(LoadIdentifyConfig(std::string(DWELLFIT_SOURCE_DIR) +
+                                                       "/datasets/" + dataset + "/beam.yaml")));
 }
 
-const ConfiguredCase& Thesis() {
-  static const ConfiguredCase* thesis = LoadCase("thesis-numerical");
+ResolvedRun& Thesis() {
+  static ResolvedRun* thesis = LoadCase("thesis-numerical");
   return *thesis;
 }
 
-const ConfiguredCase& ClampedBeam() {
-  static const ConfiguredCase* beam = LoadCase("clamped-beam-27C");
+ResolvedRun& ClampedBeam() {
+  static ResolvedRun* beam = LoadCase("clamped-beam-27C");
   return *beam;
 }
 
-// The configured fit of `fit_case`, with its residual blocks evaluated on
-// state.range(0) threads.
-void RunConfiguredFit(benchmark::State& state, const ConfiguredCase& fit_case) {
-  IdentificationOptions options = fit_case.config.identification;
-  options.solver.num_threads = static_cast<int>(state.range(0));
+// The configured fit of `run` (FitRun, as `identify` fits), with its residual
+// blocks evaluated on state.range(0) threads.
+void RunConfiguredFit(benchmark::State& state, ResolvedRun& run) {
+  run.options.solver.num_threads = static_cast<int>(state.range(0));
   for (auto _ : state) {
-    const IdentificationResult result = Identify(fit_case.data.fitted, options);
+    const IdentificationResult result = FitRun(run).best;
     benchmark::DoNotOptimize(result.parameters);
     state.counters["iterations"] = result.iterations;
     state.counters["dwells"] = result.residual_blocks;
@@ -60,13 +52,13 @@ void RunConfiguredFit(benchmark::State& state, const ConfiguredCase& fit_case) {
 // the start and a point 0.1 % away in every parameter, as a solver's steps
 // do (each dwell's Newton iteration starts from its root at the last point).
 void BM_VerticalResidualWithJacobianPerPoint(benchmark::State& state) {
-  const ConfiguredCase& thesis = Thesis();
+  const ResolvedRun& thesis = Thesis();
   ProblemBuilder builder(ProblemBuilderOptions{});
   std::vector<std::unique_ptr<ceres::CostFunction>> costs;
-  for (const Sweep* sweep : thesis.data.fitted) {
+  for (const Sweep* sweep : thesis.fitted) {
     for (const DwellPoint& point : sweep->points) costs.emplace_back(builder.MakeResidual(point));
   }
-  const ParameterVector start = thesis.config.identification.initial;
+  const ParameterVector start = thesis.options.initial;
   ParameterVector moved = start;
   for (double& value : moved) value *= 1.001;
   const double* at_start[] = {start.data()};

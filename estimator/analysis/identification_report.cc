@@ -1,8 +1,8 @@
 #include "dwellfit/estimator/analysis/identification_report.h"
 
-#include <cstdio>
 #include <sstream>
 
+#include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/data/sweep_csv_writer.h"
 #include "yaml-cpp/yaml.h"
 
@@ -41,141 +41,167 @@ double ControlInFileUnit(const Sweep& sweep, double control) {
 
 }  // namespace
 
+namespace {
+
+void EmitInterval(double low, double high, YAML::Emitter* out) {
+  *out << YAML::Key << "ci95" << YAML::Value << YAML::Flow << YAML::BeginSeq << low << high
+       << YAML::EndSeq;
+}
+
+// parameters: value, start, fixed and interval of each; the natural frequency
+// in Hz and the effective nonlinearity with its interval.
+void EmitParameters(const IdentificationReport& report, YAML::Emitter* out) {
+  const ParameterVector& p = report.result.parameters;
+  const ParameterUncertainty& u = report.uncertainty;
+  *out << YAML::Key << "parameters" << YAML::Value << YAML::BeginMap;
+  for (int i = 0; i < kNumParameters; ++i) {
+    *out << YAML::Key << ParameterName(i) << YAML::Value << YAML::BeginMap;
+    *out << YAML::Key << "value" << YAML::Value << p[i];
+    *out << YAML::Key << "initial" << YAML::Value << report.options.initial[i];
+    *out << YAML::Key << "fixed" << YAML::Value << report.options.fixed[i];
+    if (u.available && !report.options.fixed[i]) {
+      *out << YAML::Key << "standard_error" << YAML::Value << u.standard_error[i];
+      EmitInterval(u.ci95_low[i], u.ci95_high[i], out);
+    }
+    if (i == kOmega) *out << YAML::Key << "unit" << YAML::Value << "rad/s";
+    *out << YAML::EndMap;
+  }
+  *out << YAML::EndMap;
+  *out << YAML::Key << "natural_frequency_hz" << YAML::Value << RadPerSecondToHz(p[kOmega]);
+  *out << YAML::Key << "effective_nonlinearity" << YAML::Value << YAML::BeginMap;
+  *out << YAML::Key << "definition" << YAML::Value << "-(1/3)(2 delta Omega_ref^2 - 3 alpha)";
+  *out << YAML::Key << "value" << YAML::Value << EffectiveNonlinearity(p, report.omega_ref_rad_s);
+  *out << YAML::Key << "omega_ref_rad_s" << YAML::Value << report.omega_ref_rad_s;
+  if (u.available) {
+    *out << YAML::Key << "standard_error" << YAML::Value << u.effective_nonlinearity_standard_error;
+    EmitInterval(u.effective_nonlinearity_ci95_low, u.effective_nonlinearity_ci95_high, out);
+  }
+  *out << YAML::EndMap;
+}
+
+void EmitUncertainty(const IdentificationReport& report, YAML::Emitter* out) {
+  const ParameterUncertainty& u = report.uncertainty;
+  *out << YAML::Key << "uncertainty" << YAML::Value << YAML::BeginMap;
+  *out << YAML::Key << "available" << YAML::Value << u.available;
+  *out << YAML::Key << "message" << YAML::Value << u.message;
+  *out << YAML::Key << "noise_sigma" << YAML::Value << u.noise_sigma;
+  *out << YAML::Key << "degrees_of_freedom" << YAML::Value << u.degrees_of_freedom;
+  if (u.available) {
+    *out << YAML::Key << "correlation" << YAML::Value << YAML::BeginMap;
+    for (int i = 0; i < kNumParameters; ++i) {
+      if (report.options.fixed[i]) continue;
+      *out << YAML::Key << ParameterName(i) << YAML::Value << YAML::Flow << YAML::BeginSeq;
+      for (int j = 0; j < kNumParameters; ++j) {
+        if (!report.options.fixed[j]) *out << u.correlation(i, j);
+      }
+      *out << YAML::EndSeq;
+    }
+    *out << YAML::EndMap;
+  }
+  *out << YAML::Key << "warnings" << YAML::Value << YAML::BeginSeq;
+  for (const std::string& warning : u.warnings) *out << warning;
+  *out << YAML::EndSeq;
+  *out << YAML::EndMap;
+}
+
+void EmitStarts(const IdentificationReport& report, YAML::Emitter* out) {
+  *out << YAML::Key << "multi_start" << YAML::Value << YAML::BeginMap;
+  *out << YAML::Key << "starts" << YAML::Value << report.multi_start.starts.size();
+  *out << YAML::Key << "reached_best" << YAML::Value << report.multi_start.reached_best;
+  *out << YAML::Key << "best_start" << YAML::Value << report.multi_start.best_start;
+  *out << YAML::Key << "final_costs" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (double cost : report.multi_start.final_costs) *out << cost;
+  *out << YAML::EndSeq;
+  *out << YAML::EndMap;
+  if (!report.initial_guess_steps.empty()) {
+    *out << YAML::Key << "automatic_initial_guess" << YAML::Value << YAML::BeginSeq;
+    for (const std::string& step : report.initial_guess_steps) *out << step;
+    *out << YAML::EndSeq;
+  }
+}
+
+void EmitStage(const StageSummary& stage, YAML::Emitter* out) {
+  *out << YAML::BeginMap;
+  *out << YAML::Key << "residual" << YAML::Value << ResidualKindName(stage.residual);
+  *out << YAML::Key << "dwells" << YAML::Value << stage.residual_blocks;
+  *out << YAML::Key << "initial_cost" << YAML::Value << stage.initial_cost;
+  *out << YAML::Key << "final_cost" << YAML::Value << stage.final_cost;
+  *out << YAML::Key << "final_data_cost" << YAML::Value << stage.final_data_cost;
+  if (stage.penalty_unit > 0.0) {
+    *out << YAML::Key << "penalty_unit" << YAML::Value << stage.penalty_unit;
+    *out << YAML::Key << "penalty_exponent" << YAML::Value << stage.penalty_exponent;
+  }
+  *out << YAML::Key << "iterations" << YAML::Value << stage.iterations;
+  *out << YAML::Key << "solves" << YAML::Value << stage.solves;
+  *out << YAML::Key << "held_at_bound" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (int index : stage.held_at_bound) *out << ParameterName(index);
+  *out << YAML::EndSeq;
+  *out << YAML::Key << "converged" << YAML::Value << stage.converged;
+  *out << YAML::Key << "solver" << YAML::Value << stage.brief_report;
+  *out << YAML::EndMap;
+}
+
+// One measured or predicted jump: the measured bracket beside the model's
+// fold, in the file's unit (Hz or a_base).
+void EmitJump(const Sweep& sweep, const PredictedJump& jump, YAML::Emitter* out) {
+  const bool frequency = sweep.kind == SweepKind::kFrequency;
+  *out << YAML::Flow << YAML::BeginMap;
+  *out << YAML::Key << "kind" << YAML::Value << JumpKindName(jump.kind);
+  if (jump.measured) {
+    *out << YAML::Key << (frequency ? "measured_between_hz" : "measured_between_a_base")
+         << YAML::Value << YAML::Flow << YAML::BeginSeq
+         << ControlInFileUnit(sweep, jump.bracket.control_before)
+         << ControlInFileUnit(sweep, jump.bracket.control_after) << YAML::EndSeq;
+  }
+  *out << YAML::Key << (frequency ? "model_hz" : "model_a_base") << YAML::Value;
+  if (jump.exists) {
+    *out << ControlInFileUnit(sweep, jump.control);
+  } else {
+    *out << YAML::Null;
+  }
+  if (jump.measured) *out << YAML::Key << "inside" << YAML::Value << jump.inside;
+  if (jump.measured && jump.bracket.into_missing_data) {
+    *out << YAML::Key << "into_missing_data" << YAML::Value << true;
+  }
+  *out << YAML::EndMap;
+}
+
+void EmitSweep(const SweepPrediction& prediction, YAML::Emitter* out) {
+  const Sweep& sweep = *prediction.sweep;
+  *out << YAML::BeginMap;
+  *out << YAML::Key << "name" << YAML::Value << sweep.Name();
+  *out << YAML::Key << "role" << YAML::Value << Role(prediction);
+  *out << YAML::Key << "kind" << YAML::Value << SweepKindName(sweep.kind);
+  *out << YAML::Key << "points" << YAML::Value << sweep.points.size();
+  *out << YAML::Key << "rms_error" << YAML::Value << prediction.rms_error;
+  *out << YAML::Key << "relative_rms_error" << YAML::Value << prediction.relative_rms_error;
+  *out << YAML::Key << "points_off_branch" << YAML::Value << prediction.points_off_branch;
+  *out << YAML::Key << "jumps" << YAML::Value << YAML::BeginSeq;
+  for (const PredictedJump& jump : prediction.jumps) EmitJump(sweep, jump, out);
+  *out << YAML::EndSeq;
+  *out << YAML::EndMap;
+}
+
+}  // namespace
+
 std::string ReportToYaml(const IdentificationReport& report) {
   const IdentificationResult& result = report.result;
   YAML::Emitter out;
   out.SetDoublePrecision(17);
   out << YAML::BeginMap;
   out << YAML::Key << "config" << YAML::Value << report.config_path;
-  out << YAML::Key << "parameters" << YAML::Value << YAML::BeginMap;
-  for (int i = 0; i < kNumParameters; ++i) {
-    out << YAML::Key << ParameterName(i) << YAML::Value << YAML::BeginMap;
-    out << YAML::Key << "value" << YAML::Value << result.parameters[i];
-    out << YAML::Key << "initial" << YAML::Value << report.options.initial[i];
-    out << YAML::Key << "fixed" << YAML::Value << report.options.fixed[i];
-    if (report.uncertainty.available && !report.options.fixed[i]) {
-      out << YAML::Key << "standard_error" << YAML::Value << report.uncertainty.standard_error[i];
-      out << YAML::Key << "ci95" << YAML::Value << YAML::Flow << YAML::BeginSeq
-          << report.uncertainty.ci95_low[i] << report.uncertainty.ci95_high[i] << YAML::EndSeq;
-    }
-    if (i == kOmega) out << YAML::Key << "unit" << YAML::Value << "rad/s";
-    out << YAML::EndMap;
-  }
-  out << YAML::EndMap;
-  out << YAML::Key << "natural_frequency_hz" << YAML::Value
-      << RadPerSecondToHz(result.parameters[kOmega]);
-  out << YAML::Key << "effective_nonlinearity" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "definition" << YAML::Value << "-(1/3)(2 delta Omega_ref^2 - 3 alpha)";
-  out << YAML::Key << "value" << YAML::Value
-      << EffectiveNonlinearity(result.parameters, report.omega_ref_rad_s);
-  out << YAML::Key << "omega_ref_rad_s" << YAML::Value << report.omega_ref_rad_s;
-  if (report.uncertainty.available) {
-    out << YAML::Key << "standard_error" << YAML::Value
-        << report.uncertainty.effective_nonlinearity_standard_error;
-    out << YAML::Key << "ci95" << YAML::Value << YAML::Flow << YAML::BeginSeq
-        << report.uncertainty.effective_nonlinearity_ci95_low
-        << report.uncertainty.effective_nonlinearity_ci95_high << YAML::EndSeq;
-  }
-  out << YAML::EndMap;
-  const ParameterUncertainty& u = report.uncertainty;
-  out << YAML::Key << "uncertainty" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "available" << YAML::Value << u.available;
-  out << YAML::Key << "message" << YAML::Value << u.message;
-  out << YAML::Key << "noise_sigma" << YAML::Value << u.noise_sigma;
-  out << YAML::Key << "degrees_of_freedom" << YAML::Value << u.degrees_of_freedom;
-  if (u.available) {
-    out << YAML::Key << "correlation" << YAML::Value << YAML::BeginMap;
-    for (int i = 0; i < kNumParameters; ++i) {
-      if (report.options.fixed[i]) continue;
-      out << YAML::Key << ParameterName(i) << YAML::Value << YAML::Flow << YAML::BeginSeq;
-      for (int j = 0; j < kNumParameters; ++j) {
-        if (!report.options.fixed[j]) out << u.correlation(i, j);
-      }
-      out << YAML::EndSeq;
-    }
-    out << YAML::EndMap;
-  }
-  out << YAML::Key << "warnings" << YAML::Value << YAML::BeginSeq;
-  for (const std::string& warning : u.warnings) out << warning;
-  out << YAML::EndSeq;
-  out << YAML::EndMap;
-  out << YAML::Key << "multi_start" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "starts" << YAML::Value << report.multi_start.starts.size();
-  out << YAML::Key << "reached_best" << YAML::Value << report.multi_start.reached_best;
-  out << YAML::Key << "best_start" << YAML::Value << report.multi_start.best_start;
-  out << YAML::Key << "final_costs" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (double cost : report.multi_start.final_costs) out << cost;
-  out << YAML::EndSeq;
-  out << YAML::EndMap;
-  if (!report.initial_guess_steps.empty()) {
-    out << YAML::Key << "automatic_initial_guess" << YAML::Value << YAML::BeginSeq;
-    for (const std::string& step : report.initial_guess_steps) out << step;
-    out << YAML::EndSeq;
-  }
+  EmitParameters(report, &out);
+  EmitUncertainty(report, &out);
+  EmitStarts(report, &out);
   out << YAML::Key << "final_cost" << YAML::Value << result.final_cost;
   out << YAML::Key << "iterations" << YAML::Value << result.iterations;
   out << YAML::Key << "converged" << YAML::Value << result.converged;
   out << YAML::Key << "fitted_points" << YAML::Value << result.residual_blocks;
   out << YAML::Key << "stages" << YAML::Value << YAML::BeginSeq;
-  for (const StageSummary& stage : result.stages) {
-    out << YAML::BeginMap;
-    out << YAML::Key << "residual" << YAML::Value << ResidualKindName(stage.residual);
-    out << YAML::Key << "dwells" << YAML::Value << stage.residual_blocks;
-    out << YAML::Key << "initial_cost" << YAML::Value << stage.initial_cost;
-    out << YAML::Key << "final_cost" << YAML::Value << stage.final_cost;
-    out << YAML::Key << "final_data_cost" << YAML::Value << stage.final_data_cost;
-    if (stage.penalty_unit > 0.0) {
-      out << YAML::Key << "penalty_unit" << YAML::Value << stage.penalty_unit;
-      out << YAML::Key << "penalty_exponent" << YAML::Value << stage.penalty_exponent;
-    }
-    out << YAML::Key << "iterations" << YAML::Value << stage.iterations;
-    out << YAML::Key << "solves" << YAML::Value << stage.solves;
-    out << YAML::Key << "held_at_bound" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-    for (int index : stage.held_at_bound) out << ParameterName(index);
-    out << YAML::EndSeq;
-    out << YAML::Key << "converged" << YAML::Value << stage.converged;
-    out << YAML::Key << "solver" << YAML::Value << stage.brief_report;
-    out << YAML::EndMap;
-  }
+  for (const StageSummary& stage : result.stages) EmitStage(stage, &out);
   out << YAML::EndSeq;
   out << YAML::Key << "sweeps" << YAML::Value << YAML::BeginSeq;
-  for (const SweepPrediction& prediction : report.predictions) {
-    const Sweep& sweep = *prediction.sweep;
-    out << YAML::BeginMap;
-    out << YAML::Key << "name" << YAML::Value << sweep.Name();
-    out << YAML::Key << "role" << YAML::Value << Role(prediction);
-    out << YAML::Key << "kind" << YAML::Value << SweepKindName(sweep.kind);
-    out << YAML::Key << "points" << YAML::Value << sweep.points.size();
-    out << YAML::Key << "rms_error" << YAML::Value << prediction.rms_error;
-    out << YAML::Key << "relative_rms_error" << YAML::Value << prediction.relative_rms_error;
-    out << YAML::Key << "points_off_branch" << YAML::Value << prediction.points_off_branch;
-    // Measured jump brackets beside the model's jumps (Hz or a_base).
-    out << YAML::Key << "jumps" << YAML::Value << YAML::BeginSeq;
-    const bool frequency = sweep.kind == SweepKind::kFrequency;
-    for (const PredictedJump& jump : prediction.jumps) {
-      out << YAML::Flow << YAML::BeginMap;
-      out << YAML::Key << "kind" << YAML::Value << JumpKindName(jump.kind);
-      if (jump.measured) {
-        out << YAML::Key << (frequency ? "measured_between_hz" : "measured_between_a_base")
-            << YAML::Value << YAML::Flow << YAML::BeginSeq
-            << ControlInFileUnit(sweep, jump.bracket.control_before)
-            << ControlInFileUnit(sweep, jump.bracket.control_after) << YAML::EndSeq;
-      }
-      out << YAML::Key << (frequency ? "model_hz" : "model_a_base") << YAML::Value;
-      if (jump.exists) {
-        out << ControlInFileUnit(sweep, jump.control);
-      } else {
-        out << YAML::Null;
-      }
-      if (jump.measured) out << YAML::Key << "inside" << YAML::Value << jump.inside;
-      if (jump.measured && jump.bracket.into_missing_data) {
-        out << YAML::Key << "into_missing_data" << YAML::Value << true;
-      }
-      out << YAML::EndMap;
-    }
-    out << YAML::EndSeq;
-    out << YAML::EndMap;
-  }
+  for (const SweepPrediction& prediction : report.predictions) EmitSweep(prediction, &out);
   out << YAML::EndSeq;
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
@@ -201,95 +227,96 @@ std::string ReportToPredictionsCsv(const IdentificationReport& report) {
   return csv.str();
 }
 
-void PrintReport(const IdentificationReport& report, std::ostream& out) {
-  const IdentificationResult& result = report.result;
+namespace {
+
+void PrintStages(const IdentificationResult& result, std::ostream& out) {
   for (const StageSummary& stage : result.stages) {
     out << ResidualKindName(stage.residual);
     if (stage.penalty_unit > 0.0) out << " + penalties (exponent " << stage.penalty_exponent << ")";
-    char costs[64];
-    std::snprintf(costs, sizeof(costs), "%.7g -> %.7g", stage.initial_cost, stage.final_cost);
-    out << " stage: cost " << costs << ", " << stage.iterations << " iterations";
+    out << " stage: cost " << StringPrintf("%.7g -> %.7g", stage.initial_cost, stage.final_cost)
+        << ", " << stage.iterations << " iterations";
     if (stage.solves > 1) out << " in " << stage.solves << " solves";
     for (size_t i = 0; i < stage.held_at_bound.size(); ++i) {
       out << (i == 0 ? ", held at bound: " : ", ") << ParameterName(stage.held_at_bound[i]);
     }
     out << "\n  last solve: " << stage.brief_report << "\n";
   }
-  char line[256];
-  out << "\n";
+}
+
+void PrintParameters(const IdentificationReport& report, std::ostream& out) {
+  const IdentificationResult& result = report.result;
   const ParameterUncertainty& u = report.uncertainty;
-  std::snprintf(line, sizeof(line), "%-8s %-18s %-12s %-34s %-14s %s\n", "param", "estimate",
-                "std.error", "95% interval", "initial", "fixed");
-  out << line;
+  out << StringPrintf("%-8s %-18s %-12s %-34s %-14s %s\n", "param", "estimate", "std.error",
+                      "95% interval", "initial", "fixed");
   for (int i = 0; i < kNumParameters; ++i) {
     const bool interval = u.available && !report.options.fixed[i];
-    char se[32] = "-", ci[64] = "-";
-    if (interval) {
-      std::snprintf(se, sizeof(se), "%.3g", u.standard_error[i]);
-      std::snprintf(ci, sizeof(ci), "[%.6g, %.6g]", u.ci95_low[i], u.ci95_high[i]);
-    }
-    std::snprintf(line, sizeof(line), "%-8s %-18.10g %-12s %-34s %-14.6g %s\n", ParameterName(i),
-                  result.parameters[i], se, ci, report.options.initial[i],
-                  report.options.fixed[i] ? "yes" : "no");
-    out << line;
+    const std::string se = interval ? StringPrintf("%.3g", u.standard_error[i]) : "-";
+    const std::string ci =
+        interval ? StringPrintf("[%.6g, %.6g]", u.ci95_low[i], u.ci95_high[i]) : "-";
+    out << StringPrintf("%-8s %-18.10g %-12s %-34s %-14.6g %s\n", ParameterName(i),
+                        result.parameters[i], se.c_str(), ci.c_str(), report.options.initial[i],
+                        report.options.fixed[i] ? "yes" : "no");
   }
-  std::snprintf(line, sizeof(line),
-                "natural frequency %.8g Hz; effective nonlinearity %.8g at "
-                "Omega_ref %.6g rad/s\n",
-                RadPerSecondToHz(result.parameters[kOmega]),
-                EffectiveNonlinearity(result.parameters, report.omega_ref_rad_s),
-                report.omega_ref_rad_s);
-  out << line;
+  out << StringPrintf(
+      "natural frequency %.8g Hz; effective nonlinearity %.8g at Omega_ref %.6g rad/s\n",
+      RadPerSecondToHz(result.parameters[kOmega]),
+      EffectiveNonlinearity(result.parameters, report.omega_ref_rad_s), report.omega_ref_rad_s);
   if (u.available) {
-    std::snprintf(line, sizeof(line),
-                  "  effective nonlinearity std.error %.3g, 95%% interval [%.6g, %.6g]\n",
-                  u.effective_nonlinearity_standard_error, u.effective_nonlinearity_ci95_low,
-                  u.effective_nonlinearity_ci95_high);
-    out << line;
+    out << StringPrintf("  effective nonlinearity std.error %.3g, 95%% interval [%.6g, %.6g]\n",
+                        u.effective_nonlinearity_standard_error, u.effective_nonlinearity_ci95_low,
+                        u.effective_nonlinearity_ci95_high);
   }
-  std::snprintf(line, sizeof(line), "final cost %.6g after %d iterations, %s\n", result.final_cost,
-                result.iterations, result.converged ? "converged" : "NOT converged");
-  out << line;
-  std::snprintf(line, sizeof(line), "starts: %zu, %d reached the best (start %d)\n",
-                report.multi_start.starts.size(), report.multi_start.reached_best,
-                report.multi_start.best_start);
-  out << line;
+  out << StringPrintf("final cost %.6g after %d iterations, %s\n", result.final_cost,
+                      result.iterations, result.converged ? "converged" : "NOT converged");
+  out << StringPrintf("starts: %zu, %d reached the best (start %d)\n",
+                      report.multi_start.starts.size(), report.multi_start.reached_best,
+                      report.multi_start.best_start);
   out << "uncertainty: " << u.message << "\n";
   for (const std::string& warning : u.warnings) out << "warning: " << warning << "\n";
-  out << "\n";
-  std::snprintf(line, sizeof(line), "%-20s %-10s %6s %14s %14s %s\n", "sweep", "role", "points",
-                "rms_error", "relative_rms", "off_branch");
-  out << line;
+}
+
+void PrintSweeps(const IdentificationReport& report, std::ostream& out) {
+  out << StringPrintf("%-20s %-10s %6s %14s %14s %s\n", "sweep", "role", "points", "rms_error",
+                      "relative_rms", "off_branch");
   for (const SweepPrediction& prediction : report.predictions) {
-    std::snprintf(line, sizeof(line), "%-20s %-10s %6zu %14.6g %14.6g %d\n",
-                  prediction.sweep->Name().c_str(), Role(prediction),
-                  prediction.sweep->points.size(), prediction.rms_error,
-                  prediction.relative_rms_error, prediction.points_off_branch);
-    out << line;
+    out << StringPrintf("%-20s %-10s %6zu %14.6g %14.6g %d\n", prediction.sweep->Name().c_str(),
+                        Role(prediction), prediction.sweep->points.size(), prediction.rms_error,
+                        prediction.relative_rms_error, prediction.points_off_branch);
   }
-  out << "\njumps (measured bracket -> model)\n";
+}
+
+void PrintJumps(const IdentificationReport& report, std::ostream& out) {
+  out << "jumps (measured bracket -> model)\n";
   for (const SweepPrediction& prediction : report.predictions) {
     const Sweep& sweep = *prediction.sweep;
     const char* unit = sweep.kind == SweepKind::kFrequency ? " Hz" : "";
     for (const PredictedJump& jump : prediction.jumps) {
-      std::string measured = "not measured";
-      if (jump.measured) {
-        std::snprintf(line, sizeof(line), "%.6g..%.6g%s",
-                      ControlInFileUnit(sweep, jump.bracket.control_before),
-                      ControlInFileUnit(sweep, jump.bracket.control_after), unit);
-        measured = line;
-      }
-      std::string model = "no fold";
-      if (jump.exists) {
-        std::snprintf(line, sizeof(line), "%.6g%s%s", ControlInFileUnit(sweep, jump.control), unit,
-                      jump.measured ? (jump.inside ? " (inside)" : " (outside)") : "");
-        model = line;
-      }
-      std::snprintf(line, sizeof(line), "%-20s %-10s %-30s %s\n", sweep.Name().c_str(),
-                    JumpKindName(jump.kind), measured.c_str(), model.c_str());
-      out << line;
+      const std::string measured =
+          jump.measured
+              ? StringPrintf("%.6g..%.6g%s", ControlInFileUnit(sweep, jump.bracket.control_before),
+                             ControlInFileUnit(sweep, jump.bracket.control_after), unit)
+              : "not measured";
+      const std::string model =
+          jump.exists
+              ? StringPrintf("%.6g%s%s", ControlInFileUnit(sweep, jump.control), unit,
+                             jump.measured ? (jump.inside ? " (inside)" : " (outside)") : "")
+              : "no fold";
+      out << StringPrintf("%-20s %-10s %-30s %s\n", sweep.Name().c_str(), JumpKindName(jump.kind),
+                          measured.c_str(), model.c_str());
     }
   }
+}
+
+}  // namespace
+
+void PrintReport(const IdentificationReport& report, std::ostream& out) {
+  PrintStages(report.result, out);
+  out << "\n";
+  PrintParameters(report, out);
+  out << "\n";
+  PrintSweeps(report, out);
+  out << "\n";
+  PrintJumps(report, out);
 }
 
 }  // namespace dwellfit

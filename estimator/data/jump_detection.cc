@@ -12,22 +12,15 @@
 #include <vector>
 
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 
 namespace dwellfit {
 namespace {
 
-// printf-style formatting into a std::string.
-template <typename... Args>
-std::string Format(const char* format, Args... args) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), format, args...);
-  return buffer;
-}
-
 // "4.7e-3": one decimal of mantissa, exponent without padding zeros.
 std::string ShortScientific(double value) {
-  const std::string text = Format("%.1e", value);
+  const std::string text = StringPrintf("%.1e", value);
   const size_t e = text.find('e');
   if (e == std::string::npos) return text;  // inf or nan
   const int exponent = std::atoi(text.c_str() + e + 1);
@@ -48,8 +41,8 @@ std::pair<std::string, std::string> DistinctPair(const char* format, int precisi
                                                  double b) {
   std::string first, second;
   for (int p = precision; p <= 12; ++p) {
-    first = Format(format, p, a);
-    second = Format(format, p, b);
+    first = StringPrintf(format, p, a);
+    second = StringPrintf(format, p, b);
     if (first != second && ReadsBackAs(first, a) && ReadsBackAs(second, b)) break;
   }
   return {first, second};
@@ -152,8 +145,9 @@ std::optional<JumpBracket> JumpIntoMissingData(const JumpDetectionOptions& optio
 
 // "161.041 Hz" or "a_base 0.036": one control, with all its digits.
 std::string DescribeControl(SweepKind kind, double control) {
-  if (kind == SweepKind::kFrequency) return Format("%.10g", RadPerSecondToHz(control)) + " Hz";
-  return "a_base " + Format("%.10g", control);
+  if (kind == SweepKind::kFrequency)
+    return StringPrintf("%.10g", RadPerSecondToHz(control)) + " Hz";
+  return "a_base " + StringPrintf("%.10g", control);
 }
 
 }  // namespace

@@ -7,8 +7,9 @@
 #include <sstream>
 
 #include "dwellfit/estimator/common/input_error.h"
-#include "glog/logging.h"
+#include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/residuals/model/model_parameters.h"
+#include "glog/logging.h"
 
 namespace dwellfit {
 
@@ -21,10 +22,8 @@ std::string FormatRoundTrip(double value) {
 
 std::string FormatFrequencyHz(double omega_rad_s) {
   const double hz = RadPerSecondToHz(omega_rad_s);
-  char buffer[64];
   for (int digits = 1; digits <= 17; ++digits) {
-    std::snprintf(buffer, sizeof(buffer), "%.*g", digits, hz);
-    const double candidate = std::strtod(buffer, nullptr);
+    const double candidate = std::strtod(StringPrintf("%.*g", digits, hz).c_str(), nullptr);
     if (HzToRadPerSecond(candidate) == omega_rad_s) return FormatRoundTrip(candidate);
   }
   return FormatRoundTrip(hz);

@@ -10,6 +10,7 @@
 
 #include "Eigen/Dense"
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/residuals/model/response_model.h"
 
 namespace dwellfit {
@@ -26,14 +27,6 @@ constexpr double kMinRelativeSpread = 0.05;
 // (no information), small when the levels show no growth of damping with amplitude.
 constexpr double kQuadraticShareOneLevel = 0.5;
 constexpr double kQuadraticShareNoGrowth = 0.1;
-
-template <typename... Args>
-std::string Format(const char* format, Args... args) {
-  const int size = std::snprintf(nullptr, 0, format, args...);
-  std::string text(size > 0 ? size : 0, '\0');
-  std::snprintf(text.data(), text.size() + 1, format, args...);
-  return text;
-}
 
 // min |a x - y|, by Eigen's column-pivoting Householder QR on the columns
 // scaled to unit norm. Without the scaling the QR's rank threshold, relative
@@ -154,25 +147,27 @@ std::optional<BackbonePoint> FindBackbonePoint(const Level& level,
     }
   }
   if (best == nullptr) {
-    notes->push_back(Format("%s: no %s, not a backbone point", id.c_str(),
-                            level.kind == SweepKind::kFrequency ? "dwell" : "upper-branch dwell"));
+    notes->push_back(
+        StringPrintf("%s: no %s, not a backbone point", id.c_str(),
+                     level.kind == SweepKind::kFrequency ? "dwell" : "upper-branch dwell"));
     return std::nullopt;
   }
   const double omega = best->drive_frequency_rad_s;
   if (level.kind == SweepKind::kFrequency && (omega == omega_lo || omega == omega_hi)) {
     notes->push_back(
-        Format("%s: largest amplitude at the edge of the band (%.3f Hz), "
-               "resonance outside it: not a backbone point",
-               id.c_str(), RadPerSecondToHz(omega)));
+        StringPrintf("%s: largest amplitude at the edge of the band (%.3f Hz), "
+                     "resonance outside it: not a backbone point",
+                     id.c_str(), RadPerSecondToHz(omega)));
     return std::nullopt;
   }
   BackbonePoint point;
   point.omega = omega;
   point.a = best->amplitude;
   point.a_base = best->a_base;
-  point.description = Format("%s %s %.3f Hz a %.4g a_base %.4g", id.c_str(),
-                             level.kind == SweepKind::kFrequency ? "peak" : "upper-branch end",
-                             RadPerSecondToHz(omega), point.a, point.a_base);
+  point.description =
+      StringPrintf("%s %s %.3f Hz a %.4g a_base %.4g", id.c_str(),
+                   level.kind == SweepKind::kFrequency ? "peak" : "upper-branch end",
+                   RadPerSecondToHz(omega), point.a, point.a_base);
   return point;
 }
 
@@ -203,7 +198,7 @@ DampingLine FitPeakHeights(const std::vector<BackbonePoint>& backbone,
   const int num_free = (known_m1 ? 0 : 1) + (known_m2 ? 0 : 1);
   if (num_free == 2 && !HasSpread(a)) {
     split(kQuadraticShareOneLevel);
-    line.how = Format(
+    line.how = StringPrintf(
         "one peak amplitude (%.4g): mu1 and mu2 not separable, the damping "
         "mu1 + c mu2 a there split evenly between them",
         a_mean);
@@ -212,18 +207,18 @@ DampingLine FitPeakHeights(const std::vector<BackbonePoint>& backbone,
   const Line fit = FitLine(a, m, known_m1, known_m2);
   line.m1 = fit.intercept;
   line.m2 = fit.slope;
-  line.how = Format("straight line through %d peak heights", static_cast<int>(a.size()));
+  line.how = StringPrintf("straight line through %d peak heights", static_cast<int>(a.size()));
   if (!known_m2 && !(line.m2 > 0.0)) {
     split(kQuadraticShareNoGrowth);
-    line.how += Format(
+    line.how += StringPrintf(
         " has slope %.3g <= 0 (no damping growth with amplitude): mu2 set small, "
         "%.0f%% of the damping at a = %.4g",
         fit.slope, 100.0 * kQuadraticShareNoGrowth, a_mean);
   } else if (!known_m1 && !(line.m1 > 0.0)) {
     line.m1 = 0.1 * m_min;
     line.m2 = known_m2.value_or(FitLine(a, m, line.m1, std::nullopt).slope);
-    line.how += Format(" has intercept %.3g <= 0: mu1 set to 10%% of the smallest peak damping",
-                       fit.intercept);
+    line.how += StringPrintf(
+        " has intercept %.3g <= 0: mu1 set to 10%% of the smallest peak damping", fit.intercept);
   }
   return line;
 }
@@ -321,7 +316,7 @@ JointFit FitFrequencyAndForcing(const std::vector<OffResonanceDwell>& dwells, do
 }
 
 std::string RadPerSecondText(double rad_s) {
-  return Format("%.6g rad/s (%.4f Hz)", rad_s, RadPerSecondToHz(rad_s));
+  return StringPrintf("%.6g rad/s (%.4f Hz)", rad_s, RadPerSecondToHz(rad_s));
 }
 
 }  // namespace
@@ -332,7 +327,7 @@ InitialGuessReport AutomaticInitialGuess(const std::vector<const Sweep*>& sweeps
   std::vector<std::string>& steps = report.steps;
   ParameterVector& guess = report.guess;
   auto given = [&](int index) {
-    return Format("%s = %.6g: given", ParameterName(index), *known[index]);
+    return StringPrintf("%s = %.6g: given", ParameterName(index), *known[index]);
   };
 
   // 1. Backbone points.
@@ -385,7 +380,7 @@ InitialGuessReport AutomaticInitialGuess(const std::vector<const Sweep*>& sweeps
     const Line line = FitLine(a2, y, known_w2, known_b);
     w2 = line.intercept;
     b = line.slope;
-    backbone_how = Format(
+    backbone_how = StringPrintf(
         "backbone Omega_k^2 (1 + delta a_k^2 / 2) = w^2 + (3/4) alpha a_k^2 [rad^2/s^2] "
         "through %d point(s)",
         static_cast<int>(backbone.size()));
@@ -399,7 +394,7 @@ InitialGuessReport AutomaticInitialGuess(const std::vector<const Sweep*>& sweeps
     w2 = fit.w2;
     b = (y0 - w2) / (point.a * point.a);
     joint_e = fit.e;
-    backbone_how = Format(
+    backbone_how = StringPrintf(
         "one backbone amplitude: least squares over %d off-resonance dwells of "
         "s_i (w^2 + (3/4) alpha a_i^2 - Omega_i^2) = 2 eta_e sqrt(a_base_i^2 - P_i^2) / a_i "
         "for (w^2, eta_e), alpha tied to the backbone point by "
@@ -407,28 +402,28 @@ InitialGuessReport AutomaticInitialGuess(const std::vector<const Sweep*>& sweeps
         fit.dwells);
   }
   if (!(w2 > 0.0) || !std::isfinite(w2 + b)) {
-    throw InputError(
-        Format("automatic initial guess: the backbone gives w^2 = %.4g rad^2/s^2 (not positive); "
-               "give omega",
-               w2));
+    throw InputError(StringPrintf(
+        "automatic initial guess: the backbone gives w^2 = %.4g rad^2/s^2 (not positive); "
+        "give omega",
+        w2));
   }
   if (known[kOmega]) {
     guess[kOmega] = *known[kOmega];
-    steps.push_back(Format("omega = %s: given", RadPerSecondText(guess[kOmega]).c_str()));
+    steps.push_back(StringPrintf("omega = %s: given", RadPerSecondText(guess[kOmega]).c_str()));
   } else {
     guess[kOmega] = std::sqrt(w2);
-    steps.push_back(Format("omega = %s: %s; w^2 is its value at a = 0",
-                           RadPerSecondText(guess[kOmega]).c_str(), backbone_how.c_str()));
+    steps.push_back(StringPrintf("omega = %s: %s; w^2 is its value at a = 0",
+                                 RadPerSecondText(guess[kOmega]).c_str(), backbone_how.c_str()));
   }
   if (known[kAlpha]) {
     guess[kAlpha] = *known[kAlpha];
     steps.push_back(given(kAlpha));
   } else {
     guess[kAlpha] = b / 0.75;
-    steps.push_back(
-        Format("alpha = %.4g: %s; alpha is the slope in a^2 over 3/4%s", guess[kAlpha],
-               backbone_how.c_str(),
-               known[kDelta] && *known[kDelta] != 0.0 ? "" : " (with delta = 0 it is alpha_e)"));
+    steps.push_back(StringPrintf(
+        "alpha = %.4g: %s; alpha is the slope in a^2 over 3/4%s", guess[kAlpha],
+        backbone_how.c_str(),
+        known[kDelta] && *known[kDelta] != 0.0 ? "" : " (with delta = 0 it is alpha_e)"));
   }
   if (known[kDelta]) {
     guess[kDelta] = *known[kDelta];
@@ -446,7 +441,7 @@ InitialGuessReport AutomaticInitialGuess(const std::vector<const Sweep*>& sweeps
     steps.push_back(given(kEtaE));
   } else if (joint_e) {
     guess[kEtaE] = 0.5 * *joint_e;
-    steps.push_back(Format("eta_e = %.4g: %s", guess[kEtaE], backbone_how.c_str()));
+    steps.push_back(StringPrintf("eta_e = %.4g: %s", guess[kEtaE], backbone_how.c_str()));
   } else {
     std::vector<double> q, abs_d;
     for (const OffResonanceDwell& d : off_resonance) {
@@ -454,18 +449,18 @@ InitialGuessReport AutomaticInitialGuess(const std::vector<const Sweep*>& sweeps
       abs_d.push_back(std::abs(w2 + b * d.a2 - d.y));
     }
     guess[kEtaE] = 0.5 * FitLine(q, abs_d, 0.0, std::nullopt).slope;
-    steps.push_back(
-        Format("eta_e = %.4g: least squares through the origin over %d off-resonance dwells "
-               "(P <= %.1f a_base) of |w^2 + (3/4) alpha a^2 - Omega^2 (1 + delta a^2 / 2)| "
-               "= 2 eta_e sqrt(a_base^2 - P^2) / a, P = Omega a (mu1 + c mu2 a) / eta_e from the "
-               "peak heights",
-               guess[kEtaE], static_cast<int>(q.size()), kOffResonanceMaxP));
+    steps.push_back(StringPrintf(
+        "eta_e = %.4g: least squares through the origin over %d off-resonance dwells "
+        "(P <= %.1f a_base) of |w^2 + (3/4) alpha a^2 - Omega^2 (1 + delta a^2 / 2)| "
+        "= 2 eta_e sqrt(a_base^2 - P^2) / a, P = Omega a (mu1 + c mu2 a) / eta_e from the "
+        "peak heights",
+        guess[kEtaE], static_cast<int>(q.size()), kOffResonanceMaxP));
   }
   if (!(guess[kEtaE] > 0.0) || !std::isfinite(guess[kEtaE])) {
     throw InputError(
-        Format("automatic initial guess: eta_e estimate %.4g is not positive; "
-               "give eta_e",
-               guess[kEtaE]));
+        StringPrintf("automatic initial guess: eta_e estimate %.4g is not positive; "
+                     "give eta_e",
+                     guess[kEtaE]));
   }
 
   // 5. mu1, mu2 from the peak heights a_base_k / (Omega_k a_k) = m1 + m2 a_k,
@@ -483,14 +478,14 @@ InitialGuessReport AutomaticInitialGuess(const std::vector<const Sweep*>& sweeps
     steps.push_back(given(kMu1));
   } else {
     guess[kMu1] = damping.m1 * eta;
-    steps.push_back(Format("mu1 = %.4g 1/s: %s", guess[kMu1], damping_how.c_str()));
+    steps.push_back(StringPrintf("mu1 = %.4g 1/s: %s", guess[kMu1], damping_how.c_str()));
   }
   if (known[kMu2]) {
     guess[kMu2] = *known[kMu2];
     steps.push_back(given(kMu2));
   } else {
     guess[kMu2] = damping.m2 * eta / kQuadraticDampingFactor;
-    steps.push_back(Format("mu2 = %.4g: %s", guess[kMu2], damping_how.c_str()));
+    steps.push_back(StringPrintf("mu2 = %.4g: %s", guess[kMu2], damping_how.c_str()));
   }
   return report;
 }

@@ -9,9 +9,10 @@
 #include <set>
 
 #include "dwellfit/estimator/common/input_error.h"
-#include "glog/logging.h"
+#include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/residuals/model/bracketed_newton.h"
 #include "dwellfit/residuals/model/response_model.h"
+#include "glog/logging.h"
 
 namespace dwellfit {
 namespace {
@@ -21,13 +22,7 @@ constexpr int kMaxGridSteps = 1000000;
 // is an integer up to rounding of the decimal inputs.
 constexpr double kGridClosureTolerance = 1e-9;
 
-std::string Printf(const char* format, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), format, value);
-  return buffer;
-}
-
-std::string G12(double value) { return Printf("%.12g", value); }
+std::string G12(double value) { return StringPrintf("%.12g", value); }
 
 // The unstable middle root of G(a) = a_base^2, between the turning points;
 // requires both stable branches to exist there (G(a_lower_end) > a_base^2 >
@@ -310,13 +305,13 @@ void DescribeSimulation(const DwellPlan& plan, const std::vector<Sweep>& sweeps,
                        : G12(RadPerSecondToHz(first.drive_frequency_rad_s)) + " Hz")
          << ", " << control(sweep.Control(first)) << " -> "
          << control(sweep.Control(sweep.points.back())) << ", " << sweep.points.size()
-         << " dwells, a " << Printf("%.4g", a_min) << " .. " << Printf("%.4g", a_max);
+         << " dwells, a " << StringPrintf("%.4g", a_min) << " .. " << StringPrintf("%.4g", a_max);
     if (sweep.jumps.empty()) *out << ", no jump";
     for (const JumpBracket& jump : sweep.jumps) {
       *out << ", " << JumpKindName(jump.kind) << " between " << control(jump.control_before)
            << " and " << control(jump.control_after) << " (a "
-           << Printf("%.4g", jump.amplitude_before) << " -> "
-           << Printf("%.4g", jump.amplitude_after) << ")";
+           << StringPrintf("%.4g", jump.amplitude_before) << " -> "
+           << StringPrintf("%.4g", jump.amplitude_after) << ")";
     }
     *out << "\n";
   }

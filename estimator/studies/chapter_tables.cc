@@ -6,38 +6,35 @@
 #include <sstream>
 #include <vector>
 
-#include "dwellfit/estimator/fit/identification.h"
-#include "dwellfit/estimator/run/identify_run.h"
 #include "dwellfit/estimator/analysis/sweep_prediction.h"
+#include "dwellfit/estimator/common/string_printf.h"
+#include "dwellfit/estimator/fit/identification.h"
+#include "dwellfit/estimator/run/resolved_run.h"
 
 namespace dwellfit {
 namespace {
 
 struct PairedFit {
-  ConfiguredSweeps data;
+  ResolvedRun data;
   IdentificationResult with_penalty;
   IdentificationResult without_penalty;
   double omega_ref_rad_s = 0.0;
 };
 
+// The config resolved once and fitted twice: with its penalties and the
+// bifurcation-range penalty enabled, and with no penalty.
 PairedFit FitBothWays(const IdentifyConfig& config) {
   PairedFit fit;
-  fit.data = LoadConfiguredSweeps(config);
-  IdentificationOptions with = config.identification;
-  with.penalties.bifurcation_range.enabled = true;
-  IdentificationOptions without = config.identification;
-  without.penalties.bifurcation_range.enabled = false;
-  without.penalties.branch_stability.enabled = false;
-  fit.with_penalty = Identify(fit.data.fitted, with);
-  fit.without_penalty = Identify(fit.data.fitted, without);
+  fit.data = ResolveRun(config);
+  const PenaltyOptions configured = fit.data.options.penalties;
+  fit.data.options.penalties.bifurcation_range.enabled = true;
+  fit.with_penalty = FitRun(fit.data).best;
+  fit.data.options.penalties.bifurcation_range.enabled = false;
+  fit.data.options.penalties.branch_stability.enabled = false;
+  fit.without_penalty = FitRun(fit.data).best;
+  fit.data.options.penalties = configured;
   fit.omega_ref_rad_s = config.omega_ref_rad_s.value_or(fit.with_penalty.parameters[kOmega]);
   return fit;
-}
-
-std::string Format(const char* format, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), format, value);
-  return buffer;
 }
 
 // The rows: the five model parameters, omega when it was fitted, and the
@@ -62,25 +59,25 @@ std::vector<Row> Rows(const PairedFit& fit, const IdentificationOptions& options
                : fit.without_penalty.parameters[i],
          omega ? RadPerSecondToHz(truth[i]) : truth[i]});
   }
-  rows.push_back(
-      {"effective nonlinearity at " + Format("%.4g", RadPerSecondToHz(fit.omega_ref_rad_s)) + " Hz",
-       EffectiveNonlinearity(fit.with_penalty.parameters, fit.omega_ref_rad_s),
-       EffectiveNonlinearity(fit.without_penalty.parameters, fit.omega_ref_rad_s),
-       EffectiveNonlinearity(truth, fit.omega_ref_rad_s)});
+  rows.push_back({"effective nonlinearity at " +
+                      StringPrintf("%.4g", RadPerSecondToHz(fit.omega_ref_rad_s)) + " Hz",
+                  EffectiveNonlinearity(fit.with_penalty.parameters, fit.omega_ref_rad_s),
+                  EffectiveNonlinearity(fit.without_penalty.parameters, fit.omega_ref_rad_s),
+                  EffectiveNonlinearity(truth, fit.omega_ref_rad_s)});
   return rows;
 }
 
 std::string PercentError(double estimate, double reference) {
   if (reference == 0.0) return estimate == 0.0 ? "0" : "-";
-  return Format("%.3g", 100.0 * std::abs(estimate - reference) / std::abs(reference));
+  return StringPrintf("%.3g", 100.0 * std::abs(estimate - reference) / std::abs(reference));
 }
 
 void SolverLines(const PairedFit& fit, std::ostream& out) {
-  out << "- with penalty: final cost " << Format("%.6g", fit.with_penalty.final_cost) << ", "
+  out << "- with penalty: final cost " << StringPrintf("%.6g", fit.with_penalty.final_cost) << ", "
       << fit.with_penalty.iterations << " iterations, "
       << (fit.with_penalty.converged ? "converged" : "not converged") << "\n";
-  out << "- without penalty: final cost " << Format("%.6g", fit.without_penalty.final_cost) << ", "
-      << fit.without_penalty.iterations << " iterations, "
+  out << "- without penalty: final cost " << StringPrintf("%.6g", fit.without_penalty.final_cost)
+      << ", " << fit.without_penalty.iterations << " iterations, "
       << (fit.without_penalty.converged ? "converged" : "not converged") << "\n\n";
 }
 
@@ -96,7 +93,8 @@ void JumpTable(const PairedFit& fit, std::ostream& out) {
     for (const Sweep* sweep : *group) {
       const bool frequency = sweep->kind == SweepKind::kFrequency;
       auto shown = [frequency](double control) {
-        return frequency ? Format("%.3f Hz", RadPerSecondToHz(control)) : Format("%.4g", control);
+        return frequency ? StringPrintf("%.3f Hz", RadPerSecondToHz(control))
+                         : StringPrintf("%.4g", control);
       };
       const std::vector<PredictedJump> with = PredictJumps(fit.with_penalty.parameters, *sweep);
       const std::vector<PredictedJump> without =
@@ -111,7 +109,7 @@ void JumpTable(const PairedFit& fit, std::ostream& out) {
           if (counted) errors->push_back(error);
           if (!jump.exists) return std::string("no fold | -");
           return shown(jump.control) + (jump.inside ? " (inside)" : "") + " | " +
-                 Format("%.2f", error);
+                 StringPrintf("%.2f", error);
         };
         out << "| " << sweep->Name() << " | " << (fitted ? "fitted" : "held out") << " | "
             << JumpKindName(with[j].kind) << " | " << shown(with[j].bracket.control_before) << " - "
@@ -124,7 +122,7 @@ void JumpTable(const PairedFit& fit, std::ostream& out) {
     if (values.empty()) return std::string("-");
     std::sort(values.begin(), values.end());
     const size_t n = values.size();
-    return Format("%.2f", n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]));
+    return StringPrintf("%.2f", n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]));
   };
   if (!held_out_with.empty()) {
     out << "\nMedian error of the predicted jump-down frequency over the " << held_out_with.size()
@@ -156,10 +154,11 @@ std::string ChapterTablesMarkdown(const IdentifyConfig& numerical, const Paramet
       << "`)\n\n"
       << "| parameter | known value | with penalty | error % | without penalty | error % |\n"
       << "|---|---|---|---|---|---|\n";
-  for (const Row& row : Rows(thesis, numerical.identification, truth)) {
-    out << "| " << row.name << " | " << Format("%.6g", row.truth) << " | "
-        << Format("%.8g", row.with_penalty) << " | " << PercentError(row.with_penalty, row.truth)
-        << " | " << Format("%.8g", row.without_penalty) << " | "
+  for (const Row& row : Rows(thesis, thesis.data.options, truth)) {
+    out << "| " << row.name << " | " << StringPrintf("%.6g", row.truth) << " | "
+        << StringPrintf("%.8g", row.with_penalty) << " | "
+        << PercentError(row.with_penalty, row.truth) << " | "
+        << StringPrintf("%.8g", row.without_penalty) << " | "
         << PercentError(row.without_penalty, row.truth) << " |\n";
   }
   out << "\n";
@@ -175,9 +174,9 @@ std::string ChapterTablesMarkdown(const IdentifyConfig& numerical, const Paramet
       << "Percent comparison: |with - without| / |with|.\n\n"
       << "| parameter | with penalty | without penalty | percent comparison |\n"
       << "|---|---|---|---|\n";
-  for (const Row& row : Rows(beam, measured.identification, ParameterVector{})) {
-    out << "| " << row.name << " | " << Format("%.6g", row.with_penalty) << " | "
-        << Format("%.6g", row.without_penalty) << " | "
+  for (const Row& row : Rows(beam, beam.data.options, ParameterVector{})) {
+    out << "| " << row.name << " | " << StringPrintf("%.6g", row.with_penalty) << " | "
+        << StringPrintf("%.6g", row.without_penalty) << " | "
         << PercentError(row.without_penalty, row.with_penalty) << " |\n";
   }
   out << "\n";

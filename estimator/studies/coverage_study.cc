@@ -5,10 +5,11 @@
 #include <cmath>
 #include <cstdio>
 
-#include "dwellfit/estimator/fit/identification.h"
-#include "dwellfit/estimator/run/identify_run.h"
-#include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/analysis/parameter_uncertainty.h"
+#include "dwellfit/estimator/common/string_printf.h"
+#include "dwellfit/estimator/data/jump_detection.h"
+#include "dwellfit/estimator/fit/identification.h"
+#include "dwellfit/estimator/run/resolved_run.h"
 
 namespace dwellfit {
 namespace {
@@ -39,6 +40,40 @@ void Finish(const RowSums& sums, CoverageRow* row) {
     row->mean_standard_error = sums.sum_standard_error / sums.with_interval;
 }
 
+// Adds one replica's fit and uncertainty to the study; `rows` are the
+// parameter indices of study->rows (kNumParameters: alpha_e).
+void AddReplica(const IdentificationResult& result, const ParameterUncertainty& u,
+                const std::vector<int>& rows, std::vector<RowSums>* sums, CoverageStudy* study) {
+  study->converged += result.converged;
+  if (u.available) {
+    ++study->available;
+  } else if (std::find(study->messages.begin(), study->messages.end(), u.message) ==
+             study->messages.end()) {
+    study->messages.push_back(u.message);
+  }
+  for (size_t j = 0; j < rows.size(); ++j) {
+    const bool effective = rows[j] == kNumParameters;
+    const double estimate = effective ? u.effective_nonlinearity : result.parameters[rows[j]];
+    const double low = effective ? u.effective_nonlinearity_ci95_low : u.ci95_low[rows[j]];
+    const double high = effective ? u.effective_nonlinearity_ci95_high : u.ci95_high[rows[j]];
+    const double standard_error =
+        effective ? u.effective_nonlinearity_standard_error : u.standard_error[rows[j]];
+    CoverageRow& row = study->rows[j];
+    (*sums)[j].Add(estimate);
+    const bool bounded = rows[j] == kEtaE || rows[j] == kMu1 || rows[j] == kMu2;
+    row.on_bound += bounded && estimate <= 0.0;
+    if (!u.available) continue;
+    ++(*sums)[j].with_interval;
+    (*sums)[j].sum_standard_error += standard_error;
+    const bool covered = low <= row.truth && row.truth <= high;
+    row.covered += covered;
+    if (u.dwells_past_branch_end < kKinkedFitDwells) {
+      ++row.smooth_replicas;
+      row.smooth_covered += covered;
+    }
+  }
+}
+
 }  // namespace
 
 CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& plan,
@@ -47,12 +82,11 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
   CoverageStudy study;
   study.replicas = options.replicas;
   study.omega_ref_rad_s = config.omega_ref_rad_s ? *config.omega_ref_rad_s : plan.truth[kOmega];
-  const IdentificationOptions& identification = config.identification;
 
   // Rows: the free parameters, then alpha_e (index kNumParameters).
   std::vector<int> rows;
   for (int i = 0; i < kNumParameters; ++i) {
-    if (!identification.fixed[i]) rows.push_back(i);
+    if (!config.identification.fixed[i]) rows.push_back(i);
   }
   rows.push_back(kNumParameters);
   std::vector<RowSums> sums(rows.size());
@@ -70,43 +104,20 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
     DwellPlan replica_plan = plan;
     replica_plan.noise.relative_sigma = options.relative_noise;
     replica_plan.noise.seed = options.first_seed + static_cast<std::uint64_t>(r);
-    std::vector<Sweep> sweeps = SimulateDwells(replica_plan);
-    DetectJumps(config.jump_detection, &sweeps);
-    const std::vector<const Sweep*> fitted =
-        SelectSweeps(sweeps, config.fit_sweeps, config.config_path, "fit");
-    const IdentificationResult result = Identify(fitted, identification);
-    study.converged += result.converged;
+    // The simulated sweeps go the way of measured ones: labelled, the
+    // config's jumps applied, selected, the start found from them.
+    const ResolvedRun run = ResolveRun(config, SimulateDwells(replica_plan));
+    const IdentificationResult result = FitRun(run).best;
     const ParameterUncertainty u =
-        EstimateUncertainty(fitted, identification, result.parameters, study.omega_ref_rad_s);
-    if (r == 0) study.degrees_of_freedom = u.degrees_of_freedom;
-    if (u.available) {
-      ++study.available;
-      sum_noise_sigma += u.noise_sigma;
-    } else if (std::find(study.messages.begin(), study.messages.end(), u.message) ==
-               study.messages.end()) {
-      study.messages.push_back(u.message);
+        EstimateUncertainty(run.fitted, run.options, result.parameters, study.omega_ref_rad_s);
+    if (r == 0) {
+      study.degrees_of_freedom = u.degrees_of_freedom;
+      study.start_from_data = run.guessed_from_data;
+      for (const Sweep* sweep : run.fitted)
+        study.first_replica_jumps.push_back(DescribeJumps(*sweep));
     }
-    for (size_t j = 0; j < rows.size(); ++j) {
-      const bool effective = rows[j] == kNumParameters;
-      const double estimate = effective ? u.effective_nonlinearity : result.parameters[rows[j]];
-      const double low = effective ? u.effective_nonlinearity_ci95_low : u.ci95_low[rows[j]];
-      const double high = effective ? u.effective_nonlinearity_ci95_high : u.ci95_high[rows[j]];
-      const double standard_error =
-          effective ? u.effective_nonlinearity_standard_error : u.standard_error[rows[j]];
-      sums[j].Add(estimate);
-      const bool bounded = rows[j] == kEtaE || rows[j] == kMu1 || rows[j] == kMu2;
-      study.rows[j].on_bound += bounded && estimate <= 0.0;
-      if (!u.available) continue;
-      ++sums[j].with_interval;
-      sums[j].sum_standard_error += standard_error;
-      const double truth = study.rows[j].truth;
-      const bool covered = low <= truth && truth <= high;
-      study.rows[j].covered += covered;
-      if (u.dwells_past_branch_end < kKinkedFitDwells) {
-        ++study.rows[j].smooth_replicas;
-        study.rows[j].smooth_covered += covered;
-      }
-    }
+    if (u.available) sum_noise_sigma += u.noise_sigma;
+    AddReplica(result, u, rows, &sums, &study);
   }
   for (size_t j = 0; j < rows.size(); ++j) Finish(sums[j], &study.rows[j]);
   if (study.available > 0) study.mean_noise_sigma = sum_noise_sigma / study.available;
@@ -115,28 +126,26 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
 }
 
 void PrintCoverageStudy(const CoverageStudy& study, std::ostream& out) {
-  char line[256];
-  std::snprintf(line, sizeof(line),
-                "%d replicas: %d converged, %d with a covariance; %d degrees of freedom; mean "
-                "noise sigma %.4g; alpha_e at Omega_ref = 2 pi %.4g Hz; %.2f s\n",
-                study.replicas, study.converged, study.available, study.degrees_of_freedom,
-                study.mean_noise_sigma, RadPerSecondToHz(study.omega_ref_rad_s), study.seconds);
-  out << line;
-  std::snprintf(line, sizeof(line), "%-9s %12s %10s %12s %12s %8s %9s %9s %17s\n", "parameter",
-                "truth", "coverage", "mean se", "empirical sd", "se/sd", "bias/sd", "on bound",
-                "smooth-fit cover");
-  out << line;
+  out << StringPrintf(
+      "%d replicas: %d converged, %d with a covariance; %d degrees of freedom; mean "
+      "noise sigma %.4g; alpha_e at Omega_ref = 2 pi %.4g Hz; %.2f s\n",
+      study.replicas, study.converged, study.available, study.degrees_of_freedom,
+      study.mean_noise_sigma, RadPerSecondToHz(study.omega_ref_rad_s), study.seconds);
+  out << "start: " << (study.start_from_data ? "found from each replica's data" : "the config's")
+      << "; replica 0's fitted sweeps:\n";
+  for (const std::string& jumps : study.first_replica_jumps) out << "  " << jumps << "\n";
+  out << StringPrintf("%-9s %12s %10s %12s %12s %8s %9s %9s %17s\n", "parameter", "truth",
+                      "coverage", "mean se", "empirical sd", "se/sd", "bias/sd", "on bound",
+                      "smooth-fit cover");
   for (const CoverageRow& row : study.rows) {
     const double ratio =
         row.empirical_std > 0.0 ? row.mean_standard_error / row.empirical_std : 0.0;
     const double bias =
         row.empirical_std > 0.0 ? (row.mean_estimate - row.truth) / row.empirical_std : 0.0;
-    std::snprintf(line, sizeof(line),
-                  "%-9s %12.5g %9.1f%% %12.4g %12.4g %8.3f %9.3f %9d %7.1f%% of %4d\n",
-                  row.name.c_str(), row.truth, 100.0 * row.Coverage(), row.mean_standard_error,
-                  row.empirical_std, ratio, bias, row.on_bound, 100.0 * row.SmoothCoverage(),
-                  row.smooth_replicas);
-    out << line;
+    out << StringPrintf("%-9s %12.5g %9.1f%% %12.4g %12.4g %8.3f %9.3f %9d %7.1f%% of %4d\n",
+                        row.name.c_str(), row.truth, 100.0 * row.Coverage(),
+                        row.mean_standard_error, row.empirical_std, ratio, bias, row.on_bound,
+                        100.0 * row.SmoothCoverage(), row.smooth_replicas);
   }
   for (const std::string& message : study.messages) out << "no covariance: " << message << "\n";
 }

@@ -2,14 +2,14 @@
 // truth 95 % of the time?
 //
 // Each replica r = 0..R-1 simulates the dwell plan with multiplicative noise
-// a *= 1 + sigma_rel N(0, 1) (seed first_seed + r), labels branches with
-// DetectJumps on the noisy sweeps, selects the config's fitted sweeps, fits
-// with Identify from the config's start, and estimates the uncertainty at the
-// estimate, exactly as a measured run would. For every free parameter and for
-// alpha_e = alpha - (2/3) delta Omega_ref^2 it counts the replicas whose 95 %
-// interval contains the plan's truth, and compares the mean standard error
-// with the empirical standard deviation of the estimates over the replicas
-// (the two agree when the linearised covariance is right).
+// a *= 1 + sigma_rel N(0, 1) (seed first_seed + r) and takes the path of a
+// measured run (resolved_run.h): branches labelled by jump detection on the
+// noisy sweeps and the config's `jumps:`, the config's sweeps selected, the
+// initial guesses it leaves out found from the replica's data, the fit
+// (multi-start when configured), and the uncertainty at the estimate. For every free parameter and
+// for alpha_e = alpha - (2/3) delta Omega_ref^2 it counts the replicas whose 95 % interval contains
+// the plan's truth, and compares the mean standard error with the empirical standard deviation of
+// the estimates over the replicas (the two agree when the linearised covariance is right).
 #ifndef DWELLFIT_ESTIMATOR_STUDIES_COVERAGE_STUDY_H_
 #define DWELLFIT_ESTIMATOR_STUDIES_COVERAGE_STUDY_H_
 
@@ -64,13 +64,18 @@ struct CoverageStudy {
   int degrees_of_freedom = 0;         // of the first replica
   std::vector<CoverageRow> rows;      // free parameters in index order, then alpha_e
   std::vector<std::string> messages;  // distinct unavailability messages, if any
-  double seconds = 0.0;               // wall time of all replicas
+  // Whether some initial guess came from each replica's data.
+  bool start_from_data = false;
+  // Replica 0's fitted sweeps with their jumps (DescribeJumps).
+  std::vector<std::string> first_replica_jumps;
+  double seconds = 0.0;  // wall time of all replicas
 };
 
 // Runs the study on the config's fitted sweeps of `plan` (its noise is
 // replaced by options'). Omega_ref: the config's effective-nonlinearity
-// reference, else the truth's omega. Throws InputError when the plan or the
-// selection is not valid.
+// reference, else the truth's omega. Throws InputError when the plan, the
+// selection or a `jumps:` entry does not fit the simulated sweeps, or when no
+// start can be found from a replica's data.
 CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& plan,
                                const CoverageStudyOptions& options);
 

@@ -13,11 +13,10 @@
 
 #include "dwellfit/config/dwell_plan_reader.h"
 #include "dwellfit/config/identify_config.h"
-#include "dwellfit/estimator/studies/coverage_study.h"
-#include "dwellfit/estimator/simulation/dwell_simulator.h"
 #include "dwellfit/estimator/fit/identification.h"
-#include "dwellfit/estimator/run/identify_run.h"
-#include "dwellfit/estimator/data/jump_detection.h"
+#include "dwellfit/estimator/run/resolved_run.h"
+#include "dwellfit/estimator/simulation/dwell_simulator.h"
+#include "dwellfit/estimator/studies/coverage_study.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 
@@ -55,29 +54,25 @@ class UncertaintyThesisNumerical : public ::testing::Test {
     config_ = LoadIdentifyConfig(kDataset + "/beam.yaml");
     ASSERT_TRUE(config_.omega_ref_rad_s.has_value());
     omega_ref_ = *config_.omega_ref_rad_s;
-    exact_ = LoadLabelledSweeps(config_.data_files, config_.jump_detection);
+    exact_ = ResolveRun(config_);
   }
 
-  // The plan simulated with 1 % multiplicative noise, branches labelled from
-  // the noisy data as for measured sweeps.
-  std::vector<Sweep> NoisySweeps(std::uint64_t seed) const {
+  // The plan simulated with 1 % multiplicative noise, resolved as measured
+  // sweeps are (branches labelled from the noisy data).
+  ResolvedRun NoisyRun(std::uint64_t seed) const {
     DwellPlan plan = ReadDwellPlan(kDataset + "/plan.yaml");
     plan.noise.relative_sigma = 0.01;
     plan.noise.seed = seed;
-    std::vector<Sweep> sweeps = SimulateDwells(plan);
-    DetectJumps(config_.jump_detection, &sweeps);
-    return sweeps;
+    return ResolveRun(config_, SimulateDwells(plan));
   }
 
-  std::vector<const Sweep*> Fitted(const std::vector<Sweep>& sweeps) const {
-    return SelectSweeps(sweeps, config_.fit_sweeps, config_.config_path, "fit");
-  }
+  static std::vector<const Sweep*> Fitted(const ResolvedRun& run) { return run.fitted; }
 
   // Both directions of the sweeps with these ids.
-  static std::vector<const Sweep*> Named(const std::vector<Sweep>& sweeps,
+  static std::vector<const Sweep*> Named(const ResolvedRun& run,
                                          const std::vector<std::string>& ids) {
     std::vector<const Sweep*> selected;
-    for (const Sweep& sweep : sweeps) {
+    for (const Sweep& sweep : run.sweeps) {
       for (const std::string& id : ids) {
         if (sweep.id == id) selected.push_back(&sweep);
       }
@@ -87,7 +82,7 @@ class UncertaintyThesisNumerical : public ::testing::Test {
 
   IdentifyConfig config_;
   double omega_ref_ = 0.0;
-  std::vector<Sweep> exact_;
+  ResolvedRun exact_;
 };
 
 TEST_F(UncertaintyThesisNumerical, ExactDataAtTheTruthGivesTinyIntervalsAroundIt) {
@@ -110,7 +105,7 @@ TEST_F(UncertaintyThesisNumerical, ExactDataAtTheTruthGivesTinyIntervalsAroundIt
 }
 
 TEST_F(UncertaintyThesisNumerical, NoisyFitGivesStudentTIntervalsFromTheResidualNoise) {
-  const std::vector<Sweep> noisy = NoisySweeps(20261121);
+  const ResolvedRun noisy = NoisyRun(20261121);
   const std::vector<const Sweep*> fitted = Fitted(noisy);
   const IdentificationResult result = Identify(fitted, config_.identification);
   const ParameterUncertainty u =
@@ -147,13 +142,13 @@ TEST_F(UncertaintyThesisNumerical, NoisyFitGivesStudentTIntervalsFromTheResidual
 }
 
 TEST_F(UncertaintyThesisNumerical, PointSigmasStandardiseTheResidualsAndUseTheNormalQuantile) {
-  std::vector<Sweep> noisy = NoisySweeps(20261121);
+  ResolvedRun noisy = NoisyRun(20261121);
   const std::vector<const Sweep*> fitted = Fitted(noisy);
   const IdentificationResult result = Identify(fitted, config_.identification);
   const ParameterUncertainty estimated =
       EstimateUncertainty(fitted, config_.identification, result.parameters, omega_ref_);
   // The true standard deviation of every amplitude: 1 % of it (ln a: 0.01).
-  for (Sweep& sweep : noisy) {
+  for (Sweep& sweep : noisy.sweeps) {
     for (DwellPoint& point : sweep.points) point.sigma = 0.01 * point.amplitude;
   }
   IdentificationOptions options = config_.identification;
@@ -176,7 +171,7 @@ TEST_F(UncertaintyThesisNumerical, PointSigmasStandardiseTheResidualsAndUseTheNo
   EXPECT_THAT(given.warnings, ::testing::Each(Not(HasSubstr("sigma"))));
 
   // Only some points with a sigma: mixed units, said so.
-  for (DwellPoint& point : noisy[0].points) point.sigma.reset();
+  for (DwellPoint& point : noisy.sweeps[0].points) point.sigma.reset();
   const ParameterUncertainty mixed =
       EstimateUncertainty(fitted, options, result.parameters, omega_ref_);
   EXPECT_THAT(mixed.warnings, ::testing::Contains(HasSubstr("only some points have a sigma")));
@@ -223,7 +218,7 @@ TEST_F(UncertaintyThesisNumerical, AmplitudeSweepAloneCannotSeparateDeltaAndAlph
 TEST_F(UncertaintyThesisNumerical, FrequencySweepAloneWarnsButKeepsTheEffectiveNonlinearity) {
   // Omega^2 varies by 47 % over 38-46 Hz, so delta and alpha are separable in
   // principle but correlate beyond 0.99: a warning, not a failure.
-  const std::vector<Sweep> noisy = NoisySweeps(7);
+  const ResolvedRun noisy = NoisyRun(7);
   const std::vector<const Sweep*> fitted = Named(noisy, {"F0.01"});
   const IdentificationResult result = Identify(fitted, config_.identification);
   const ParameterUncertainty u =
@@ -241,7 +236,7 @@ TEST_F(UncertaintyThesisNumerical, FrequencySweepAloneWarnsButKeepsTheEffectiveN
 }
 
 TEST_F(UncertaintyThesisNumerical, FixedParametersHaveZeroErrorAndStayOutOfWarnings) {
-  const std::vector<Sweep> noisy = NoisySweeps(3);
+  const ResolvedRun noisy = NoisyRun(3);
   const std::vector<const Sweep*> fitted = Fitted(noisy);
   IdentificationOptions options = config_.identification;
   options.initial[kDelta] = kTruth[kDelta];

@@ -6,12 +6,13 @@
 
 #include "dwellfit/config/config_override.h"
 #include "dwellfit/config/identify_config.h"
-#include "dwellfit/estimator/run/identify_run.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/data/jump_detection.h"
+#include "dwellfit/estimator/run/identify_run.h"
+#include "dwellfit/estimator/run/resolved_run.h"
+#include "dwellfit/residuals/model/model_parameters.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
-#include "dwellfit/residuals/model/model_parameters.h"
 #include "tests/config_test_support.h"
 
 namespace dwellfit {
@@ -222,9 +223,8 @@ TEST(ConfigJumps, ApplyToTheMeasuredBeamAfterDetection) {
   - sweep: L0.040g/down
     none: true
 )")));
-  std::vector<Sweep> sweeps = LoadLabelledSweeps(config.data_files, config.jump_detection);
-  ApplyJumpOverrides(config.jump_overrides, config.config_path, &sweeps);
-  for (const Sweep& sweep : sweeps) {
+  const ResolvedRun run = ResolveRun(config);
+  for (const Sweep& sweep : run.sweeps) {
     if (sweep.Name() == "L0.060g/down") {
       ASSERT_EQ(sweep.jumps.size(), 1u);
       EXPECT_EQ(sweep.jumps[0].control_before, HzToRadPerSecond(161.07));

@@ -9,10 +9,10 @@
 
 #include "ceres/problem.h"
 #include "dwellfit/config/identify_config.h"
-#include "dwellfit/estimator/fit/identification.h"
-#include "dwellfit/estimator/run/identify_run.h"
-#include "dwellfit/estimator/fit/problem_builder.h"
 #include "dwellfit/estimator/analysis/sweep_prediction.h"
+#include "dwellfit/estimator/fit/identification.h"
+#include "dwellfit/estimator/fit/problem_builder.h"
+#include "dwellfit/estimator/run/resolved_run.h"
 #include "gtest/gtest.h"
 
 namespace dwellfit {
@@ -25,8 +25,8 @@ class ClampedBeamIdentification : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     config_ = new IdentifyConfig(LoadIdentifyConfig(kBeamConfig));
-    data_ = new ConfiguredSweeps(LoadConfiguredSweeps(*config_));
-    committed_ = new IdentificationResult(Identify(data_->fitted, config_->identification));
+    data_ = new ResolvedRun(ResolveRun(*config_));
+    committed_ = new IdentificationResult(FitRun(*data_).best);
   }
   static void TearDownTestSuite() {
     delete committed_;
@@ -35,12 +35,12 @@ class ClampedBeamIdentification : public ::testing::Test {
   }
 
   static IdentifyConfig* config_;
-  static ConfiguredSweeps* data_;
+  static ResolvedRun* data_;
   static IdentificationResult* committed_;  // the committed config's fit
 };
 
 IdentifyConfig* ClampedBeamIdentification::config_ = nullptr;
-ConfiguredSweeps* ClampedBeamIdentification::data_ = nullptr;
+ResolvedRun* ClampedBeamIdentification::data_ = nullptr;
 IdentificationResult* ClampedBeamIdentification::committed_ = nullptr;
 
 // The bars with the penalty on: the damping stays physical (the

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "dwellfit/config/identify_config.h"
-#include "dwellfit/estimator/run/identify_run.h"
 #include "dwellfit/estimator/fit/initial_guess.h"
+#include "dwellfit/estimator/run/resolved_run.h"
 #include "gtest/gtest.h"
 
 namespace dwellfit {
@@ -29,11 +29,11 @@ class ThesisStarts : public ::testing::Test {
  protected:
   void SetUp() override {
     config_ = LoadIdentifyConfig(kThesis + "/beam.yaml");
-    sweeps_ = LoadLabelledSweeps(config_.data_files, config_.jump_detection);
-    fitted_ = SelectSweeps(sweeps_, config_.fit_sweeps, config_.config_path, "fit");
+    run_ = ResolveRun(config_);
+    fitted_ = run_.fitted;
   }
   IdentifyConfig config_;
-  std::vector<Sweep> sweeps_;
+  ResolvedRun run_;
   std::vector<const Sweep*> fitted_;
 };
 
@@ -110,9 +110,8 @@ TEST_F(ThesisStarts, NoGuessesAtAllReachTheTruth) {
 // (in cost) the guided fit of the committed config.
 TEST(ClampedBeamStarts, NoGuessesMatchTheGuidedFit) {
   const IdentifyConfig config = LoadIdentifyConfig(kBeam + "/beam.yaml");
-  std::vector<Sweep> sweeps = LoadLabelledSweeps(config.data_files, config.jump_detection);
-  const std::vector<const Sweep*> fitted =
-      SelectSweeps(sweeps, config.fit_sweeps, config.config_path, "fit");
+  const ResolvedRun run = ResolveRun(config);
+  const std::vector<const Sweep*>& fitted = run.fitted;
   const IdentificationResult guided = Identify(fitted, config.identification);
   IdentificationOptions automatic = config.identification;
   automatic.initial = AutomaticInitialGuess(fitted, KnownParameters{}).guess;

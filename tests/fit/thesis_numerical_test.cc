@@ -6,11 +6,10 @@
 
 #include "dwellfit/config/dwell_plan_reader.h"
 #include "dwellfit/config/identify_config.h"
-#include "dwellfit/estimator/simulation/dwell_simulator.h"
-#include "dwellfit/estimator/fit/identification.h"
-#include "dwellfit/estimator/run/identify_run.h"
-#include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/analysis/sweep_prediction.h"
+#include "dwellfit/estimator/fit/identification.h"
+#include "dwellfit/estimator/run/resolved_run.h"
+#include "dwellfit/estimator/simulation/dwell_simulator.h"
 #include "gtest/gtest.h"
 
 namespace dwellfit {
@@ -23,9 +22,9 @@ class ThesisNumerical : public ::testing::Test {
  protected:
   void SetUp() override {
     config_ = LoadIdentifyConfig(kDataset + "/beam.yaml");
-    sweeps_ = LoadLabelledSweeps(config_.data_files, config_.jump_detection);
-    fitted_ = SelectSweeps(sweeps_, config_.fit_sweeps, config_.config_path, "fit");
-    validation_ = SelectSweeps(sweeps_, config_.validate_sweeps, config_.config_path, "validate");
+    run_ = ResolveRun(config_);
+    fitted_ = run_.fitted;
+    validation_ = run_.validation;
   }
 
   IdentificationOptions StartAt(const std::vector<double>& factors) const {
@@ -35,7 +34,7 @@ class ThesisNumerical : public ::testing::Test {
   }
 
   IdentifyConfig config_;
-  std::vector<Sweep> sweeps_;
+  ResolvedRun run_;
   std::vector<const Sweep*> fitted_;
   std::vector<const Sweep*> validation_;
 };
@@ -124,12 +123,9 @@ TEST_F(ThesisNumerical, OnePercentNoiseKeepsEtaAndTheEffectiveNonlinearityWithin
   DwellPlan plan = ReadDwellPlan(kDataset + "/plan.yaml");
   plan.noise.relative_sigma = 0.01;
   plan.noise.seed = 20261121;
-  std::vector<Sweep> noisy = SimulateDwells(plan);
-  // Label branches from the noisy data, as for measured sweeps.
-  DetectJumps(config_.jump_detection, &noisy);
-  const std::vector<const Sweep*> fitted =
-      SelectSweeps(noisy, config_.fit_sweeps, config_.config_path, "fit");
-  const IdentificationResult result = Identify(fitted, config_.identification);
+  // Labelled from the noisy data and fitted as measured sweeps are.
+  const ResolvedRun noisy = ResolveRun(config_, SimulateDwells(plan));
+  const IdentificationResult result = FitRun(noisy).best;
   EXPECT_TRUE(result.converged);
   EXPECT_NEAR(result.parameters[kEtaE] / kTruth[kEtaE], 1.0, 0.01);
   ASSERT_TRUE(config_.omega_ref_rad_s.has_value());

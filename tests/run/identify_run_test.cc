@@ -76,6 +76,28 @@ TEST(RunIdentify, WritesResultYamlAndPredictionsForTheThesisCase) {
   EXPECT_EQ(manifest["files"][1]["bytes"].as<std::size_t>(), csv.size());
 }
 
+// A config with no initial guess at all: the run finds the start from the
+// data, says how, and reaches the truth with omega free.
+TEST(RunIdentify, WithNoGuessesFindsTheStartFromTheDataAndReachesTheTruth) {
+  const std::string out_dir = FreshDir("automatic");
+  const IdentifyConfig config = LoadIdentifyConfig(kConfig, {{"output_dir", out_dir, "--test"},
+                                                             {"initial_guess", "auto", "--test"},
+                                                             {"fixed", "[]", "--test"}});
+  std::ostringstream printed;
+  RunIdentify(config, printed);
+  EXPECT_THAT(printed.str(), HasSubstr("automatic initial guess:\n  "));
+  EXPECT_THAT(printed.str(), Not(HasSubstr("automatic start of the multi-start")));
+  const YAML::Node result = YAML::LoadFile(out_dir + "/result.yaml");
+  ASSERT_TRUE(result["automatic_initial_guess"].IsSequence());
+  EXPECT_GE(result["automatic_initial_guess"].size(), 6u);  // a line per parameter at least
+  EXPECT_TRUE(result["converged"].as<bool>());
+  EXPECT_NEAR(result["parameters"]["eta_e"]["value"].as<double>(), 100.0, 1e-4);
+  EXPECT_NEAR(result["parameters"]["mu1"]["value"].as<double>(), 0.2, 1e-7);
+  EXPECT_NEAR(result["parameters"]["mu2"]["value"].as<double>(), 300.0, 1e-3);
+  EXPECT_NEAR(result["parameters"]["alpha"]["value"].as<double>(), 9e8, 1e3);
+  EXPECT_NEAR(result["parameters"]["omega"]["value"].as<double>(), HzToRadPerSecond(40.0), 1e-9);
+}
+
 TEST(RunIdentify, SameInputGivesTheSameFiles) {
   std::string first[2];
   for (int run = 0; run < 2; ++run) {

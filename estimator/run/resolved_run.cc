@@ -1,0 +1,195 @@
+#include "dwellfit/estimator/run/resolved_run.h"
+
+#include <algorithm>
+#include <map>
+#include <utility>
+
+#include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/data/jump_detection.h"
+#include "dwellfit/estimator/data/sweep_csv.h"
+#include "dwellfit/estimator/fit/initial_guess.h"
+
+namespace dwellfit {
+namespace {
+
+// Every sweep of the data files; sweep names must be unique across files.
+std::vector<Sweep> LoadSweeps(const std::vector<std::string>& data_files) {
+  std::vector<Sweep> sweeps;
+  std::map<std::string, std::string> file_of_sweep;
+  for (const std::string& file : data_files) {
+    LoadedSweeps loaded = LoadSweepsCsv(file);
+    for (Sweep& sweep : loaded.sweeps) {
+      const auto [it, inserted] = file_of_sweep.emplace(sweep.Name(), file);
+      if (!inserted) {
+        throw InputError(file, sweep.points.front().source_line, "sweep",
+                         "sweep '" + sweep.Name() + "' also appears in " + it->second +
+                             "; give the sweeps of different files different ids");
+      }
+      sweeps.push_back(std::move(sweep));
+    }
+  }
+  return sweeps;
+}
+
+// The sweeps `selections` name, in data order. Throws InputError naming
+// `config_path` and `field` when a selection matches no sweep.
+std::vector<const Sweep*> SelectSweeps(const std::vector<Sweep>& sweeps,
+                                       const std::vector<SweepSelection>& selections,
+                                       const std::string& config_path, const std::string& field) {
+  for (const SweepSelection& selection : selections) {
+    bool found = false;
+    for (const Sweep& sweep : sweeps) found = found || selection.Selects(sweep);
+    if (!found) {
+      std::string available;
+      for (const Sweep& sweep : sweeps) available += (available.empty() ? "" : ", ") + sweep.Name();
+      throw InputError(
+          config_path, 0, field,
+          "sweep '" + selection.Name() + "' is not in the data; available: " + available);
+    }
+  }
+  std::vector<const Sweep*> selected;
+  for (const Sweep& sweep : sweeps) {
+    for (const SweepSelection& selection : selections) {
+      if (selection.Selects(sweep)) {
+        selected.push_back(&sweep);
+        break;
+      }
+    }
+  }
+  return selected;
+}
+
+// Throws when the fitted sweeps hold no more dwells than there are free
+// parameters: such a fit interpolates (or is underdetermined) and has no
+// degree of freedom left to estimate the noise, so no usable result.
+void CheckEnoughDwells(const IdentifyConfig& config, const std::vector<const Sweep*>& fitted) {
+  std::size_t dwells = 0;
+  for (const Sweep* sweep : fitted) dwells += sweep->points.size();
+  const auto free = static_cast<std::size_t>(
+      std::count(config.identification.fixed.begin(), config.identification.fixed.end(), false));
+  if (dwells > free) return;
+  std::string names;
+  for (const Sweep* sweep : fitted) {
+    names += (names.empty() ? "" : ", ") + sweep->Name() + " (" +
+             std::to_string(sweep->points.size()) + ")";
+  }
+  throw InputError(config.config_path, 0, "fit",
+                   "the fitted sweeps hold " + std::to_string(dwells) + " measured dwell(s) (" +
+                       names + ") for " + std::to_string(free) +
+                       " free parameters; a fit needs more dwells than free parameters: fit more "
+                       "sweeps, or fix parameters (fixed: with their initial_guess)");
+}
+
+// A fixed parameter is held at its initial value, so that value must be
+// the user's: held at an estimate from the data, it would bias every other
+// parameter without a word.
+void CheckFixedAreGiven(const IdentifyConfig& config) {
+  for (int i = 0; i < kNumParameters; ++i) {
+    if (!config.identification.fixed[i] || config.initial_guess[i]) continue;
+    const std::string key = i == kOmega ? "omega_hz" : ParameterName(i);
+    throw InputError(config.config_path, 0, "fixed",
+                     std::string(ParameterName(i)) +
+                         " is held fixed but its initial guess is left to the data (auto); give "
+                         "initial_guess." +
+                         key + ", or remove it from 'fixed'");
+  }
+}
+
+// The settings blocks are checked when the config is loaded (at their
+// lines); checked again here because a config can also be built in code.
+void CheckSettings(const IdentifyConfig& config) {
+  const std::string& path = config.config_path;
+  const IdentificationOptions& options = config.identification;
+  std::string message;
+  if (!options.solver.IsValid(&message)) throw InputError(path, 0, "solver", message);
+  if (!options.penalties.bifurcation_range.IsValid(&message)) {
+    throw InputError(path, 0, "penalties.bifurcation_range", message);
+  }
+  if (!options.penalties.branch_stability.IsValid(&message)) {
+    throw InputError(path, 0, "penalties.branch_stability", message);
+  }
+  if (options.stages.empty()) {
+    throw InputError(path, 0, "stages", "at least one fit stage is required");
+  }
+  if (!config.multi_start.IsValid(&message)) throw InputError(path, 0, "multi_start", message);
+  if (!config.jump_detection.IsValid(&message)) {
+    throw InputError(path, 0, "jump_detection", message);
+  }
+  CheckFixedAreGiven(config);
+}
+
+// Fills the guesses the config leaves to the data into run->options.initial,
+// estimated from the fitted sweeps with the given guesses as known.
+void FillGuessesFromData(const IdentifyConfig& config, ResolvedRun* run) {
+  const KnownParameters& given = config.initial_guess;
+  run->guessed_from_data = std::any_of(given.begin(), given.end(),
+                                       [](const std::optional<double>& value) { return !value; });
+  if (!run->guessed_from_data) return;
+  InitialGuessReport guess;
+  try {
+    guess = AutomaticInitialGuess(run->fitted, given);
+  } catch (const InputError& error) {
+    throw InputError(config.config_path, 0, "initial_guess",
+                     std::string("cannot find a starting point from the data: ") + error.what() +
+                         "; give the initial guesses in the config");
+  }
+  for (int i = 0; i < kNumParameters; ++i) {
+    if (!given[i]) run->options.initial[i] = guess.guess[i];
+  }
+  run->initial_guess_steps = std::move(guess.steps);
+}
+
+// The multi-start's automatic start: every free parameter from the data
+// (the fixed ones at their given values), so that it differs from start 0
+// whenever guesses are given. Without a resonance to estimate from, the
+// multi-start does without it.
+void FindAutomaticStart(const IdentifyConfig& config, ResolvedRun* run) {
+  if (config.multi_start.starts <= 1) return;
+  KnownParameters fixed;
+  for (int i = 0; i < kNumParameters; ++i) {
+    if (config.identification.fixed[i]) fixed[i] = config.initial_guess[i];
+  }
+  try {
+    InitialGuessReport guess = AutomaticInitialGuess(run->fitted, fixed);
+    run->automatic_start = guess.guess;
+    run->automatic_start_steps = std::move(guess.steps);
+  } catch (const InputError& error) {
+    run->automatic_start_steps = {std::string("none (the multi-start does without it): ") +
+                                  error.what()};
+  }
+}
+
+}  // namespace
+
+ResolvedRun ResolveRun(const IdentifyConfig& config) {
+  return ResolveRun(config, LoadSweeps(config.data_files));
+}
+
+ResolvedRun ResolveRun(const IdentifyConfig& config, std::vector<Sweep> sweeps) {
+  CheckSettings(config);
+  ResolvedRun run;
+  run.config_path = config.config_path;
+  run.sweeps = std::move(sweeps);
+  DetectJumps(config.jump_detection, &run.sweeps);
+  ApplyJumpOverrides(config.jump_overrides, config.config_path, &run.sweeps);
+  run.fitted = SelectSweeps(run.sweeps, config.fit_sweeps, config.config_path, "fit");
+  run.validation = SelectSweeps(run.sweeps, config.validate_sweeps, config.config_path, "validate");
+  CheckEnoughDwells(config, run.fitted);
+  run.options = config.identification;
+  run.multi_start = config.multi_start;
+  FillGuessesFromData(config, &run);
+  FindAutomaticStart(config, &run);
+  std::string invalid;
+  if (!run.options.IsValid(&invalid)) {
+    throw InputError(config.config_path, 0, "initial_guess",
+                     "the starting point is not usable (" + invalid +
+                         "); give the initial guesses in the config");
+  }
+  return run;
+}
+
+MultiStartResult FitRun(const ResolvedRun& run) {
+  return IdentifyMultiStart(run.fitted, run.options, run.automatic_start, run.multi_start);
+}
+
+}  // namespace dwellfit
