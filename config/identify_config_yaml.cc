@@ -87,38 +87,24 @@ void EmitJumpOverrides(YAML::Emitter& out, const std::vector<JumpOverride>& jump
   out << YAML::EndSeq;
 }
 
-}  // namespace
-
-std::string ConfigToYaml(const IdentifyConfig& config) {
-  const IdentificationOptions& identification = config.identification;
-  YAML::Emitter out;
-  std::string header = "Configuration in effect, loaded from " + config.config_path;
-  for (const ConfigOverride& applied : config.overrides) {
-    header += "\noverride: " + DescribeOverride(applied);
-  }
-  out << YAML::Comment(header) << YAML::Newline;
-  out << YAML::BeginMap;
-
-  out << YAML::Key << "data" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (const std::string& file : config.data_files) out << file;
-  out << YAML::EndSeq;
-  EmitSelections(out, "fit", config.fit_sweeps);
-  EmitSelections(out, "validate", config.validate_sweeps);
-
+void EmitInitialGuess(YAML::Emitter& out, const IdentifyConfig& config) {
+  const ParameterVector& initial = config.identification.initial;
   out << YAML::Key << "initial_guess" << YAML::Value << YAML::BeginMap;
   for (int i = 0; i < kNumParameters; ++i) {
     if (!config.initial_guess[i]) {
       out << YAML::Key << (i == kOmega ? "omega_hz" : ParameterName(i)) << YAML::Value << "auto";
     } else if (i == kOmega) {
-      out << YAML::Key << "omega_hz" << YAML::Value
-          << ConvertedNumber(RadPerSecondToHz(identification.initial[i]))
-          << YAML::Comment(ExactNumber(identification.initial[i]) + " rad/s");
+      out << YAML::Key << "omega_hz" << YAML::Value << ConvertedNumber(RadPerSecondToHz(initial[i]))
+          << YAML::Comment(ExactNumber(initial[i]) + " rad/s");
     } else {
-      out << YAML::Key << ParameterName(i) << YAML::Value << ExactNumber(identification.initial[i]);
+      out << YAML::Key << ParameterName(i) << YAML::Value << ExactNumber(initial[i]);
     }
   }
   out << YAML::EndMap;
+}
 
+// fixed, stages, residual and solver: how the fit runs.
+void EmitFitSettings(YAML::Emitter& out, const IdentificationOptions& identification) {
   out << YAML::Key << "fixed" << YAML::Value << YAML::Flow << YAML::BeginSeq;
   for (int i = 0; i < kNumParameters; ++i) {
     if (identification.fixed[i]) out << ParameterName(i);
@@ -144,10 +130,9 @@ std::string ConfigToYaml(const IdentifyConfig& config) {
   out << YAML::Key << "num_threads" << YAML::Value << solver.num_threads;
   out << YAML::Key << "nonmonotonic_steps" << YAML::Value << solver.nonmonotonic_steps;
   out << YAML::EndMap;
+}
 
-  EmitPenalties(out, identification.penalties);
-
-  const JumpDetectionOptions& jump_detection = config.jump_detection;
+void EmitMultiStartAndJumpDetection(YAML::Emitter& out, const IdentifyConfig& config) {
   out << YAML::Key << "multi_start" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "starts" << YAML::Value << config.multi_start.starts;
   out << YAML::Key << "spread" << YAML::Value << ExactNumber(config.multi_start.spread);
@@ -155,6 +140,7 @@ std::string ConfigToYaml(const IdentifyConfig& config) {
   out << YAML::Key << "threads" << YAML::Value << config.multi_start.threads;
   out << YAML::EndMap;
 
+  const JumpDetectionOptions& jump_detection = config.jump_detection;
   out << YAML::Key << "jump_detection" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "min_ratio" << YAML::Value << ExactNumber(jump_detection.min_ratio);
   out << YAML::Key << "min_relative_amplitude" << YAML::Value
@@ -162,8 +148,28 @@ std::string ConfigToYaml(const IdentifyConfig& config) {
   out << YAML::Key << "noise_multiple" << YAML::Value << ExactNumber(jump_detection.noise_multiple);
   out << YAML::Key << "min_candidate_steps" << YAML::Value << jump_detection.min_candidate_steps;
   out << YAML::EndMap;
-  EmitJumpOverrides(out, config.jump_overrides);
+}
 
+}  // namespace
+
+std::string ConfigToYaml(const IdentifyConfig& config) {
+  YAML::Emitter out;
+  std::string header = "Configuration in effect, loaded from " + config.config_path;
+  for (const ConfigOverride& applied : config.overrides) {
+    header += "\noverride: " + DescribeOverride(applied);
+  }
+  out << YAML::Comment(header) << YAML::Newline;
+  out << YAML::BeginMap;
+  out << YAML::Key << "data" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (const std::string& file : config.data_files) out << file;
+  out << YAML::EndSeq;
+  EmitSelections(out, "fit", config.fit_sweeps);
+  EmitSelections(out, "validate", config.validate_sweeps);
+  EmitInitialGuess(out, config);
+  EmitFitSettings(out, config.identification);
+  EmitPenalties(out, config.identification.penalties);
+  EmitMultiStartAndJumpDetection(out, config);
+  EmitJumpOverrides(out, config.jump_overrides);
   if (config.omega_ref_rad_s.has_value()) {
     out << YAML::Key << "effective_nonlinearity_reference_hz" << YAML::Value
         << ConvertedNumber(RadPerSecondToHz(*config.omega_ref_rad_s))

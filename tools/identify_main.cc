@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "dwellfit/config/identify_config.h"
-#include "dwellfit/estimator/run/identify_run.h"
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/run/identify_run.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 

@@ -321,22 +321,22 @@ std::string RadPerSecondText(double rad_s) {
 
 }  // namespace
 
-InitialGuessReport AutomaticInitialGuess(const std::vector<const Sweep*>& sweeps,
-                                         const KnownParameters& known) {
-  InitialGuessReport report;
-  std::vector<std::string>& steps = report.steps;
-  ParameterVector& guess = report.guess;
-  auto given = [&](int index) {
-    return StringPrintf("%s = %.6g: given", ParameterName(index), *known[index]);
-  };
+namespace {
 
-  // 1. Backbone points.
+// "eta_e = 100: given".
+std::string GivenStep(const KnownParameters& known, int index) {
+  return StringPrintf("%s = %.6g: given", ParameterName(index), *known[index]);
+}
+
+// Step 1: one backbone point per level that resonates in the band.
+std::vector<BackbonePoint> FindBackbone(const std::vector<const Sweep*>& sweeps,
+                                        std::vector<std::string>* steps) {
   std::vector<BackbonePoint> backbone;
   std::vector<std::string> notes;
   for (const Level& level : GroupLevels(sweeps)) {
     if (auto point = FindBackbonePoint(level, &notes)) backbone.push_back(*point);
   }
-  for (const std::string& note : notes) steps.push_back(note);
+  for (const std::string& note : notes) steps->push_back(note);
   if (backbone.empty()) {
     throw InputError(
         "automatic initial guess: no resonance in the fitted sweeps (no frequency sweep peaks "
@@ -346,41 +346,42 @@ InitialGuessReport AutomaticInitialGuess(const std::vector<const Sweep*>& sweeps
   for (size_t k = 0; k < backbone.size(); ++k) {
     points += (k == 0 ? " " : "; ") + backbone[k].description;
   }
-  steps.push_back(points);
+  steps->push_back(points);
+  return backbone;
+}
 
+// The backbone Omega_k^2 (1 + delta a_k^2 / 2) = w^2 + b a_k^2, b = (3/4) alpha.
+struct BackboneFit {
+  double w2 = 0.0;                // [rad^2/s^2]
+  double b = 0.0;                 // (3/4) alpha
+  std::optional<double> joint_e;  // 2 eta_e, when fitted jointly with w^2
+  std::string how;
+};
+
+// Step 2: a line through the backbone points, or (one backbone amplitude) a
+// joint fit of w^2 and eta_e over the off-resonance dwells.
+BackboneFit FitBackbone(const std::vector<const Sweep*>& sweeps,
+                        const std::vector<BackbonePoint>& backbone,
+                        const std::vector<OffResonanceDwell>& off_resonance,
+                        const KnownParameters& known) {
   const double delta = known[kDelta].value_or(0.0);
-  auto backbone_ordinate = [delta](double omega, double a) {
+  auto ordinate = [delta](double omega, double a) {
     return omega * omega * (1.0 + 0.5 * delta * a * a);
   };
-
-  // 3. Damping per unit eta_e from the peak heights: independent of w and eta_e,
-  // and needed first to tell which dwells are off resonance.
-  const DampingLine data_damping = FitPeakHeights(backbone, std::nullopt, std::nullopt);
-  const std::vector<OffResonanceDwell> off_resonance =
-      CollectOffResonance(sweeps, data_damping, delta);
-  if (off_resonance.empty()) {
-    throw InputError(
-        "automatic initial guess: every dwell is near resonance (P > 0.9 a_base); no "
-        "off-resonance dwell to estimate eta_e from; give eta_e");
-  }
-
-  // 2. Backbone: Omega_k^2 (1 + delta a_k^2 / 2) = w^2 + (3/4) alpha a_k^2.
   std::vector<double> a2, y;
   for (const BackbonePoint& point : backbone) {
     a2.push_back(point.a * point.a);
-    y.push_back(backbone_ordinate(point.omega, point.a));
+    y.push_back(ordinate(point.omega, point.a));
   }
   std::optional<double> known_w2, known_b;
   if (known[kOmega]) known_w2 = *known[kOmega] * *known[kOmega];
   if (known[kAlpha]) known_b = 0.75 * *known[kAlpha];
-  double w2 = 0.0, b = 0.0;
-  std::optional<double> joint_e;
-  std::string backbone_how;  // how w^2 and (3/4) alpha were obtained
+  BackboneFit fit;
   if (known_w2 || known_b || HasSpread(a2)) {
     const Line line = FitLine(a2, y, known_w2, known_b);
-    w2 = line.intercept;
-    b = line.slope;
-    backbone_how = StringPrintf(
+    fit.w2 = line.intercept;
+    fit.b = line.slope;
+    fit.how = StringPrintf(
         "backbone Omega_k^2 (1 + delta a_k^2 / 2) = w^2 + (3/4) alpha a_k^2 [rad^2/s^2] "
         "through %d point(s)",
         static_cast<int>(backbone.size()));
@@ -388,68 +389,79 @@ InitialGuessReport AutomaticInitialGuess(const std::vector<const Sweep*>& sweeps
     const BackbonePoint& point =
         *std::min_element(backbone.begin(), backbone.end(),
                           [](const BackbonePoint& l, const BackbonePoint& r) { return l.a < r.a; });
-    const double y0 = backbone_ordinate(point.omega, point.a);
-    const JointFit fit =
+    const double y0 = ordinate(point.omega, point.a);
+    const JointFit joint =
         FitFrequencyAndForcing(off_resonance, y0, point.a, point.omega, LooksSoftening(sweeps));
-    w2 = fit.w2;
-    b = (y0 - w2) / (point.a * point.a);
-    joint_e = fit.e;
-    backbone_how = StringPrintf(
+    fit.w2 = joint.w2;
+    fit.b = (y0 - joint.w2) / (point.a * point.a);
+    fit.joint_e = joint.e;
+    fit.how = StringPrintf(
         "one backbone amplitude: least squares over %d off-resonance dwells of "
         "s_i (w^2 + (3/4) alpha a_i^2 - Omega_i^2) = 2 eta_e sqrt(a_base_i^2 - P_i^2) / a_i "
         "for (w^2, eta_e), alpha tied to the backbone point by "
         "Omega_0^2 = w^2 + (3/4) alpha a_0^2",
-        fit.dwells);
+        joint.dwells);
   }
-  if (!(w2 > 0.0) || !std::isfinite(w2 + b)) {
+  if (!(fit.w2 > 0.0) || !std::isfinite(fit.w2 + fit.b)) {
     throw InputError(StringPrintf(
         "automatic initial guess: the backbone gives w^2 = %.4g rad^2/s^2 (not positive); "
         "give omega",
-        w2));
+        fit.w2));
   }
+  return fit;
+}
+
+// omega, alpha and delta from the backbone fit (or as given).
+void SetStiffness(const BackboneFit& fit, const KnownParameters& known,
+                  InitialGuessReport* report) {
+  ParameterVector& guess = report->guess;
+  std::vector<std::string>& steps = report->steps;
   if (known[kOmega]) {
     guess[kOmega] = *known[kOmega];
     steps.push_back(StringPrintf("omega = %s: given", RadPerSecondText(guess[kOmega]).c_str()));
   } else {
-    guess[kOmega] = std::sqrt(w2);
+    guess[kOmega] = std::sqrt(fit.w2);
     steps.push_back(StringPrintf("omega = %s: %s; w^2 is its value at a = 0",
-                                 RadPerSecondText(guess[kOmega]).c_str(), backbone_how.c_str()));
+                                 RadPerSecondText(guess[kOmega]).c_str(), fit.how.c_str()));
   }
   if (known[kAlpha]) {
     guess[kAlpha] = *known[kAlpha];
-    steps.push_back(given(kAlpha));
+    steps.push_back(GivenStep(known, kAlpha));
   } else {
-    guess[kAlpha] = b / 0.75;
+    guess[kAlpha] = fit.b / 0.75;
     steps.push_back(StringPrintf(
-        "alpha = %.4g: %s; alpha is the slope in a^2 over 3/4%s", guess[kAlpha],
-        backbone_how.c_str(),
+        "alpha = %.4g: %s; alpha is the slope in a^2 over 3/4%s", guess[kAlpha], fit.how.c_str(),
         known[kDelta] && *known[kDelta] != 0.0 ? "" : " (with delta = 0 it is alpha_e)"));
   }
   if (known[kDelta]) {
     guess[kDelta] = *known[kDelta];
-    steps.push_back(given(kDelta));
+    steps.push_back(GivenStep(known, kDelta));
   } else {
     guess[kDelta] = 0.0;
     steps.push_back(
         "delta = 0: over a narrow band only alpha_e = alpha - (2/3) delta Omega^2 is "
         "identifiable; the fit may free delta");
   }
+}
 
-  // 4. eta_e from |D_i| = 2 eta_e |Q_i| / a_i off resonance.
+// Step 4: eta_e from |D_i| = 2 eta_e |Q_i| / a_i off resonance.
+void SetForcing(const BackboneFit& fit, const std::vector<OffResonanceDwell>& off_resonance,
+                const KnownParameters& known, InitialGuessReport* report) {
+  ParameterVector& guess = report->guess;
   if (known[kEtaE]) {
     guess[kEtaE] = *known[kEtaE];
-    steps.push_back(given(kEtaE));
-  } else if (joint_e) {
-    guess[kEtaE] = 0.5 * *joint_e;
-    steps.push_back(StringPrintf("eta_e = %.4g: %s", guess[kEtaE], backbone_how.c_str()));
+    report->steps.push_back(GivenStep(known, kEtaE));
+  } else if (fit.joint_e) {
+    guess[kEtaE] = 0.5 * *fit.joint_e;
+    report->steps.push_back(StringPrintf("eta_e = %.4g: %s", guess[kEtaE], fit.how.c_str()));
   } else {
     std::vector<double> q, abs_d;
     for (const OffResonanceDwell& d : off_resonance) {
       q.push_back(d.q);
-      abs_d.push_back(std::abs(w2 + b * d.a2 - d.y));
+      abs_d.push_back(std::abs(fit.w2 + fit.b * d.a2 - d.y));
     }
     guess[kEtaE] = 0.5 * FitLine(q, abs_d, 0.0, std::nullopt).slope;
-    steps.push_back(StringPrintf(
+    report->steps.push_back(StringPrintf(
         "eta_e = %.4g: least squares through the origin over %d off-resonance dwells "
         "(P <= %.1f a_base) of |w^2 + (3/4) alpha a^2 - Omega^2 (1 + delta a^2 / 2)| "
         "= 2 eta_e sqrt(a_base^2 - P^2) / a, P = Omega a (mu1 + c mu2 a) / eta_e from the "
@@ -457,36 +469,61 @@ InitialGuessReport AutomaticInitialGuess(const std::vector<const Sweep*>& sweeps
         guess[kEtaE], static_cast<int>(q.size()), kOffResonanceMaxP));
   }
   if (!(guess[kEtaE] > 0.0) || !std::isfinite(guess[kEtaE])) {
-    throw InputError(
-        StringPrintf("automatic initial guess: eta_e estimate %.4g is not positive; "
-                     "give eta_e",
-                     guess[kEtaE]));
+    throw InputError(StringPrintf(
+        "automatic initial guess: eta_e estimate %.4g is not positive; give eta_e", guess[kEtaE]));
   }
+}
 
-  // 5. mu1, mu2 from the peak heights a_base_k / (Omega_k a_k) = m1 + m2 a_k,
-  // m1 = mu1 / eta_e, m2 = c mu2 / eta_e.
+// Step 5: mu1, mu2 from the peak heights a_base_k / (Omega_k a_k) = m1 + m2 a_k,
+// m1 = mu1 / eta_e, m2 = c mu2 / eta_e.
+void SetDamping(const std::vector<BackbonePoint>& backbone, const KnownParameters& known,
+                InitialGuessReport* report) {
+  ParameterVector& guess = report->guess;
   const double eta = guess[kEtaE];
   std::optional<double> known_m1, known_m2;
   if (known[kMu1]) known_m1 = *known[kMu1] / eta;
   if (known[kMu2]) known_m2 = kQuadraticDampingFactor * *known[kMu2] / eta;
   const DampingLine damping = FitPeakHeights(backbone, known_m1, known_m2);
-  const std::string damping_how =
+  const std::string how =
       "peak heights a_base_k / (Omega_k a_k) = (mu1 + c mu2 a_k) / eta_e, c = 4 / (3 pi): " +
       damping.how;
   if (known[kMu1]) {
     guess[kMu1] = *known[kMu1];
-    steps.push_back(given(kMu1));
+    report->steps.push_back(GivenStep(known, kMu1));
   } else {
     guess[kMu1] = damping.m1 * eta;
-    steps.push_back(StringPrintf("mu1 = %.4g 1/s: %s", guess[kMu1], damping_how.c_str()));
+    report->steps.push_back(StringPrintf("mu1 = %.4g 1/s: %s", guess[kMu1], how.c_str()));
   }
   if (known[kMu2]) {
     guess[kMu2] = *known[kMu2];
-    steps.push_back(given(kMu2));
+    report->steps.push_back(GivenStep(known, kMu2));
   } else {
     guess[kMu2] = damping.m2 * eta / kQuadraticDampingFactor;
-    steps.push_back(StringPrintf("mu2 = %.4g: %s", guess[kMu2], damping_how.c_str()));
+    report->steps.push_back(StringPrintf("mu2 = %.4g: %s", guess[kMu2], how.c_str()));
   }
+}
+
+}  // namespace
+
+InitialGuessReport AutomaticInitialGuess(const std::vector<const Sweep*>& sweeps,
+                                         const KnownParameters& known) {
+  InitialGuessReport report;
+  const std::vector<BackbonePoint> backbone = FindBackbone(sweeps, &report.steps);
+  // Step 3 comes before step 2: the damping per unit eta_e from the peak
+  // heights is independent of w and eta_e, and tells which dwells are off
+  // resonance.
+  const DampingLine data_damping = FitPeakHeights(backbone, std::nullopt, std::nullopt);
+  const std::vector<OffResonanceDwell> off_resonance =
+      CollectOffResonance(sweeps, data_damping, known[kDelta].value_or(0.0));
+  if (off_resonance.empty()) {
+    throw InputError(
+        "automatic initial guess: every dwell is near resonance (P > 0.9 a_base); no "
+        "off-resonance dwell to estimate eta_e from; give eta_e");
+  }
+  const BackboneFit fit = FitBackbone(sweeps, backbone, off_resonance, known);
+  SetStiffness(fit, known, &report);
+  SetForcing(fit, off_resonance, known, &report);
+  SetDamping(backbone, known, &report);
   return report;
 }
 

@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "dwellfit/config/identify_config.h"
-#include "dwellfit/estimator/fit/identification.h"
-#include "dwellfit/estimator/run/identify_run.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/data/sweep_csv.h"
+#include "dwellfit/estimator/fit/identification.h"
+#include "dwellfit/estimator/run/identify_run.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "yaml-cpp/yaml.h"
