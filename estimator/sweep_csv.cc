@@ -96,6 +96,16 @@ double ParsePositive(const Location& where, const char* column, const char* text
   return value;
 }
 
+// A drive frequency [Hz]: positive, and finite in rad/s too.
+double ParseFrequencyHz(const Location& where, const char* text) {
+  const double hz = ParsePositive(where, kFrequencyColumn, text, "the drive frequency");
+  if (!std::isfinite(HzToRadPerSecond(hz))) {
+    throw InputError(where.file, where.line, kFrequencyColumn,
+                     "value '" + std::string(text) + "' is too large (infinite in rad/s)");
+  }
+  return hz;
+}
+
 // Reads the header and checks the column set; returns the header's line.
 int ReadHeader(const std::string& path, CsvReader* reader) {
   try {
@@ -247,8 +257,7 @@ LoadedSweeps LoadSweepsCsv(const std::string& path) {
       throw InputError(path, where.line, kDirectionColumn,
                        "value '" + std::string(row.direction) + "' must be 'up' or 'down'");
     }
-    const double freq_hz =
-        ParsePositive(where, kFrequencyColumn, row.freq_hz, "the drive frequency");
+    const double freq_hz = ParseFrequencyHz(where, row.freq_hz);
     const double a_base = ParsePositive(where, kABaseColumn, row.a_base, "the base level a_base");
     const double amplitude = ParseNumber(where, kAmplitudeColumn, row.a);
     std::optional<double> phase_rad;

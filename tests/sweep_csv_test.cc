@@ -335,6 +335,10 @@ INSTANTIATE_TEST_SUITE_P(
                    4, "freq_hz", "and a_base (first change at line 3)"},
         BadCsvCase{"zero_sigma", "sweep,direction,freq_hz,a_base,a,sigma\nF,up,40,0.01,1e-3,0\n", 2,
                    "sigma", "sigma must be > 0"},
+        // Finite in Hz, infinite in rad/s.
+        BadCsvCase{"frequency_overflowing_in_rad_s",
+                   "sweep,direction,freq_hz,a_base,a\nF,up,40,0.01,1e-3\nF,up,1e308,0.01,1e-3\n", 3,
+                   "freq_hz", "value '1e308' is too large (infinite in rad/s)"},
         BadCsvCase{"negative_sigma",
                    "sweep,direction,freq_hz,a_base,a,sigma\nF,up,40,0.01,1e-3,-1e-5\n", 2, "sigma",
                    "sigma must be > 0"},
