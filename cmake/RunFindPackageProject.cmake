@@ -8,7 +8,9 @@
 #   PROJECT_SOURCE       tests/find_package_project
 #   WORK_DIR             build directory of the outside project (wiped first)
 #   PREFIX               install prefix (wiped first)
-# Optional: GENERATOR, CXX_COMPILER, BUILD_TYPE.
+# Optional: GENERATOR, CXX_COMPILER, BUILD_TYPE, and CXX_FLAGS and LINKER_FLAGS
+# (the sanitizer flags of a DWELLFIT_SANITIZE build: an instrumented library
+# links only into an instrumented program).
 cmake_minimum_required(VERSION 3.16)
 
 foreach(var DWELLFIT_BINARY_DIR PROJECT_SOURCE WORK_DIR PREFIX)
@@ -42,6 +44,12 @@ if(GENERATOR)
 endif()
 if(CXX_COMPILER)
   list(APPEND configure_args "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}")
+endif()
+if(CXX_FLAGS)
+  list(APPEND configure_args "-DCMAKE_CXX_FLAGS=${CXX_FLAGS}")
+endif()
+if(LINKER_FLAGS)
+  list(APPEND configure_args "-DCMAKE_EXE_LINKER_FLAGS=${LINKER_FLAGS}")
 endif()
 run_step(configure "${CMAKE_COMMAND}" ${configure_args})
 run_step(build "${CMAKE_COMMAND}" --build "${WORK_DIR}" --config "${BUILD_TYPE}")

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages dwellfit needs to build, test, benchmark and
-# plot. Idempotent: when every package is already installed it only says so and
+# Installs the Debian 12 packages dwellfit needs to build, test, fuzz, benchmark
+# and plot. Idempotent: when every package is already installed it only says so and
 # never calls apt-get (no network, under a second).
 #
 #   bash cmake/install-debian-deps.sh
@@ -24,6 +24,11 @@ packages=(
   libfccp-dev
   libboost-dev
   gnuplot-nox
+  # The fuzzers (tests/fuzz): Clang, its libFuzzer and sanitizer runtimes, and
+  # its OpenMP runtime (the library uses OpenMP).
+  clang-14
+  libclang-rt-14-dev
+  libomp-14-dev
 )
 
 is_installed() {

@@ -81,6 +81,10 @@ void CheckKeyPath(const std::string& key_path, const std::string& entry,
 std::vector<ConfigOverride> ParseSetFlag(const std::string& flag_value, const std::string& origin) {
   std::vector<ConfigOverride> overrides;
   if (Trim(flag_value).empty()) return overrides;
+  // No command line holds one; the printed config would end there.
+  if (flag_value.find('\0') != std::string::npos) {
+    throw InputError(origin, 0, "", "the value holds a NUL character; remove it");
+  }
   for (const std::string& part : SplitTopLevel(flag_value, origin)) {
     const std::string entry = Trim(part);
     if (entry.empty()) {

@@ -316,6 +316,12 @@ void ConfigSource::ApplyOne(const ConfigOverride& override_value) {
     for (const YAML::Node& entry : added) added_.emplace_back(entry, index);
   } else {
     if (value.IsNull()) {
+      // A removal that finds nothing is most likely a misspelt key: say so.
+      if (!static_cast<const YAML::Node&>(map)[key].IsDefined()) {
+        throw InputError(override_value.origin, 0, key_path,
+                         "nothing to remove: the config does not set '" + key_path +
+                             "'; check the key path (the value null removes a key)");
+      }
       map.remove(key);
     } else {
       Rebind(&map, key, value);

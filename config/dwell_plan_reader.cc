@@ -85,8 +85,9 @@ ParameterVector ReadTruth(const ConfigValue& value, const ConfigSource& source) 
 // missing or unknown kind is reported when the block is read.
 std::optional<SweepKind> StatedKind(const YAML::Node& block) {
   if (!block.IsMap()) return std::nullopt;
+  // A missing key gives an invalid node, which throws on all but IsDefined().
   const YAML::Node kind = block["kind"];
-  if (!kind.IsScalar()) return std::nullopt;
+  if (!kind.IsDefined() || !kind.IsScalar()) return std::nullopt;
   for (SweepKind candidate : {SweepKind::kFrequency, SweepKind::kAmplitude}) {
     if (kind.Scalar() == SweepKindName(candidate)) return candidate;
   }

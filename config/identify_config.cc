@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <optional>
+#include <sstream>
 #include <system_error>
 #include <utility>
 
@@ -30,6 +32,19 @@ fs::path ResolvePath(const std::string& text, const ConfigValue& value, const Co
     path = (source.OverrideFor(value.path) != nullptr ? fs::current_path() : config_dir) / path;
   }
   return path.lexically_normal();
+}
+
+// `hz` in rad/s. A frequency so large that it overflows there is an error
+// at `value` (the reader has checked that `hz` is finite).
+double RadPerSecond(double hz, const ConfigValue& value, const ConfigSource& source) {
+  const double rad_s = HzToRadPerSecond(hz);
+  if (!std::isfinite(rad_s)) {
+    std::ostringstream text;
+    text << hz;
+    throw source.Error(value.path, value.mark,
+                       "the frequency " + text.str() + " Hz is too large (infinite in rad/s)");
+  }
+  return rad_s;
 }
 
 std::string RelativeToWhat(const ConfigValue& value, const ConfigSource& source) {
@@ -447,8 +462,8 @@ JumpOverride ReadJumpOverride(const ConfigValue& entry, const ConfigSource& sour
   const auto [before, after] = ReadBracket(*statement, source);
   const bool frequency = key == "between_hz";
   jump.control = frequency ? SweepKind::kFrequency : SweepKind::kAmplitude;
-  jump.control_before = frequency ? HzToRadPerSecond(before) : before;
-  jump.control_after = frequency ? HzToRadPerSecond(after) : after;
+  jump.control_before = frequency ? RadPerSecond(before, *statement, source) : before;
+  jump.control_after = frequency ? RadPerSecond(after, *statement, source) : after;
   return jump;
 }
 
@@ -611,7 +626,7 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
                          "must be a positive frequency in Hz, got " + value->node.Scalar() +
                              "; remove the key to use the identified natural frequency");
     }
-    config.omega_ref_rad_s = HzToRadPerSecond(hz);
+    config.omega_ref_rad_s = RadPerSecond(hz, *value, source);
   }
 
   const ConfigValue output_dir =

@@ -159,6 +159,10 @@ bool ReadBool(const ConfigValue& value, const ConfigSource& source) {
 std::string ReadNonEmptyString(const ConfigValue& value, const ConfigSource& source) {
   const std::string& text = ScalarText(value, source, "a single value");
   if (text.empty()) throw source.Error(value.path, value.mark, "must not be empty");
+  // ("\0" in a double-quoted YAML string.) A path or name would end there.
+  if (text.find('\0') != std::string::npos) {
+    throw source.Error(value.path, value.mark, "holds a NUL character; remove it");
+  }
   return text;
 }
 

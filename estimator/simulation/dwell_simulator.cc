@@ -97,6 +97,12 @@ bool SweepPlan::IsValid(std::string* error) const {
   if (!(step > 0.0) || !std::isfinite(step)) {
     return fail(step_key + " must be positive, got " + G12(step));
   }
+  // The simulator works in rad/s: the highest frequency must be finite there.
+  const double highest_hz = frequency ? to : held_frequency_hz;
+  if (!std::isfinite(HzToRadPerSecond(highest_hz))) {
+    return fail((frequency ? to_key : std::string("the held frequency")) + " (" + G12(highest_hz) +
+                " Hz) is too large (infinite in rad/s)");
+  }
   if (NumSteps() < 0) {
     return fail(to_key + " - " + from_key + " (" + G12(to - from) +
                 ") must be a whole number of steps of " + step_key + " (" + G12(step) +

@@ -85,6 +85,16 @@ TEST(ConfigJumps, EachEntryStatesExactlyOneOfBetweenHzBetweenABaseAndNone) {
                                       "or none: true"));
 }
 
+TEST(ConfigJumps, ABracketOverflowingInRadPerSecondIsAnError) {
+  const ConfigDirectory dir;
+  std::string path;
+  const InputError error = LoadError(
+      dir, ConfigWith(Replace(kJumps, "[161.041, 161.012]", "[161.041, 1.7e308]")), &path);
+  EXPECT_EQ(error.line(), 31);
+  EXPECT_EQ(error.field(), "jumps[0].between_hz");
+  EXPECT_THAT(error.what(), HasSubstr("the frequency 1.7e+308 Hz is too large"));
+}
+
 TEST(ConfigJumps, KindGoesWithABracketAndNoneMustBeTrue) {
   const ConfigDirectory dir;
   std::string path;

@@ -53,6 +53,11 @@ TEST(ParseSetFlag, SplitsEntriesButNotInsideBracketsOrQuotes) {
   EXPECT_EQ(overrides[3].yaml_value, "'a,b'");
 }
 
+TEST(ParseSetFlag, ANulCharacterIsAnError) {
+  const InputError error = SetFlagError(std::string("output_dir='a\0b'", 16));
+  EXPECT_THAT(error.what(), StartsWith("--set: the value holds a NUL character"));
+}
+
 TEST(ParseSetFlag, EmptyFlagGivesNoOverrides) { EXPECT_TRUE(ParseSetFlag("", "--set").empty()); }
 
 TEST(ParseSetFlag, MalformedEntriesAreErrorsNamingTheFlag) {
@@ -174,6 +179,16 @@ TEST(ConfigOverrideErrors, RemovingARequiredKeyNamesTheFlag) {
   const InputError error = LoadErrorWith(ParseSetFlag("output_dir=~", "--set"));
   EXPECT_THAT(error.what(), HasSubstr("--set"));
   EXPECT_THAT(error.what(), HasSubstr("output_dir"));
+}
+
+// A removal would otherwise pass unnoticed when its key is misspelt.
+TEST(ConfigOverrideErrors, RemovingAKeyTheConfigDoesNotSetNamesTheFlag) {
+  InputError error =
+      LoadErrorWith(ParseSetFlag("effective_nonlinearity_reference_hx=null", "--set"));
+  EXPECT_THAT(error.what(), StartsWith("--set: field 'effective_nonlinearity_reference_hx': "
+                                       "nothing to remove: the config does not set"));
+  error = LoadErrorWith(ParseSetFlag("solver.max_iteration=~", "--set"));
+  EXPECT_THAT(error.what(), StartsWith("--set: field 'solver.max_iteration': nothing to remove"));
 }
 
 TEST(ConfigOverrideErrors, InvalidValueInAFileBlockNamesTheFlag) {

@@ -451,6 +451,16 @@ TEST(IdentifyConfigErrors, NonPositiveReferenceFrequency) {
   EXPECT_THAT(error.what(), HasSubstr("must be a positive frequency in Hz"));
 }
 
+// Finite in Hz but infinite in rad/s: the printed config would read "inf".
+TEST(IdentifyConfigErrors, ReferenceFrequencyOverflowingInRadPerSecond) {
+  const ConfigDirectory dir;
+  std::string path;
+  const InputError error = ErrorWith(dir, "effective_nonlinearity_reference_hz: 41",
+                                     "effective_nonlinearity_reference_hz: 1e308", &path);
+  ExpectAt(error, path, 26, "effective_nonlinearity_reference_hz");
+  EXPECT_THAT(error.what(), HasSubstr("the frequency 1e+308 Hz is too large (infinite in rad/s)"));
+}
+
 TEST(IdentifyConfigErrors, YamlSyntaxErrorHasItsLine) {
   const ConfigDirectory dir;
   std::string path;

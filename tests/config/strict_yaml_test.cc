@@ -43,5 +43,20 @@ TEST(StrictMap, AnUnknownKeyIsNamedWithItsLine) {
   }
 }
 
+// YAML's "\0" escape would cut a path or a name short where the system or a
+// printed config reads it.
+TEST(ReadNonEmptyString, ANulCharacterIsAnError) {
+  const ConfigSource source =
+      ConfigSource::Parse("block.yaml", "path: \"out\\0put\"\nname: output\n");
+  const StrictMap map(DocumentValue(source), source, {"path", "name"});
+  EXPECT_EQ(ReadNonEmptyString(*map.Optional("name"), source), "output");
+  try {
+    ReadNonEmptyString(*map.Optional("path"), source);
+    FAIL() << "a NUL character was accepted";
+  } catch (const InputError& error) {
+    EXPECT_THAT(error.what(), HasSubstr("block.yaml:1: field 'path': holds a NUL character"));
+  }
+}
+
 }  // namespace
 }  // namespace dwellfit

@@ -494,6 +494,34 @@ TEST(DwellPlanReader, UnknownKeysGetADidYouMean) {
   });
 }
 
+// The kind decides which keys a sweep allows; without it the sweep is still
+// read for an InputError (a yaml-cpp exception escaped here once).
+TEST(DwellPlanReader, ASweepWithoutKindIsAnInputError) {
+  const std::string head = std::string(kTruth) + "sweeps:\n  - id: F\n";
+  const std::string grid = "    a_base: 0.01\n    from_hz: 38\n    to_hz: 46\n    step_hz: 0.1\n";
+  EXPECT_THAT(PlanError(head + grid),
+              ::testing::StartsWith("3 sweeps[0].kind: plan.yaml:3: field 'sweeps[0].kind': "
+                                    "missing required key 'kind' in 'sweeps[0]'"));
+  EXPECT_THAT(PlanError(head + "    knd: frequency\n" + grid),
+              ::testing::StartsWith("4 sweeps[0].knd: plan.yaml:4: field 'sweeps[0].knd': "
+                                    "unknown key 'knd' in 'sweeps[0]' (did you mean 'kind'?)"));
+}
+
+// The simulator works in rad/s, where these frequencies are infinite.
+TEST(DwellPlanReader, FrequenciesOverflowingInRadPerSecondAreErrors) {
+  const std::string head = std::string(kTruth) + "sweeps:\n  - id: F\n";
+  ExpectPlanErrors({
+      {head + "    kind: frequency\n    a_base: 0.01\n    from_hz: 1e308\n    to_hz: 1.5e308\n"
+              "    step_hz: 0.5e308\n",
+       "3 sweeps[0]: plan.yaml:3: field 'sweeps[0]': to_hz (1.5e+308 Hz) is too large (infinite "
+       "in rad/s)"},
+      {head + "    kind: amplitude\n    freq_hz: 1e308\n    a_base_from: 0.001\n"
+              "    a_base_to: 0.003\n    a_base_step: 0.001\n",
+       "3 sweeps[0]: plan.yaml:3: field 'sweeps[0]': the held frequency (1e+308 Hz) is too large "
+       "(infinite in rad/s)"},
+  });
+}
+
 TEST(DwellPlanReader, AFileThatCannotBeReadIsNamedAsThePlanFile) {
   const std::string missing = ::testing::TempDir() + "/no-such-dir/plan.yaml";
   try {

@@ -1,0 +1,19 @@
+#include "tests/fuzz/fuzz_targets.h"
+
+#include <glog/logging.h>
+
+namespace dwellfit::fuzz {
+
+const std::vector<FuzzTarget>& AllFuzzTargets() {
+  static const std::vector<FuzzTarget> targets = {
+      {"sweep_csv", &SweepCsvBody, ".csv"},
+      {"identify_config", &IdentifyConfigBody, ".yaml"},
+      {"set_flag", &SetFlagBody, ""},
+      {"dwell_plan", &DwellPlanBody, ".yaml"},
+  };
+  return targets;
+}
+
+void QuietLogging() { FLAGS_minloglevel = google::GLOG_ERROR; }
+
+}  // namespace dwellfit::fuzz

@@ -1,0 +1,52 @@
+// The fuzz targets' bodies, as plain functions: the libFuzzer executables
+// (libfuzzer_entry.cc) call them for generated inputs, and the regular test
+// suite (fuzz_replay_test.cc) replays the committed seeds and regression
+// inputs through them in any build.
+//
+// A body returns normally when the loader accepts its input or rejects it
+// with dwellfit::InputError, the expected rejection of bad input. Anything
+// else is a finding: a crash, a sanitizer report, a hang, or an exception of
+// another type escaping (including the std::logic_error a body throws when an
+// accepted input breaks a documented property of the result).
+#ifndef DWELLFIT_TESTS_FUZZ_FUZZ_TARGETS_H_
+#define DWELLFIT_TESTS_FUZZ_FUZZ_TARGETS_H_
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dwellfit::fuzz {
+
+using FuzzBody = void (*)(const std::uint8_t* data, std::size_t size);
+
+// The input as the text of a sweeps CSV file (LoadSweepsCsv).
+void SweepCsvBody(const std::uint8_t* data, std::size_t size);
+// The input as an identify config file (LoadIdentifyConfig), beside an
+// (empty) `sweeps.csv`; an accepted config must print (ConfigToYaml) as text
+// that reads back to the same config.
+void IdentifyConfigBody(const std::uint8_t* data, std::size_t size);
+// The input as the value of `--set` (ParseSetFlag), applied to a complete
+// config; the result must print and read back like IdentifyConfigBody's.
+void SetFlagBody(const std::uint8_t* data, std::size_t size);
+// The input as a dwell plan (ParseDwellPlan); every accepted sweep must give
+// its control grid.
+void DwellPlanBody(const std::uint8_t* data, std::size_t size);
+
+struct FuzzTarget {
+  std::string name;  // tests/fuzz/corpus/<name>, tests/fuzz/regressions/<name>
+  FuzzBody body;
+  // Files under datasets/ that are seeds of this target ("" for none).
+  std::string dataset_extension;
+};
+
+// Every target, in a fixed order.
+const std::vector<FuzzTarget>& AllFuzzTargets();
+
+// Makes logging quiet (errors only): the loaders LOG(WARNING) about dropped
+// rows, which would cost more than the loading itself.
+void QuietLogging();
+
+}  // namespace dwellfit::fuzz
+
+#endif  // DWELLFIT_TESTS_FUZZ_FUZZ_TARGETS_H_
