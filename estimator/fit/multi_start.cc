@@ -60,6 +60,16 @@ MultiStartResult IdentifyMultiStart(const std::vector<const Sweep*>& fitted,
                                     const std::optional<ParameterVector>& automatic,
                                     const MultiStartOptions& multi_start) {
   MultiStartResult result;
+  std::string error;
+  if (!multi_start.IsValid(&error)) {
+    result.best.parameters = options.initial;
+    result.best.status = FitStatus::kInvalidInput;
+    result.best.message = error;
+    result.starts = {options.initial};
+    result.final_costs = {0.0};
+    result.converged = {false};
+    return result;
+  }
   result.starts = MultiStartPoints(options, automatic, multi_start);
   const int n = static_cast<int>(result.starts.size());
   std::vector<IdentificationResult> fits(n);
@@ -82,17 +92,21 @@ MultiStartResult IdentifyMultiStart(const std::vector<const Sweep*>& fitted,
   worker();
   for (std::thread& thread : pool) thread.join();
 
+  int best = -1;
   for (int i = 0; i < n; ++i) {
     result.final_costs.push_back(fits[i].final_cost);
     result.converged.push_back(fits[i].converged);
     const bool finite = std::all_of(fits[i].parameters.begin(), fits[i].parameters.end(),
                                     [](double v) { return std::isfinite(v); });
-    // Lowest cost wins; ties go to the earlier start, so the result does not
-    // depend on scheduling.
-    if (finite && (i == 0 || !(fits[i].final_cost >= fits[result.best_start].final_cost))) {
-      result.best_start = i;
+    // Lowest cost of the usable fits wins; ties go to the earlier start, so
+    // the result does not depend on scheduling.
+    if (fits[i].IsSolutionUsable() && finite &&
+        (best < 0 || !(fits[i].final_cost >= fits[best].final_cost))) {
+      best = i;
     }
   }
+  // No usable fit: the first start's, with its status and message.
+  result.best_start = std::max(best, 0);
   result.best = fits[result.best_start];
   for (int i = 0; i < n; ++i) {
     bool same = true;

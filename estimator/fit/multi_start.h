@@ -41,9 +41,12 @@ std::vector<ParameterVector> MultiStartPoints(const IdentificationOptions& optio
                                               const std::optional<ParameterVector>& automatic,
                                               const MultiStartOptions& multi_start);
 
-// Runs Identify from every start. A start "reached the best" when each free
-// parameter is within 1e-5 of the best estimate, relative to that estimate's
-// magnitude (or to the start's scale for a parameter at 0).
+// Runs Identify from every start and keeps the usable fit of lowest cost
+// (the first start's fit, with its status, when none is usable). A start
+// "reached the best" when each free parameter is within 1e-5 of the best
+// estimate, relative to that estimate's magnitude (or to the start's scale
+// for a parameter at 0). Invalid `multi_start` options give
+// best.status = FitStatus::kInvalidInput, naming the field.
 MultiStartResult IdentifyMultiStart(const std::vector<const Sweep*>& fitted,
                                     const IdentificationOptions& options,
                                     const std::optional<ParameterVector>& automatic,

@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <utility>
 
 #include "glog/logging.h"
 
@@ -26,92 +27,160 @@ int ResolveThreadCount(int num_threads) {
 // evaluator saw.
 class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunction {
  public:
-  ReplayingCostFunction(ceres::CostFunction* wrapped, int size, ParallelResidualEvaluator* owner)
-      : wrapped_(wrapped),
-        owner_(owner),
-        point_(size),
-        residuals_(wrapped->num_residuals()),
-        jacobian_(static_cast<size_t>(wrapped->num_residuals()) * size) {
-    CHECK_EQ(wrapped->parameter_block_sizes().size(), 1u);
-    CHECK_EQ(wrapped->parameter_block_sizes()[0], size);
+  // `offsets`: where each of the wrapped function's parameter blocks starts
+  // in the evaluator's point.
+  ReplayingCostFunction(ceres::CostFunction* wrapped, std::vector<int> offsets,
+                        ParallelResidualEvaluator* owner)
+      : wrapped_(wrapped), owner_(owner), offsets_(std::move(offsets)) {
+    const std::vector<int32_t>& sizes = wrapped->parameter_block_sizes();
+    CHECK_EQ(sizes.size(), offsets_.size());
     set_num_residuals(wrapped->num_residuals());
-    *mutable_parameter_block_sizes() = wrapped->parameter_block_sizes();
+    *mutable_parameter_block_sizes() = sizes;
+    const int rows = wrapped->num_residuals();
+    int total = 0;
+    for (int size : sizes) {
+      starts_.push_back(total);
+      total += size;
+    }
+    point_.resize(total);
+    residuals_.resize(rows);
+    jacobian_.resize(static_cast<size_t>(rows) * total);
+    for (size_t j = 0; j < sizes.size(); ++j) {
+      block_pointers_.push_back(point_.data() + starts_[j]);
+      jacobian_pointers_.push_back(jacobian_.data() + static_cast<size_t>(rows) * starts_[j]);
+    }
   }
 
-  // Adds J^T r at the precomputed point to `gradient`; false if the
-  // evaluation failed.
+  // Adds J^T r at the precomputed point to `gradient` (a point's
+  // coordinates); false if the evaluation failed.
   bool AddGradient(double* gradient) const {
     if (!ok_) return false;
-    const int size = static_cast<int>(point_.size());
-    for (size_t row = 0; row < residuals_.size(); ++row) {
-      for (int col = 0; col < size; ++col)
-        gradient[col] += jacobian_[row * size + col] * residuals_[row];
+    const std::vector<int32_t>& sizes = parameter_block_sizes();
+    for (size_t j = 0; j < sizes.size(); ++j) {
+      const double* jacobian = jacobian_pointers_[j];
+      for (size_t row = 0; row < residuals_.size(); ++row) {
+        for (int col = 0; col < sizes[j]; ++col)
+          gradient[offsets_[j] + col] += jacobian[row * sizes[j] + col] * residuals_[row];
+      }
     }
     return true;
   }
 
   // Computes the values at `point` (the evaluator's thread for this block).
   void Precompute(const double* point) {
-    std::copy(point, point + point_.size(), point_.begin());
-    const double* blocks[] = {point};
-    double* jacobians[] = {jacobian_.data()};
-    ok_ = wrapped_->Evaluate(blocks, residuals_.data(), jacobians);
+    const std::vector<int32_t>& sizes = parameter_block_sizes();
+    for (size_t j = 0; j < sizes.size(); ++j) {
+      std::copy(point + offsets_[j], point + offsets_[j] + sizes[j], point_.begin() + starts_[j]);
+    }
+    ok_ = wrapped_->Evaluate(block_pointers_.data(), residuals_.data(), jacobian_pointers_.data());
     valid_ = true;
   }
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
-    if (!valid_ || !std::equal(point_.begin(), point_.end(), parameters[0])) {
+    if (!valid_ || !AtPoint(parameters)) {
       ++owner_->evaluated_directly_;
       return wrapped_->Evaluate(parameters, residuals, jacobians);
     }
     ++owner_->replayed_;
     if (!ok_) return false;
     std::copy(residuals_.begin(), residuals_.end(), residuals);
-    if (jacobians != nullptr && jacobians[0] != nullptr) {
-      std::copy(jacobian_.begin(), jacobian_.end(), jacobians[0]);
+    if (jacobians == nullptr) return true;
+    const std::vector<int32_t>& sizes = parameter_block_sizes();
+    for (size_t j = 0; j < sizes.size(); ++j) {
+      if (jacobians[j] == nullptr) continue;
+      std::copy(jacobian_pointers_[j], jacobian_pointers_[j] + residuals_.size() * sizes[j],
+                jacobians[j]);
     }
     return true;
   }
 
  private:
+  // `parameters` are the precomputed point.
+  bool AtPoint(double const* const* parameters) const {
+    const std::vector<int32_t>& sizes = parameter_block_sizes();
+    for (size_t j = 0; j < sizes.size(); ++j) {
+      const double* own = point_.data() + starts_[j];
+      if (!std::equal(own, own + sizes[j], parameters[j])) return false;
+    }
+    return true;
+  }
+
   const std::unique_ptr<ceres::CostFunction> wrapped_;
   ParallelResidualEvaluator* const owner_;
-  std::vector<double> point_;
+  const std::vector<int> offsets_;  // of each parameter block in the evaluator's point
+  std::vector<int> starts_;         // of each parameter block in point_
+  std::vector<double> point_;       // the point the values are for, its blocks concatenated
   std::vector<double> residuals_;
-  std::vector<double> jacobian_;  // row-major, num_residuals x size
+  std::vector<double> jacobian_;  // per parameter block: row-major, num_residuals x its size
+  std::vector<const double*> block_pointers_;  // into point_
+  std::vector<double*> jacobian_pointers_;     // into jacobian_
   bool ok_ = false;
   bool valid_ = false;
 };
 
-ParallelResidualEvaluator::ParallelResidualEvaluator(const double* parameters, int size,
-                                                     int num_threads)
-    : parameters_(parameters), size_(size), num_threads_(num_threads) {
-  CHECK(parameters != nullptr);
-  CHECK_GT(size, 0);
+ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads)
+    : blocks_(std::move(blocks)), num_threads_(num_threads) {
+  CHECK(!blocks_.empty());
+  for (const Block& block : blocks_) {
+    CHECK(block.values != nullptr);
+    CHECK_GT(block.size, 0);
+    offsets_.push_back(size_);
+    size_ += block.size;
+  }
   CHECK_GE(num_threads, 1);
 }
 
+ParallelResidualEvaluator::ParallelResidualEvaluator(const double* parameters, int size,
+                                                     int num_threads)
+    : ParallelResidualEvaluator(std::vector<Block>{{parameters, size}}, num_threads) {}
+
 ParallelResidualEvaluator::~ParallelResidualEvaluator() = default;
 
-ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_function) {
-  auto* wrapper = new ReplayingCostFunction(cost_function, size_, this);
+ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_function,
+                                                     const std::vector<double*>& parameter_blocks) {
+  CHECK_EQ(cost_function->parameter_block_sizes().size(), parameter_blocks.size());
+  std::vector<int> offsets;
+  for (size_t j = 0; j < parameter_blocks.size(); ++j) {
+    size_t b = 0;
+    while (b < blocks_.size() && blocks_[b].values != parameter_blocks[j]) ++b;
+    CHECK_LT(b, blocks_.size()) << "a parameter block the evaluator does not watch";
+    CHECK_EQ(cost_function->parameter_block_sizes()[j], blocks_[b].size);
+    offsets.push_back(offsets_[b]);
+  }
+  auto* wrapper = new ReplayingCostFunction(cost_function, std::move(offsets), this);
   wrappers_.push_back(wrapper);
   return wrapper;
 }
 
-void ParallelResidualEvaluator::PrepareForEvaluation(bool /*evaluate_jacobians*/,
-                                                     bool /*new_evaluation_point*/) {
-  // Ceres has copied the point into the caller's block. The same point again
-  // (the Jacobian at an accepted step, a line search's trial step and the
-  // trust-region candidate): the values, Jacobians included, are there.
-  if (computed_ && std::equal(last_point_.begin(), last_point_.end(), parameters_)) return;
-  PrecomputeAll(parameters_);
+ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_function) {
+  return Wrap(cost_function, {const_cast<double*>(blocks_[0].values)});
 }
 
-void ParallelResidualEvaluator::PrecomputeAll(const double* point) {
+bool ParallelResidualEvaluator::AtLastPoint() const {
+  for (size_t b = 0; b < blocks_.size(); ++b) {
+    const double* last = last_point_.data() + offsets_[b];
+    if (!std::equal(last, last + blocks_[b].size, blocks_[b].values)) return false;
+  }
+  return true;
+}
+
+void ParallelResidualEvaluator::PrepareForEvaluation(bool /*evaluate_jacobians*/,
+                                                     bool /*new_evaluation_point*/) {
+  // Ceres has copied the point into the caller's blocks. The same point
+  // again (the Jacobian at an accepted step, a line search's trial step and
+  // the trust-region candidate): the values, Jacobians included, are there.
+  if (computed_ && AtLastPoint()) return;
+  last_point_.resize(size_);
+  for (size_t b = 0; b < blocks_.size(); ++b) {
+    std::copy(blocks_[b].values, blocks_[b].values + blocks_[b].size,
+              last_point_.begin() + offsets_[b]);
+  }
+  PrecomputeAll();
+}
+
+void ParallelResidualEvaluator::PrecomputeAll() {
   // Every thread reads this one copy of the point.
-  last_point_.assign(point, point + size_);
   computed_ = true;
   const double* copy = last_point_.data();
   const int count = static_cast<int>(wrappers_.size());
@@ -123,7 +192,8 @@ void ParallelResidualEvaluator::PrecomputeAll(const double* point) {
 }
 
 bool ParallelResidualEvaluator::CostGradient(const double* point, std::vector<double>* gradient) {
-  PrecomputeAll(point);
+  last_point_.assign(point, point + size_);
+  PrecomputeAll();
   gradient->assign(size_, 0.0);
   for (const ReplayingCostFunction* wrapper : wrappers_) {
     if (!wrapper->AddGradient(gradient->data())) return false;
