@@ -75,9 +75,9 @@ bool BlockIsValid(const FitDescription& fit, int b, std::string* error) {
   return true;
 }
 
-// The start of parameter `i` of `dataset`, in `slot`, is inside the model's
+// The value of parameter `i` of `dataset`, in `slot`, is inside the model's
 // range.
-bool StartIsInRange(const FitDescription& fit, const FitDataset& dataset, int i,
+bool IsInModelRange(const FitDescription& fit, const FitDataset& dataset, int i,
                     const ParameterSlot& slot, std::string* error) {
   const double value = slot.block[slot.index];
   const bool positive = i == kEtaE || i == kOmega;
@@ -86,7 +86,7 @@ bool StartIsInRange(const FitDescription& fit, const FitDataset& dataset, int i,
     return true;
   }
   *error = "dataset " + Quoted(dataset.name) + ": " + ParameterName(i) + " (" +
-           fit.EntryName(fit.AmbientIndex(slot)) + ") must start " +
+           fit.EntryName(fit.AmbientIndex(slot)) + ") must be " +
            (positive ? "positive (> 0)" : "non-negative (>= 0: it is bounded below by 0)") +
            ", got " + ToText(value);
   return false;
@@ -120,7 +120,7 @@ bool DatasetIsValid(const FitDescription& fit, const FitDataset& dataset, std::s
                ToText(fit.blocks[b].size - 1);
       return false;
     }
-    if (!StartIsInRange(fit, dataset, i, slot, error)) return false;
+    if (!IsInModelRange(fit, dataset, i, slot, error)) return false;
   }
   return true;
 }

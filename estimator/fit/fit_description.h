@@ -81,7 +81,7 @@ struct FitDescription {
   // False, with a message naming the dataset, block or entry, when the
   // description cannot be solved: no dataset or no dwell, a slot outside
   // the blocks, overlapping blocks, optional vectors of the wrong length,
-  // non-positive scales, values that are not finite, or a start outside the
+  // non-positive scales, values that are not finite, or values outside the
   // model's range (eta_e and w > 0; mu1, mu2 >= 0).
   bool IsValid(std::string* error) const;
 
