@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <utility>
 
 #include "glog/logging.h"
@@ -24,7 +25,9 @@ int ResolveThreadCount(int num_threads) {
 }
 
 // Owns one wrapped cost function and the values it had at the last point the
-// evaluator saw.
+// evaluator saw. One allocation holds them all: the point (the wrapped
+// function's parameter blocks concatenated), its residuals, and its Jacobian
+// (per parameter block, row-major, num_residuals x the block's size).
 class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunction {
  public:
   // `offsets`: where each of the wrapped function's parameter blocks starts
@@ -32,23 +35,12 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
   ReplayingCostFunction(ceres::CostFunction* wrapped, std::vector<int> offsets,
                         ParallelResidualEvaluator* owner)
       : wrapped_(wrapped), owner_(owner), offsets_(std::move(offsets)) {
-    const std::vector<int32_t>& sizes = wrapped->parameter_block_sizes();
-    CHECK_EQ(sizes.size(), offsets_.size());
+    CHECK_EQ(wrapped->parameter_block_sizes().size(), offsets_.size());
     set_num_residuals(wrapped->num_residuals());
-    *mutable_parameter_block_sizes() = sizes;
-    const int rows = wrapped->num_residuals();
-    int total = 0;
-    for (int size : sizes) {
-      starts_.push_back(total);
-      total += size;
-    }
-    point_.resize(total);
-    residuals_.resize(rows);
-    jacobian_.resize(static_cast<size_t>(rows) * total);
-    for (size_t j = 0; j < sizes.size(); ++j) {
-      block_pointers_.push_back(point_.data() + starts_[j]);
-      jacobian_pointers_.push_back(jacobian_.data() + static_cast<size_t>(rows) * starts_[j]);
-    }
+    *mutable_parameter_block_sizes() = wrapped->parameter_block_sizes();
+    rows_ = wrapped->num_residuals();
+    for (int size : parameter_block_sizes()) total_ += size;
+    storage_.resize(static_cast<size_t>(total_) * (1 + rows_) + rows_);
   }
 
   // Adds J^T r at the precomputed point to `gradient` (a point's
@@ -56,52 +48,118 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
   bool AddGradient(double* gradient) const {
     if (!ok_) return false;
     const std::vector<int32_t>& sizes = parameter_block_sizes();
+    int start = 0;
     for (size_t j = 0; j < sizes.size(); ++j) {
-      const double* jacobian = jacobian_pointers_[j];
-      for (size_t row = 0; row < residuals_.size(); ++row) {
+      const double* jacobian = Jacobian() + rows_ * start;
+      for (int row = 0; row < rows_; ++row) {
         for (int col = 0; col < sizes[j]; ++col)
-          gradient[offsets_[j] + col] += jacobian[row * sizes[j] + col] * residuals_[row];
+          gradient[offsets_[j] + col] += jacobian[row * sizes[j] + col] * Residuals()[row];
       }
+      start += sizes[j];
     }
     return true;
   }
 
   // Computes the values at `point` (the evaluator's thread for this block).
   void Precompute(const double* point) {
-    const std::vector<int32_t>& sizes = parameter_block_sizes();
-    for (size_t j = 0; j < sizes.size(); ++j) {
-      std::copy(point + offsets_[j], point + offsets_[j] + sizes[j], point_.begin() + starts_[j]);
-    }
-    ok_ = wrapped_->Evaluate(block_pointers_.data(), residuals_.data(), jacobian_pointers_.data());
     valid_ = true;
+    if (offsets_.size() == 1) {  // one parameter block: no per-block bookkeeping
+      std::copy(point + offsets_[0], point + offsets_[0] + total_, Point());
+      const double* blocks[] = {Point()};
+      double* jacobians[] = {Jacobian()};
+      ok_ = wrapped_->Evaluate(blocks, Residuals(), jacobians);
+      return;
+    }
+    const std::vector<int32_t>& sizes = parameter_block_sizes();
+    int start = 0;
+    for (size_t j = 0; j < sizes.size(); ++j) {
+      std::copy(point + offsets_[j], point + offsets_[j] + sizes[j], Point() + start);
+      start += sizes[j];
+    }
+    ok_ = EvaluateAtOwnPoint();
   }
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
+    if (offsets_.size() == 1) return EvaluateOneBlock(parameters, residuals, jacobians);
     if (!valid_ || !AtPoint(parameters)) {
       ++owner_->evaluated_directly_;
       return wrapped_->Evaluate(parameters, residuals, jacobians);
     }
     ++owner_->replayed_;
     if (!ok_) return false;
-    std::copy(residuals_.begin(), residuals_.end(), residuals);
+    std::copy(Residuals(), Residuals() + rows_, residuals);
     if (jacobians == nullptr) return true;
     const std::vector<int32_t>& sizes = parameter_block_sizes();
+    int start = 0;
     for (size_t j = 0; j < sizes.size(); ++j) {
-      if (jacobians[j] == nullptr) continue;
-      std::copy(jacobian_pointers_[j], jacobian_pointers_[j] + residuals_.size() * sizes[j],
-                jacobians[j]);
+      const double* jacobian = Jacobian() + rows_ * start;
+      if (jacobians[j] != nullptr) std::copy(jacobian, jacobian + rows_ * sizes[j], jacobians[j]);
+      start += sizes[j];
     }
     return true;
   }
 
  private:
+  // Parameter blocks whose pointers fit on the stack (every dwellfit
+  // residual reads at most six).
+  static constexpr size_t kStackBlocks = 8;
+
+  double* Point() { return storage_.data(); }
+  const double* Point() const { return storage_.data(); }
+  double* Residuals() { return storage_.data() + total_; }
+  const double* Residuals() const { return storage_.data() + total_; }
+  double* Jacobian() { return storage_.data() + total_ + rows_; }
+  const double* Jacobian() const { return storage_.data() + total_ + rows_; }
+
+  // The wrapped function at Point(), into Residuals() and Jacobian().
+  bool EvaluateAtOwnPoint() {
+    const std::vector<int32_t>& sizes = parameter_block_sizes();
+    std::array<const double*, kStackBlocks> block_array;
+    std::array<double*, kStackBlocks> jacobian_array;
+    std::vector<const double*> block_vector;
+    std::vector<double*> jacobian_vector;
+    const double** blocks = block_array.data();
+    double** jacobians = jacobian_array.data();
+    if (sizes.size() > kStackBlocks) {
+      block_vector.resize(sizes.size());
+      jacobian_vector.resize(sizes.size());
+      blocks = block_vector.data();
+      jacobians = jacobian_vector.data();
+    }
+    int start = 0;
+    for (size_t j = 0; j < sizes.size(); ++j) {
+      blocks[j] = Point() + start;
+      jacobians[j] = Jacobian() + rows_ * start;
+      start += sizes[j];
+    }
+    return wrapped_->Evaluate(blocks, Residuals(), jacobians);
+  }
+
+  // Evaluate for a function of one parameter block (every dwell on one
+  // 6-double block): the same, without the per-block bookkeeping.
+  bool EvaluateOneBlock(double const* const* parameters, double* residuals,
+                        double** jacobians) const {
+    if (!valid_ || !std::equal(Point(), Point() + total_, parameters[0])) {
+      ++owner_->evaluated_directly_;
+      return wrapped_->Evaluate(parameters, residuals, jacobians);
+    }
+    ++owner_->replayed_;
+    if (!ok_) return false;
+    std::copy(Residuals(), Residuals() + rows_, residuals);
+    if (jacobians != nullptr && jacobians[0] != nullptr) {
+      std::copy(Jacobian(), Jacobian() + rows_ * total_, jacobians[0]);
+    }
+    return true;
+  }
+
   // `parameters` are the precomputed point.
   bool AtPoint(double const* const* parameters) const {
     const std::vector<int32_t>& sizes = parameter_block_sizes();
+    int start = 0;
     for (size_t j = 0; j < sizes.size(); ++j) {
-      const double* own = point_.data() + starts_[j];
-      if (!std::equal(own, own + sizes[j], parameters[j])) return false;
+      if (!std::equal(Point() + start, Point() + start + sizes[j], parameters[j])) return false;
+      start += sizes[j];
     }
     return true;
   }
@@ -109,12 +167,9 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
   const std::unique_ptr<ceres::CostFunction> wrapped_;
   ParallelResidualEvaluator* const owner_;
   const std::vector<int> offsets_;  // of each parameter block in the evaluator's point
-  std::vector<int> starts_;         // of each parameter block in point_
-  std::vector<double> point_;       // the point the values are for, its blocks concatenated
-  std::vector<double> residuals_;
-  std::vector<double> jacobian_;  // per parameter block: row-major, num_residuals x its size
-  std::vector<const double*> block_pointers_;  // into point_
-  std::vector<double*> jacobian_pointers_;     // into jacobian_
+  int rows_ = 0;                    // residuals
+  int total_ = 0;                   // doubles over the parameter blocks
+  std::vector<double> storage_;     // point, residuals, Jacobian
   bool ok_ = false;
   bool valid_ = false;
 };
@@ -154,7 +209,11 @@ ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_f
 }
 
 ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_function) {
-  return Wrap(cost_function, {const_cast<double*>(blocks_[0].values)});
+  CHECK_EQ(cost_function->parameter_block_sizes().size(), 1u);
+  CHECK_EQ(cost_function->parameter_block_sizes()[0], blocks_[0].size);
+  auto* wrapper = new ReplayingCostFunction(cost_function, {0}, this);
+  wrappers_.push_back(wrapper);
+  return wrapper;
 }
 
 bool ParallelResidualEvaluator::AtLastPoint() const {
