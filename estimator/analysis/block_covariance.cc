@@ -103,9 +103,11 @@ BlockCovariance Unavailable(BlockCovariance c, const std::string& message) {
   return c;
 }
 
-// Counts, free entries, zeroed results and the point-sigma flags; false when
-// there is nothing to estimate (`c->message` says why).
+// A valid description, counts, free entries, zeroed results and the
+// point-sigma flags; false when there is nothing to estimate (`c->message`
+// says why).
 bool Prepare(const FitDescription& fit, const ResidualOptions& residual, BlockCovariance* c) {
+  if (!fit.IsValid(&c->message) || !residual.IsValid(&c->message)) return false;
   c->values = fit.Values();
   const int n = static_cast<int>(c->values.size());
   c->standard_error.assign(n, 0.0);
@@ -120,7 +122,6 @@ bool Prepare(const FitDescription& fit, const ResidualOptions& residual, BlockCo
   int with_sigma = 0;
   for (const FitDataset& dataset : fit.datasets) {
     for (const Sweep* sweep : dataset.sweeps) {
-      if (sweep == nullptr) continue;
       c->num_points += static_cast<int>(sweep->points.size());
       for (const DwellPoint& point : sweep->points) with_sigma += point.sigma.has_value();
     }
@@ -129,16 +130,8 @@ bool Prepare(const FitDescription& fit, const ResidualOptions& residual, BlockCo
   const bool use_sigma = residual.use_point_sigma;
   c->all_standardised = use_sigma && c->num_points > 0 && with_sigma == c->num_points;
   c->some_standardised = use_sigma && with_sigma > 0;
-  std::string error;
-  if (c->num_points == 0) {
-    c->message = "no dwell points were fitted";
-  } else if (c->num_free == 0) {
-    c->message = "every parameter is fixed: nothing was estimated";
-  } else if (!fit.IsValid(&error) || !residual.IsValid(&error)) {
-    c->message = error;
-  } else {
-    return true;
-  }
+  if (c->num_free > 0) return true;
+  c->message = "every parameter is fixed: nothing was estimated";
   return false;
 }
 
@@ -304,6 +297,11 @@ BlockCovariance EstimateBlockCovariance(const FitDescription& fit,
 
   // With the caller's residual blocks: the dwells weighted by 1/s beside them.
   double factor = c.noise_sigma * c.noise_sigma;
+  if (fit.add_residuals && !(c.noise_sigma > 0.0)) {
+    return Unavailable(c,
+                       "the dwells fit exactly (noise sigma 0): there is no scale to weigh them "
+                       "against the caller's residual blocks");
+  }
   if (fit.add_residuals) {
     problem = AssembleDataProblem(fit, residual, 1.0 / c.noise_sigma, true);
     std::vector<ceres::ResidualBlockId> rows = problem->dwell_blocks();

@@ -75,7 +75,8 @@ struct BlockCovariance {
   // sigma_max / sigma_min of the column-normalised J (0: not computed).
   double collinearity = 0.0;
   // Per ambient entry (FitDescription::AmbientIndex): value, standard error
-  // (0 for fixed entries) and 95 % interval (the value for fixed entries).
+  // (0 for fixed entries) and 95 % interval (the value for fixed entries);
+  // empty when the description is invalid.
   std::vector<double> values, standard_error, ci95_low, ci95_high;
   Eigen::MatrixXd covariance;  // ambient x ambient, physical units
   std::vector<int> free;       // ambient index of each free entry, in order

@@ -4,6 +4,8 @@
 #include <functional>
 #include <sstream>
 
+#include "glog/logging.h"
+
 namespace dwellfit {
 
 ParameterMap IdentityMap(double* parameters) {
@@ -242,8 +244,10 @@ ParameterLayout LayoutOf(const FitDescription& fit, const ParameterMap& map) {
       ++position;
     }
     if (position == static_cast<int>(layout.blocks.size())) {
+      const int b = fit.BlockOf(map[i].block);
+      CHECK_GE(b, 0) << ParameterName(i) << " is mapped to a block the description lacks";
       layout.blocks.push_back(map[i].block);
-      layout.sizes.push_back(fit.blocks[fit.BlockOf(map[i].block)].size);
+      layout.sizes.push_back(fit.blocks[b].size);
     }
     layout.block[i] = position;
     layout.index[i] = map[i].index;

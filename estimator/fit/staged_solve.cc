@@ -152,7 +152,8 @@ PenaltyOptions WeighPenalties(const PenaltyOptions& penalties, StageProblem* pro
   return weighted;
 }
 
-// The entries of `fit` holding `parameter` (or, for kMu1, either damping).
+// The entries of `fit` holding eta_e of some dataset, or with `damping` its
+// mu1 or mu2, each once.
 std::vector<double*> EntriesHolding(const FitDescription& fit, bool damping) {
   std::vector<bool> holding = fit.EntriesHolding(damping ? kMu1 : kEtaE);
   if (damping) {

@@ -47,7 +47,8 @@ namespace dwellfit {
 enum class FitStatus {
   kConverged,      // the last stage met a convergence test
   kNoConvergence,  // the last stage stopped at its iteration limit: usable, not a proven minimum
-  kFailure,        // a stage's solve failed (the model could not be evaluated): not usable
+  kFailure,        // a stage's solve failed (the model could not be evaluated): not
+                   // usable; the blocks hold where that solve stopped
   kInvalidInput,   // invalid options or description: nothing solved, blocks untouched
 };
 const char* FitStatusName(FitStatus status);  // "converged", "no_convergence", ...
