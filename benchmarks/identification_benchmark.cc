@@ -1,9 +1,11 @@
 // Speed of the identification: the vertical residual with its Jacobian per
-// dwell point, the whole two-stage thesis-numerical fit (about 260 points;
-// target under 20 ms), and the measured clamped-beam fit (two levels, 4096
-// dwells, with the bifurcation-range penalty; target under 200 ms). The fits
-// run with the residual blocks evaluated on 1 and on 2 threads (the argument);
-// their results do not depend on it.
+// dwell point (read from one block, and through MappedCostFunction from
+// three), the whole two-stage thesis-numerical fit (about 260 points; target
+// under 20 ms), the measured clamped-beam fit (two levels, 4096 dwells, with
+// the bifurcation-range penalty; target under 200 ms), and a joint fit of two
+// simulated datasets sharing eta_e (mapped blocks). The fits run with the
+// residual blocks evaluated on 1 and on 2 threads (the argument); their
+// results do not depend on it.
 #include <memory>
 #include <string>
 #include <vector>
@@ -11,8 +13,11 @@
 #include "benchmark/benchmark.h"
 #include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/fit/identification.h"
+#include "dwellfit/estimator/fit/mapped_cost_function.h"
 #include "dwellfit/estimator/fit/problem_builder.h"
+#include "dwellfit/estimator/fit/staged_solve.h"
 #include "dwellfit/estimator/run/resolved_run.h"
+#include "dwellfit/estimator/simulation/dwell_simulator.h"
 
 namespace dwellfit {
 namespace {
@@ -51,21 +56,36 @@ void RunConfiguredFit(benchmark::State& state, ResolvedRun& run) {
 // Residual plus Jacobian of every fitted dwell, per point, alternating between
 // the start and a point 0.1 % away in every parameter, as a solver's steps
 // do (each dwell's Newton iteration starts from its root at the last point).
-void BM_VerticalResidualWithJacobianPerPoint(benchmark::State& state) {
+// With `mapped`, each dwell reads the parameters from three blocks (eta_e;
+// mu1, mu2; delta, alpha, omega) through MappedCostFunction.
+void ResidualWithJacobianPerPoint(benchmark::State& state, bool mapped) {
   const ResolvedRun& thesis = Thesis();
   ProblemBuilder builder(ProblemBuilderOptions{});
-  std::vector<std::unique_ptr<ceres::CostFunction>> costs;
-  for (const Sweep* sweep : thesis.fitted) {
-    for (const DwellPoint& point : sweep->points) costs.emplace_back(builder.MakeResidual(point));
-  }
-  const ParameterVector start = thesis.options.initial;
+  ParameterVector start = thesis.options.initial;
   ParameterVector moved = start;
   for (double& value : moved) value *= 1.001;
-  const double* at_start[] = {start.data()};
-  const double* at_moved[] = {moved.data()};
+  FitDescription fit;  // the three blocks' sizes, for the layout
+  fit.blocks = {
+      {start.data(), 1, "eta_e"}, {start.data() + 1, 2, "damping"}, {start.data() + 3, 3, "rest"}};
+  const ParameterMap map = {{{start.data(), 0},
+                             {start.data() + 1, 0},
+                             {start.data() + 1, 1},
+                             {start.data() + 3, 0},
+                             {start.data() + 3, 1},
+                             {start.data() + 3, 2}}};
+  const ParameterLayout layout = LayoutOf(fit, map);
+  std::vector<std::unique_ptr<ceres::CostFunction>> costs;
+  for (const Sweep* sweep : thesis.fitted) {
+    for (const DwellPoint& point : sweep->points) {
+      ceres::CostFunction* cost = builder.MakeResidual(point);
+      costs.emplace_back(mapped ? new MappedCostFunction(cost, layout) : cost);
+    }
+  }
+  const double* at_start[] = {start.data(), start.data() + 1, start.data() + 3};
+  const double* at_moved[] = {moved.data(), moved.data() + 1, moved.data() + 3};
   double residual;
   double jacobian[kNumParameters];
-  double* jacobians[] = {jacobian};
+  double* jacobians[] = {jacobian, jacobian + 1, jacobian + 3};
   bool moved_now = false;
   for (auto _ : state) {
     const double* const* blocks = moved_now ? at_moved : at_start;
@@ -81,7 +101,16 @@ void BM_VerticalResidualWithJacobianPerPoint(benchmark::State& state) {
       benchmark::Counter(static_cast<double>(state.iterations() * costs.size()),
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
+
+void BM_VerticalResidualWithJacobianPerPoint(benchmark::State& state) {
+  ResidualWithJacobianPerPoint(state, false);
+}
 BENCHMARK(BM_VerticalResidualWithJacobianPerPoint)->Unit(benchmark::kMicrosecond);
+
+void BM_MappedVerticalResidualWithJacobianPerPoint(benchmark::State& state) {
+  ResidualWithJacobianPerPoint(state, true);
+}
+BENCHMARK(BM_MappedVerticalResidualWithJacobianPerPoint)->Unit(benchmark::kMicrosecond);
 
 // The whole default fit (algebraic stage, then vertical) from the config's start.
 void BM_ThesisNumericalWholeFit(benchmark::State& state) { RunConfiguredFit(state, Thesis()); }
@@ -102,6 +131,64 @@ BENCHMARK(BM_ClampedBeamFit)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(5)
+    ->UseRealTime();
+
+// Two simulated datasets of the thesis model (w = 2 pi 40 and 2 pi 43 rad/s,
+// 1 % noise), one eta_e, mu1, mu2, delta, alpha block shared and one w block
+// each: the staged solve on mapped blocks (520 dwells) from the thesis start.
+void BM_TwoDatasetsSharedEtaEFit(benchmark::State& state) {
+  static const std::vector<Sweep>* datasets = [] {
+    auto* sweeps = new std::vector<Sweep>[2];
+    for (int d = 0; d < 2; ++d) {
+      const double f0 = d == 0 ? 40.0 : 43.0;
+      SweepPlan frequency;
+      frequency.id = "F";
+      frequency.held_a_base = 0.01;
+      frequency.from = f0 - 2.0;
+      frequency.to = f0 + 6.0;
+      frequency.step = 0.1;
+      SweepPlan amplitude = frequency;
+      amplitude.id = "A";
+      amplitude.kind = SweepKind::kAmplitude;
+      amplitude.held_frequency_hz = f0 + 1.5;
+      amplitude.from = 0.002;
+      amplitude.to = 0.05;
+      amplitude.step = 0.001;
+      DwellPlan plan;
+      plan.truth = {100.0, 0.2, 300.0, 1e4, 9e8, HzToRadPerSecond(f0)};
+      plan.sweeps = {frequency, amplitude};
+      sweeps[d] = SimulateDwells(plan);  // noise-free: the simulator's labels
+    }
+    return sweeps;
+  }();
+  StagedSolveOptions options;
+  options.residual.error = ErrorMeasure::kRelative;
+  options.solver.num_threads = static_cast<int>(state.range(0));
+  for (auto _ : state) {
+    double shared[5] = {130.0, 0.14, 390.0, 7000.0, 1.17e9};
+    double w[2][1] = {{HzToRadPerSecond(40.2)}, {HzToRadPerSecond(42.8)}};
+    FitDescription fit;
+    fit.blocks = {{shared, 5, "shared"}, {w[0], 1, "w_A"}, {w[1], 1, "w_B"}};
+    for (int d = 0; d < 2; ++d) {
+      std::vector<const Sweep*> sweeps;
+      for (const Sweep& sweep : datasets[d]) sweeps.push_back(&sweep);
+      fit.datasets.push_back(
+          {d == 0 ? "A" : "B",
+           sweeps,
+           {{{shared, 0}, {shared, 1}, {shared, 2}, {shared, 3}, {shared, 4}, {w[d], 0}}}});
+    }
+    const FitSummary summary = SolveStaged(fit, options);
+    benchmark::DoNotOptimize(shared);
+    state.counters["iterations"] = summary.iterations;
+    state.counters["dwells"] = summary.residual_blocks;
+    state.counters["converged"] = summary.converged;
+  }
+}
+BENCHMARK(BM_TwoDatasetsSharedEtaEFit)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
 }  // namespace

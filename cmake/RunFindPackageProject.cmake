@@ -1,16 +1,18 @@
-# CTest driver for `find_package_project` (cmake -P): installs the built
-# dwellfit into a fresh prefix, configures and builds the outside project
-# tests/find_package_project against it, and runs the program. Any failing
-# step fails the test with that step's name and output.
+# CTest driver for the tests that build an outside project against an
+# installed dwellfit (cmake -P): installs the built dwellfit into a fresh
+# prefix, configures and builds the outside project (tests/find_package_project,
+# examples/two_beams) against it with find_package(dwellfit), and runs its
+# program. Any failing step fails the test with that step's name and output.
 #
 # Required -D variables:
 #   DWELLFIT_BINARY_DIR  the dwellfit build tree to install from
-#   PROJECT_SOURCE       tests/find_package_project
+#   PROJECT_SOURCE       the outside project's source directory
 #   WORK_DIR             build directory of the outside project (wiped first)
 #   PREFIX               install prefix (wiped first)
-# Optional: GENERATOR, CXX_COMPILER, BUILD_TYPE, and CXX_FLAGS and LINKER_FLAGS
-# (the sanitizer flags of a DWELLFIT_SANITIZE build: an instrumented library
-# links only into an instrumented program).
+# Optional: PROGRAM (the program to run, default embed_dwellfit), NAME (in
+# messages, default find_package_project), GENERATOR, CXX_COMPILER, BUILD_TYPE,
+# and CXX_FLAGS and LINKER_FLAGS (the sanitizer flags of a DWELLFIT_SANITIZE
+# build: an instrumented library links only into an instrumented program).
 cmake_minimum_required(VERSION 3.16)
 
 foreach(var DWELLFIT_BINARY_DIR PROJECT_SOURCE WORK_DIR PREFIX)
@@ -21,13 +23,19 @@ endforeach()
 if(NOT BUILD_TYPE)
   set(BUILD_TYPE Release)
 endif()
+if(NOT PROGRAM)
+  set(PROGRAM embed_dwellfit)
+endif()
+if(NOT NAME)
+  set(NAME find_package_project)
+endif()
 
 function(run_step name)
   list(JOIN ARGN " " command_line)
-  message(STATUS "find_package_project: ${name}: ${command_line}")
+  message(STATUS "${NAME}: ${name}: ${command_line}")
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE result)
   if(NOT result EQUAL 0)
-    message(FATAL_ERROR "find_package_project: step '${name}' failed (${result}): ${command_line}")
+    message(FATAL_ERROR "${NAME}: step '${name}' failed (${result}): ${command_line}")
   endif()
 endfunction()
 
@@ -54,9 +62,9 @@ endif()
 run_step(configure "${CMAKE_COMMAND}" ${configure_args})
 run_step(build "${CMAKE_COMMAND}" --build "${WORK_DIR}" --config "${BUILD_TYPE}")
 
-find_program(program embed_dwellfit
+find_program(program ${PROGRAM}
   PATHS "${WORK_DIR}" "${WORK_DIR}/${BUILD_TYPE}" NO_DEFAULT_PATH)
 if(NOT program)
-  message(FATAL_ERROR "find_package_project: the built program embed_dwellfit is missing in ${WORK_DIR}")
+  message(FATAL_ERROR "${NAME}: the built program ${PROGRAM} is missing in ${WORK_DIR}")
 endif()
 run_step(run "${program}")

@@ -23,8 +23,9 @@
 // fixed reference Omega_ref has, by the delta method, the variance g^T C g
 // with g = d alpha_e / dp = [0, 0, 0, -(2/3) Omega_ref^2, 1, 0].
 //
-// Identifiability. (J^T J)^-1 is computed by ceres::Covariance (DENSE_SVD) on
-// J with unit-length columns, so that its condition number measures only how
+// Identifiability. (J^T J)^-1 is computed by EstimateBlockCovariance
+// (block_covariance.h), the one covariance path: ceres::Covariance (DENSE_SVD)
+// on J with unit-length columns, so that its condition number measures only how
 // nearly the parameters' effects on the fitted amplitudes coincide (the
 // collinearity diagnostic of Belsley, Kuh and Welsch), not their units. When
 // it exceeds kMaxCollinearity the covariance is not reported (available =
@@ -44,18 +45,12 @@
 #include <vector>
 
 #include "Eigen/Core"
-#include "dwellfit/estimator/fit/identification_options.h"
+#include "dwellfit/estimator/analysis/block_covariance.h"
 #include "dwellfit/estimator/data/sweep.h"
+#include "dwellfit/estimator/fit/identification_options.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 
 namespace dwellfit {
-
-// Largest sigma_max / sigma_min of the column-normalised Jacobian for which a
-// covariance is reported: about 1/sqrt(machine epsilon), so that J^T J keeps a
-// reciprocal condition number above ~1e-16 and its inverse is not rounding
-// noise. Measured: exactly collinear parameters (delta and alpha on one
-// amplitude sweep) give 8e15; the thesis case's two fitted sweeps give ~200.
-inline constexpr double kMaxCollinearity = 1e8;
 
 // |correlation| above which a pair of free parameters is reported as weakly
 // separated.

@@ -6,22 +6,33 @@
 
 namespace dwellfit {
 
-BoundRestWatcher::BoundRestWatcher(const double* parameters, std::vector<Bound> watched, int steps)
-    : parameters_(parameters),
-      watched_(std::move(watched)),
-      steps_(steps),
-      steps_at_bound_(watched_.size(), 0) {
+std::vector<BoundRestWatcher::Entry> BoundRestWatcher::EntriesOf(
+    const double* parameters, const std::vector<Bound>& watched) {
   CHECK(parameters != nullptr);
+  std::vector<Entry> entries;
+  for (const Bound& bound : watched) {
+    entries.push_back({parameters + bound.index, bound.lower, bound.index});
+  }
+  return entries;
+}
+
+BoundRestWatcher::BoundRestWatcher(const double* parameters, const std::vector<Bound>& watched,
+                                   int steps)
+    : BoundRestWatcher(EntriesOf(parameters, watched), steps) {}
+
+BoundRestWatcher::BoundRestWatcher(std::vector<Entry> watched, int steps)
+    : watched_(std::move(watched)), steps_(steps), steps_at_bound_(watched_.size(), 0) {
+  for (const Entry& entry : watched_) CHECK(entry.value != nullptr);
   CHECK_GE(steps, 1);
 }
 
 ceres::CallbackReturnType BoundRestWatcher::operator()(const ceres::IterationSummary& summary) {
   if (!summary.step_is_successful || summary.iteration == 0) return ceres::SOLVER_CONTINUE;
   for (size_t i = 0; i < watched_.size(); ++i) {
-    const Bound& bound = watched_[i];
-    steps_at_bound_[i] = parameters_[bound.index] == bound.lower ? steps_at_bound_[i] + 1 : 0;
+    const Entry& entry = watched_[i];
+    steps_at_bound_[i] = *entry.value == entry.lower ? steps_at_bound_[i] + 1 : 0;
     if (steps_at_bound_[i] >= steps_) {
-      resting_ = bound.index;
+      resting_ = entry.id;
       return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
     }
   }

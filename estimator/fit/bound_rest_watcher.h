@@ -12,10 +12,10 @@
 // converges in a few steps (Identify's stages: hold, solve, then release any
 // held parameter whose cost gradient points back into the feasible side).
 //
-// The watcher reads the parameter block after every successful step
-// (needs ceres::Solver::Options::update_state_every_iteration) and stops the
-// solve, with SOLVER_TERMINATE_SUCCESSFULLY, once one watched parameter has
-// sat exactly on its bound for `steps` successful steps in a row.
+// The watcher reads the watched entries after every successful step (needs
+// ceres::Solver::Options::update_state_every_iteration) and stops the solve,
+// with SOLVER_TERMINATE_SUCCESSFULLY, once one watched entry has sat exactly
+// on its bound for `steps` successful steps in a row.
 #ifndef DWELLFIT_ESTIMATOR_FIT_BOUND_REST_WATCHER_H_
 #define DWELLFIT_ESTIMATOR_FIT_BOUND_REST_WATCHER_H_
 
@@ -32,18 +32,27 @@ class BoundRestWatcher : public ceres::IterationCallback {
     int index = 0;       // into the parameter block
     double lower = 0.0;  // the bound
   };
+  // One watched entry of any block the solver updates.
+  struct Entry {
+    const double* value = nullptr;  // owned by the caller
+    double lower = 0.0;             // its bound
+    int id = 0;                     // what resting() reports
+  };
 
-  // `parameters`: the block the solver updates (owned by the caller).
-  BoundRestWatcher(const double* parameters, std::vector<Bound> watched, int steps);
+  // Entries of the one block `parameters` (owned by the caller); resting()
+  // reports a Bound's index.
+  BoundRestWatcher(const double* parameters, const std::vector<Bound>& watched, int steps);
+  BoundRestWatcher(std::vector<Entry> watched, int steps);
 
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override;
 
-  // The parameter that stopped the solve by resting on its bound, if any.
+  // The id of the entry that stopped the solve by resting on its bound, if any.
   std::optional<int> resting() const { return resting_; }
 
  private:
-  const double* parameters_;
-  const std::vector<Bound> watched_;
+  static std::vector<Entry> EntriesOf(const double* parameters, const std::vector<Bound>& watched);
+
+  const std::vector<Entry> watched_;
   const int steps_;
   std::vector<int> steps_at_bound_;  // per watched parameter
   std::optional<int> resting_;

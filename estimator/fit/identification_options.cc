@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 namespace dwellfit {
 
@@ -33,14 +34,41 @@ bool ErrorMeasureFromName(const std::string& name, ErrorMeasure* measure) {
   return false;
 }
 
+namespace {
+
+template <typename T>
+std::string ToText(const T& value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
+}  // namespace
+
+bool ResidualOptions::IsValid(std::string* error) const {
+  if (!(amplitude_floor >= 0.0) || !std::isfinite(amplitude_floor)) {
+    *error = "residual.amplitude_floor must be a non-negative number (>= 0), got " +
+             ToText(amplitude_floor);
+    return false;
+  }
+  return true;
+}
+
 bool SolverSettings::IsValid(std::string* error) const {
   if (max_iterations < 1) {
     *error = "solver.max_iterations must be at least 1";
     return false;
   }
-  if (!(function_tolerance >= 0) || !(gradient_tolerance >= 0) || !(parameter_tolerance >= 0)) {
-    *error = "solver tolerances must be non-negative numbers";
-    return false;
+  const std::pair<const char*, double> tolerances[] = {
+      {"function_tolerance", function_tolerance},
+      {"gradient_tolerance", gradient_tolerance},
+      {"parameter_tolerance", parameter_tolerance}};
+  for (const auto& [name, value] : tolerances) {
+    if (!(value >= 0.0) || !std::isfinite(value)) {
+      *error = std::string("solver.") + name + " must be a non-negative number (>= 0), got " +
+               ToText(value);
+      return false;
+    }
   }
   if (num_threads < 0) {
     *error = "solver.num_threads must be at least 0 (0: one per processor available)";
@@ -102,33 +130,42 @@ bool PenaltyOptions::IsValid(std::string* error) const {
   return bifurcation_range.IsValid(error) && branch_stability.IsValid(error);
 }
 
+bool StagedSolveOptions::IsValid(std::string* error) const {
+  if (stages.empty()) {
+    *error = "stages must list at least one fit stage (algebraic or vertical)";
+    return false;
+  }
+  return residual.IsValid(error) && penalties.IsValid(error) && solver.IsValid(error);
+}
+
 bool IdentificationOptions::IsValid(std::string* error) const {
   for (int i = 0; i < kNumParameters; ++i) {
+    const std::string field = std::string("initial.") + ParameterName(i);
     if (!std::isfinite(initial[i])) {
-      *error = std::string("initial value of ") + ParameterName(i) + " is not a finite number";
+      *error = field + " must be a finite number, got " + ToText(initial[i]);
+      return false;
+    }
+    const bool positive = i == kEtaE || i == kOmega;
+    if (positive && !(initial[i] > 0.0)) {
+      *error = field + " must be positive (> 0), got " + ToText(initial[i]);
+      return false;
+    }
+    if ((i == kMu1 || i == kMu2) && initial[i] < 0.0) {
+      *error = field + " must be non-negative (>= 0: it is bounded below by 0), got " +
+               ToText(initial[i]);
       return false;
     }
   }
-  for (int i : {kEtaE, kMu1, kMu2}) {
-    if (initial[i] < 0.0) {
-      *error = std::string("initial value of ") + ParameterName(i) +
-               " must be non-negative (it is bounded below by 0)";
-      return false;
-    }
-  }
-  if (!(initial[kEtaE] > 0.0)) {
-    *error = "initial value of eta_e must be positive";
-    return false;
-  }
-  if (!(initial[kOmega] > 0.0)) {
-    *error = "initial value of omega (natural frequency) must be positive";
-    return false;
-  }
-  if (stages.empty()) {
-    *error = "at least one fit stage is required";
-    return false;
-  }
-  return penalties.IsValid(error) && solver.IsValid(error);
+  return SolveOptions().IsValid(error);
+}
+
+StagedSolveOptions IdentificationOptions::SolveOptions() const {
+  StagedSolveOptions options;
+  options.stages = stages;
+  options.residual = residual;
+  options.penalties = penalties;
+  options.solver = solver;
+  return options;
 }
 
 }  // namespace dwellfit

@@ -1,5 +1,6 @@
 // Options of one identification run, one struct per component, each with
-// defaults in the body and `bool IsValid(std::string* error) const`.
+// defaults in the body and `bool IsValid(std::string* error) const`, whose
+// message names the field (as the config spells it) and the bound it breaks.
 #ifndef DWELLFIT_ESTIMATOR_FIT_IDENTIFICATION_OPTIONS_H_
 #define DWELLFIT_ESTIMATOR_FIT_IDENTIFICATION_OPTIONS_H_
 
@@ -7,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "dwellfit/residuals/model/model_parameters.h"
 #include "dwellfit/residuals/functors/vertical_error_residual.h"
+#include "dwellfit/residuals/model/model_parameters.h"
 
 namespace dwellfit {
 
@@ -30,6 +31,7 @@ struct ResidualOptions {
   // f of the relative error ln(a_i + f) - ln(a_model + f), in the data's
   // amplitude unit: the measurement's noise floor (0: purely relative).
   double amplitude_floor = 0.0;
+  bool IsValid(std::string* error) const;
 };
 
 struct SolverSettings {
@@ -99,6 +101,19 @@ struct PenaltyOptions {
   bool IsValid(std::string* error) const;
 };
 
+// The stages of a staged solve (staged_solve.h) and how each is solved.
+struct StagedSolveOptions {
+  // Fit stages run in order, each starting where the previous one ended.
+  std::vector<ResidualKind> stages = {ResidualKind::kAlgebraic, ResidualKind::kVertical};
+  ResidualOptions residual;
+  // Soft constraints added to every vertical-error stage.
+  PenaltyOptions penalties;
+  SolverSettings solver;
+  bool IsValid(std::string* error) const;
+};
+
+// The single-dataset identification (Identify, identification.h): its
+// start and fixed parameters, and the staged solve's options.
 struct IdentificationOptions {
   // Starting point, ParameterIndex order, physical units (omega in rad/s).
   ParameterVector initial = {0, 0, 0, 0, 0, 0};
@@ -111,6 +126,8 @@ struct IdentificationOptions {
   PenaltyOptions penalties;
   SolverSettings solver;
   bool IsValid(std::string* error) const;
+  // stages, residual, penalties and solver.
+  StagedSolveOptions SolveOptions() const;
 };
 
 }  // namespace dwellfit

@@ -56,11 +56,32 @@ std::vector<ParameterVector> MultiStartPoints(const IdentificationOptions& optio
   return starts;
 }
 
+namespace {
+
+// A fit that solved (converged or stopped at its iteration limit) to finite
+// parameters: only such a fit can be the best.
+bool Usable(const IdentificationResult& fit) {
+  return fit.IsSolutionUsable() && std::all_of(fit.parameters.begin(), fit.parameters.end(),
+                                               [](double v) { return std::isfinite(v); });
+}
+
+}  // namespace
+
 MultiStartResult IdentifyMultiStart(const std::vector<const Sweep*>& fitted,
                                     const IdentificationOptions& options,
                                     const std::optional<ParameterVector>& automatic,
                                     const MultiStartOptions& multi_start) {
   MultiStartResult result;
+  std::string error;
+  if (!multi_start.IsValid(&error)) {
+    result.best.parameters = options.initial;
+    result.best.status = FitStatus::kInvalidInput;
+    result.best.message = error;
+    result.starts = {options.initial};
+    result.final_costs = {0.0};
+    result.converged = {false};
+    return result;
+  }
   result.starts = MultiStartPoints(options, automatic, multi_start);
   const int n = static_cast<int>(result.starts.size());
   std::vector<IdentificationResult> fits(n);
@@ -87,10 +108,7 @@ MultiStartResult IdentifyMultiStart(const std::vector<const Sweep*>& fitted,
   for (int i = 0; i < n; ++i) {
     result.final_costs.push_back(fits[i].final_cost);
     result.converged.push_back(fits[i].converged);
-    const bool usable =
-        fits[i].failure.empty() && std::all_of(fits[i].parameters.begin(), fits[i].parameters.end(),
-                                               [](double v) { return std::isfinite(v); });
-    if (!usable) {
+    if (!Usable(fits[i])) {
       ++result.failed;
       continue;
     }
@@ -102,7 +120,7 @@ MultiStartResult IdentifyMultiStart(const std::vector<const Sweep*>& fitted,
   result.best_start = std::max(best_usable, 0);
   result.best = fits[result.best_start];
   for (int i = 0; i < n; ++i) {
-    bool same = fits[i].failure.empty();
+    bool same = Usable(fits[i]);
     for (int j = 0; j < kNumParameters && same; ++j) {
       if (options.fixed[j]) continue;
       const double reference = std::abs(result.best.parameters[j]) > 0.0

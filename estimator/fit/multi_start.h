@@ -41,7 +41,7 @@ struct MultiStartResult {
   std::vector<double> final_costs;      // of each start
   std::vector<bool> converged;          // of each start
   int reached_best = 0;                 // starts whose estimate matches the best's
-  // Starts whose fit failed (IdentificationResult::failure, or parameters
+  // Starts whose fit failed (IdentificationResult::IsSolutionUsable() false, or parameters
   // that are not finite): never the best unless all failed.
   int failed = 0;
 };
@@ -51,9 +51,12 @@ std::vector<ParameterVector> MultiStartPoints(const IdentificationOptions& optio
                                               const std::optional<ParameterVector>& automatic,
                                               const MultiStartOptions& multi_start);
 
-// Runs Identify from every start. A start "reached the best" when each free
-// parameter is within 1e-5 of the best estimate, relative to that estimate's
-// magnitude (or to the start's scale for a parameter at 0).
+// Runs Identify from every start and keeps the usable fit of lowest cost
+// (the first start's fit, with its status, when none is usable). A start
+// "reached the best" when each free parameter is within 1e-5 of the best
+// estimate, relative to that estimate's magnitude (or to the start's scale
+// for a parameter at 0). Invalid `multi_start` options give
+// best.status = FitStatus::kInvalidInput, naming the field.
 MultiStartResult IdentifyMultiStart(const std::vector<const Sweep*>& fitted,
                                     const IdentificationOptions& options,
                                     const std::optional<ParameterVector>& automatic,

@@ -3,6 +3,8 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
+#include <utility>
 
 #include "glog/logging.h"
 
@@ -23,95 +25,221 @@ int ResolveThreadCount(int num_threads) {
 }
 
 // Owns one wrapped cost function and the values it had at the last point the
-// evaluator saw.
+// evaluator saw. One allocation holds them all: the point (the wrapped
+// function's parameter blocks concatenated), its residuals, and its Jacobian
+// (per parameter block, row-major, num_residuals x the block's size).
 class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunction {
  public:
-  ReplayingCostFunction(ceres::CostFunction* wrapped, int size, ParallelResidualEvaluator* owner)
-      : wrapped_(wrapped),
-        owner_(owner),
-        point_(size),
-        residuals_(wrapped->num_residuals()),
-        jacobian_(static_cast<size_t>(wrapped->num_residuals()) * size) {
-    CHECK_EQ(wrapped->parameter_block_sizes().size(), 1u);
-    CHECK_EQ(wrapped->parameter_block_sizes()[0], size);
+  // `offsets`: where each of the wrapped function's parameter blocks starts
+  // in the evaluator's point.
+  ReplayingCostFunction(ceres::CostFunction* wrapped, std::vector<int> offsets,
+                        ParallelResidualEvaluator* owner)
+      : wrapped_(wrapped), owner_(owner), offsets_(std::move(offsets)) {
+    CHECK_EQ(wrapped->parameter_block_sizes().size(), offsets_.size());
     set_num_residuals(wrapped->num_residuals());
     *mutable_parameter_block_sizes() = wrapped->parameter_block_sizes();
+    rows_ = wrapped->num_residuals();
+    for (int size : parameter_block_sizes()) total_ += size;
+    storage_.resize(static_cast<size_t>(total_) * (1 + rows_) + rows_);
   }
 
-  // Adds J^T r at the precomputed point to `gradient`; false if the
-  // evaluation failed.
+  // Adds J^T r at the precomputed point to `gradient` (a point's
+  // coordinates); false if the evaluation failed.
   bool AddGradient(double* gradient) const {
     if (!ok_) return false;
-    const int size = static_cast<int>(point_.size());
-    for (size_t row = 0; row < residuals_.size(); ++row) {
-      for (int col = 0; col < size; ++col)
-        gradient[col] += jacobian_[row * size + col] * residuals_[row];
+    const std::vector<int32_t>& sizes = parameter_block_sizes();
+    int start = 0;
+    for (size_t j = 0; j < sizes.size(); ++j) {
+      const double* jacobian = Jacobian() + rows_ * start;
+      for (int row = 0; row < rows_; ++row) {
+        for (int col = 0; col < sizes[j]; ++col)
+          gradient[offsets_[j] + col] += jacobian[row * sizes[j] + col] * Residuals()[row];
+      }
+      start += sizes[j];
     }
     return true;
   }
 
   // Computes the values at `point` (the evaluator's thread for this block).
   void Precompute(const double* point) {
-    std::copy(point, point + point_.size(), point_.begin());
-    const double* blocks[] = {point};
-    double* jacobians[] = {jacobian_.data()};
-    ok_ = wrapped_->Evaluate(blocks, residuals_.data(), jacobians);
     valid_ = true;
+    if (offsets_.size() == 1) {  // one parameter block: no per-block bookkeeping
+      std::copy(point + offsets_[0], point + offsets_[0] + total_, Point());
+      const double* blocks[] = {Point()};
+      double* jacobians[] = {Jacobian()};
+      ok_ = wrapped_->Evaluate(blocks, Residuals(), jacobians);
+      return;
+    }
+    const std::vector<int32_t>& sizes = parameter_block_sizes();
+    int start = 0;
+    for (size_t j = 0; j < sizes.size(); ++j) {
+      std::copy(point + offsets_[j], point + offsets_[j] + sizes[j], Point() + start);
+      start += sizes[j];
+    }
+    ok_ = EvaluateAtOwnPoint();
   }
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
-    if (!valid_ || !std::equal(point_.begin(), point_.end(), parameters[0])) {
+    if (offsets_.size() == 1) return EvaluateOneBlock(parameters, residuals, jacobians);
+    if (!valid_ || !AtPoint(parameters)) {
       ++owner_->evaluated_directly_;
       return wrapped_->Evaluate(parameters, residuals, jacobians);
     }
     ++owner_->replayed_;
     if (!ok_) return false;
-    std::copy(residuals_.begin(), residuals_.end(), residuals);
-    if (jacobians != nullptr && jacobians[0] != nullptr) {
-      std::copy(jacobian_.begin(), jacobian_.end(), jacobians[0]);
+    std::copy(Residuals(), Residuals() + rows_, residuals);
+    if (jacobians == nullptr) return true;
+    const std::vector<int32_t>& sizes = parameter_block_sizes();
+    int start = 0;
+    for (size_t j = 0; j < sizes.size(); ++j) {
+      const double* jacobian = Jacobian() + rows_ * start;
+      if (jacobians[j] != nullptr) std::copy(jacobian, jacobian + rows_ * sizes[j], jacobians[j]);
+      start += sizes[j];
     }
     return true;
   }
 
  private:
+  // Parameter blocks whose pointers fit on the stack (every dwellfit
+  // residual reads at most six).
+  static constexpr size_t kStackBlocks = 8;
+
+  double* Point() { return storage_.data(); }
+  const double* Point() const { return storage_.data(); }
+  double* Residuals() { return storage_.data() + total_; }
+  const double* Residuals() const { return storage_.data() + total_; }
+  double* Jacobian() { return storage_.data() + total_ + rows_; }
+  const double* Jacobian() const { return storage_.data() + total_ + rows_; }
+
+  // The wrapped function at Point(), into Residuals() and Jacobian().
+  bool EvaluateAtOwnPoint() {
+    const std::vector<int32_t>& sizes = parameter_block_sizes();
+    std::array<const double*, kStackBlocks> block_array;
+    std::array<double*, kStackBlocks> jacobian_array;
+    std::vector<const double*> block_vector;
+    std::vector<double*> jacobian_vector;
+    const double** blocks = block_array.data();
+    double** jacobians = jacobian_array.data();
+    if (sizes.size() > kStackBlocks) {
+      block_vector.resize(sizes.size());
+      jacobian_vector.resize(sizes.size());
+      blocks = block_vector.data();
+      jacobians = jacobian_vector.data();
+    }
+    int start = 0;
+    for (size_t j = 0; j < sizes.size(); ++j) {
+      blocks[j] = Point() + start;
+      jacobians[j] = Jacobian() + rows_ * start;
+      start += sizes[j];
+    }
+    return wrapped_->Evaluate(blocks, Residuals(), jacobians);
+  }
+
+  // Evaluate for a function of one parameter block (every dwell on one
+  // 6-double block): the same, without the per-block bookkeeping.
+  bool EvaluateOneBlock(double const* const* parameters, double* residuals,
+                        double** jacobians) const {
+    if (!valid_ || !std::equal(Point(), Point() + total_, parameters[0])) {
+      ++owner_->evaluated_directly_;
+      return wrapped_->Evaluate(parameters, residuals, jacobians);
+    }
+    ++owner_->replayed_;
+    if (!ok_) return false;
+    std::copy(Residuals(), Residuals() + rows_, residuals);
+    if (jacobians != nullptr && jacobians[0] != nullptr) {
+      std::copy(Jacobian(), Jacobian() + rows_ * total_, jacobians[0]);
+    }
+    return true;
+  }
+
+  // `parameters` are the precomputed point.
+  bool AtPoint(double const* const* parameters) const {
+    const std::vector<int32_t>& sizes = parameter_block_sizes();
+    int start = 0;
+    for (size_t j = 0; j < sizes.size(); ++j) {
+      if (!std::equal(Point() + start, Point() + start + sizes[j], parameters[j])) return false;
+      start += sizes[j];
+    }
+    return true;
+  }
+
   const std::unique_ptr<ceres::CostFunction> wrapped_;
   ParallelResidualEvaluator* const owner_;
-  std::vector<double> point_;
-  std::vector<double> residuals_;
-  std::vector<double> jacobian_;  // row-major, num_residuals x size
+  const std::vector<int> offsets_;  // of each parameter block in the evaluator's point
+  int rows_ = 0;                    // residuals
+  int total_ = 0;                   // doubles over the parameter blocks
+  std::vector<double> storage_;     // point, residuals, Jacobian
   bool ok_ = false;
   bool valid_ = false;
 };
 
-ParallelResidualEvaluator::ParallelResidualEvaluator(const double* parameters, int size,
-                                                     int num_threads)
-    : parameters_(parameters), size_(size), num_threads_(num_threads) {
-  CHECK(parameters != nullptr);
-  CHECK_GT(size, 0);
+ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads)
+    : blocks_(std::move(blocks)), num_threads_(num_threads) {
+  CHECK(!blocks_.empty());
+  for (const Block& block : blocks_) {
+    CHECK(block.values != nullptr);
+    CHECK_GT(block.size, 0);
+    offsets_.push_back(size_);
+    size_ += block.size;
+  }
   CHECK_GE(num_threads, 1);
 }
 
+ParallelResidualEvaluator::ParallelResidualEvaluator(const double* parameters, int size,
+                                                     int num_threads)
+    : ParallelResidualEvaluator(std::vector<Block>{{parameters, size}}, num_threads) {}
+
 ParallelResidualEvaluator::~ParallelResidualEvaluator() = default;
 
-ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_function) {
-  auto* wrapper = new ReplayingCostFunction(cost_function, size_, this);
+ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_function,
+                                                     const std::vector<double*>& parameter_blocks) {
+  CHECK_EQ(cost_function->parameter_block_sizes().size(), parameter_blocks.size());
+  std::vector<int> offsets;
+  for (size_t j = 0; j < parameter_blocks.size(); ++j) {
+    size_t b = 0;
+    while (b < blocks_.size() && blocks_[b].values != parameter_blocks[j]) ++b;
+    CHECK_LT(b, blocks_.size()) << "a parameter block the evaluator does not watch";
+    CHECK_EQ(cost_function->parameter_block_sizes()[j], blocks_[b].size);
+    offsets.push_back(offsets_[b]);
+  }
+  auto* wrapper = new ReplayingCostFunction(cost_function, std::move(offsets), this);
   wrappers_.push_back(wrapper);
   return wrapper;
 }
 
-void ParallelResidualEvaluator::PrepareForEvaluation(bool /*evaluate_jacobians*/,
-                                                     bool /*new_evaluation_point*/) {
-  // Ceres has copied the point into the caller's block. The same point again
-  // (the Jacobian at an accepted step, a line search's trial step and the
-  // trust-region candidate): the values, Jacobians included, are there.
-  if (computed_ && std::equal(last_point_.begin(), last_point_.end(), parameters_)) return;
-  PrecomputeAll(parameters_);
+ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_function) {
+  CHECK_EQ(cost_function->parameter_block_sizes().size(), 1u);
+  CHECK_EQ(cost_function->parameter_block_sizes()[0], blocks_[0].size);
+  auto* wrapper = new ReplayingCostFunction(cost_function, {0}, this);
+  wrappers_.push_back(wrapper);
+  return wrapper;
 }
 
-void ParallelResidualEvaluator::PrecomputeAll(const double* point) {
+bool ParallelResidualEvaluator::AtLastPoint() const {
+  for (size_t b = 0; b < blocks_.size(); ++b) {
+    const double* last = last_point_.data() + offsets_[b];
+    if (!std::equal(last, last + blocks_[b].size, blocks_[b].values)) return false;
+  }
+  return true;
+}
+
+void ParallelResidualEvaluator::PrepareForEvaluation(bool /*evaluate_jacobians*/,
+                                                     bool /*new_evaluation_point*/) {
+  // Ceres has copied the point into the caller's blocks. The same point
+  // again (the Jacobian at an accepted step, a line search's trial step and
+  // the trust-region candidate): the values, Jacobians included, are there.
+  if (computed_ && AtLastPoint()) return;
+  last_point_.resize(size_);
+  for (size_t b = 0; b < blocks_.size(); ++b) {
+    std::copy(blocks_[b].values, blocks_[b].values + blocks_[b].size,
+              last_point_.begin() + offsets_[b]);
+  }
+  PrecomputeAll();
+}
+
+void ParallelResidualEvaluator::PrecomputeAll() {
   // Every thread reads this one copy of the point.
-  last_point_.assign(point, point + size_);
   computed_ = true;
   const double* copy = last_point_.data();
   const int count = static_cast<int>(wrappers_.size());
@@ -123,7 +251,8 @@ void ParallelResidualEvaluator::PrecomputeAll(const double* point) {
 }
 
 bool ParallelResidualEvaluator::CostGradient(const double* point, std::vector<double>* gradient) {
-  PrecomputeAll(point);
+  last_point_.assign(point, point + size_);
+  PrecomputeAll();
   gradient->assign(size_, 0.0);
   for (const ReplayingCostFunction* wrapper : wrappers_) {
     if (!wrapper->AddGradient(gradient->data())) return false;

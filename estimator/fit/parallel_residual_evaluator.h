@@ -19,11 +19,12 @@
 // point. Jacobians are computed with every new point: a trust-region step is
 // usually accepted, and Ceres then asks for the Jacobian at that same point.
 //
-// Use: construct with the parameter block, pass it as
-// ceres::Problem::Options::evaluation_callback, add Wrap(cost) as each
-// residual block's cost function (the problem owns the wrapper, the wrapper
-// the wrapped function). Every wrapped function must take exactly that one
-// parameter block. The evaluator must outlive the problem's solves.
+// Use: construct with the parameter blocks the wrapped functions read, pass
+// it as ceres::Problem::Options::evaluation_callback, add Wrap(cost, blocks)
+// as each residual block's cost function (the problem owns the wrapper, the
+// wrapper the wrapped function). A point is the values of every watched
+// block, concatenated in the order given. The evaluator must outlive the
+// problem's solves.
 #ifndef DWELLFIT_ESTIMATOR_FIT_PARALLEL_RESIDUAL_EVALUATOR_H_
 #define DWELLFIT_ESTIMATOR_FIT_PARALLEL_RESIDUAL_EVALUATOR_H_
 
@@ -42,20 +43,33 @@ int ResolveThreadCount(int num_threads);
 
 class ParallelResidualEvaluator : public ceres::EvaluationCallback {
  public:
-  // `parameters`: the block (of `size` doubles, owned by the caller) that
-  // every wrapped cost function reads. `num_threads` >= 1.
+  // A parameter block the solver updates (owned by the caller).
+  struct Block {
+    const double* values = nullptr;
+    int size = 0;
+  };
+
+  // `blocks`: every parameter block a wrapped cost function reads, distinct.
+  // `num_threads` >= 1.
+  ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads);
+  // One block of `size` doubles that every wrapped cost function reads.
   ParallelResidualEvaluator(const double* parameters, int size, int num_threads);
   ~ParallelResidualEvaluator() override;
 
-  // Takes ownership of `cost_function`, which must have the one parameter
-  // block of `size`; returns its replaying wrapper, owned by the caller.
+  // Takes ownership of `cost_function`, whose parameter blocks are
+  // `parameter_blocks` (each a watched block, in the residual block's
+  // order); returns its replaying wrapper, owned by the caller.
+  ceres::CostFunction* Wrap(ceres::CostFunction* cost_function,
+                            const std::vector<double*>& parameter_blocks);
+  // The same for a cost function of the first watched block alone.
   ceres::CostFunction* Wrap(ceres::CostFunction* cost_function);
 
   void PrepareForEvaluation(bool evaluate_jacobians, bool new_evaluation_point) override;
 
-  // The gradient of (1/2) sum |r|^2 over every wrapped block at `point`, in
-  // the block's own coordinates (no manifold, no bounds), evaluated on the
-  // threads and summed in block order. False if a block fails to evaluate.
+  // The gradient of (1/2) sum |r|^2 over every wrapped block at `point` (a
+  // point as above), in the blocks' own coordinates (no manifold, no
+  // bounds), evaluated on the threads and summed in block order. False if a
+  // block fails to evaluate.
   bool CostGradient(const double* point, std::vector<double>* gradient);
 
   // Wrapper evaluations answered from the precomputed values, and those that
@@ -67,11 +81,14 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
  private:
   class ReplayingCostFunction;
 
-  // Evaluates every wrapper at `point`, on the threads.
-  void PrecomputeAll(const double* point);
+  // Evaluates every wrapper at last_point_, on the threads.
+  void PrecomputeAll();
+  // The watched blocks hold last_point_.
+  bool AtLastPoint() const;
 
-  const double* parameters_;
-  const int size_;
+  const std::vector<Block> blocks_;
+  std::vector<int> offsets_;  // of each block in a point
+  int size_ = 0;              // of a point
   const int num_threads_;
   std::vector<ReplayingCostFunction*> wrappers_;  // owned by the problem
   bool computed_ = false;                         // last_point_ holds a point evaluated

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
-#include "dwellfit/estimator/fit/scaled_subset_manifold.h"
-#include "glog/logging.h"
+#include "dwellfit/estimator/fit/mapped_cost_function.h"
 #include "dwellfit/residuals/functors/algebraic_residual.h"
 #include "dwellfit/residuals/functors/bifurcation_range_penalty.h"
 #include "dwellfit/residuals/functors/branch_stability_penalty.h"
@@ -13,55 +13,52 @@
 namespace dwellfit {
 
 bool ProblemBuilderOptions::IsValid(std::string* error) const {
-  if (scale) {
-    for (int i = 0; i < kNumParameters; ++i) {
-      if (!fixed[i] && !((*scale)[i] > 0.0 && std::isfinite((*scale)[i]))) {
-        *error = std::string("scale of ") + ParameterName(i) + " must be positive and finite";
-        return false;
-      }
-    }
+  if (!(dwell_weight > 0.0) || !std::isfinite(dwell_weight)) {
+    std::ostringstream message;
+    message << "dwell_weight must be positive and finite (> 0), got " << dwell_weight;
+    *error = message.str();
+    return false;
   }
-  return true;
+  return residual_options.IsValid(error) && penalties.IsValid(error);
 }
 
-ProblemBuilder::ProblemBuilder(const ProblemBuilderOptions& options) : options_(options) {
-  std::string error;
-  CHECK(options_.IsValid(&error)) << error;
-}
+ProblemBuilder::ProblemBuilder(const ProblemBuilderOptions& options) : options_(options) {}
 
 ceres::CostFunction* ProblemBuilder::MakeResidual(const DwellPoint& point) const {
   if (options_.residual == ResidualKind::kAlgebraic) {
     return AlgebraicResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
-                                     1.0);
+                                     options_.dwell_weight);
   }
-  double weight = 1.0;
+  double weight = options_.dwell_weight;
   if (options_.residual_options.use_point_sigma && point.sigma) {
     // sigma is the standard deviation of a; in relative error it becomes
     // that of ln a, sigma / a.
-    weight = options_.residual_options.error == ErrorMeasure::kAbsolute
-                 ? 1.0 / *point.sigma
-                 : (point.amplitude + options_.residual_options.amplitude_floor) / *point.sigma;
+    weight *= options_.residual_options.error == ErrorMeasure::kAbsolute
+                  ? 1.0 / *point.sigma
+                  : (point.amplitude + options_.residual_options.amplitude_floor) / *point.sigma;
   }
   return VerticalErrorResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
                                        point.branch, options_.residual_options.error, weight,
                                        options_.residual_options.amplitude_floor);
 }
 
-namespace {
-
-// `cost` as the problem receives it: through `evaluator` when there is one.
-ceres::CostFunction* Evaluated(ceres::CostFunction* cost, ParallelResidualEvaluator* evaluator) {
-  return evaluator != nullptr ? evaluator->Wrap(cost) : cost;
+void ProblemBuilder::Add(ceres::CostFunction* cost, const ParameterLayout& layout,
+                         ceres::Problem* problem, ParallelResidualEvaluator* evaluator) const {
+  // The one-block case reads the block directly: no adapter in between.
+  if (!layout.IsIdentity()) cost = new MappedCostFunction(cost, layout);
+  if (evaluator != nullptr) cost = evaluator->Wrap(cost, layout.blocks);
+  problem->AddResidualBlock(cost, nullptr, layout.blocks);
 }
 
-}  // namespace
+int ProblemBuilder::AddSweep(const Sweep& sweep, const ParameterLayout& layout,
+                             ceres::Problem* problem, ParallelResidualEvaluator* evaluator) const {
+  for (const DwellPoint& point : sweep.points) Add(MakeResidual(point), layout, problem, evaluator);
+  return static_cast<int>(sweep.points.size());
+}
 
 int ProblemBuilder::AddSweep(const Sweep& sweep, double* parameters, ceres::Problem* problem,
                              ParallelResidualEvaluator* evaluator) const {
-  for (const DwellPoint& point : sweep.points) {
-    problem->AddResidualBlock(Evaluated(MakeResidual(point), evaluator), nullptr, parameters);
-  }
-  return static_cast<int>(sweep.points.size());
+  return AddSweep(sweep, SingleBlockLayout(parameters), problem, evaluator);
 }
 
 JumpTarget TargetOf(const Sweep& sweep, const JumpBracket& jump) {
@@ -87,6 +84,12 @@ ceres::CostFunction* MakeBifurcationRangePenalty(const Sweep& sweep, const JumpB
 
 int ProblemBuilder::AddPenalties(const Sweep& sweep, double* parameters, ceres::Problem* problem,
                                  ParallelResidualEvaluator* evaluator) const {
+  return AddPenalties(sweep, SingleBlockLayout(parameters), problem, evaluator);
+}
+
+int ProblemBuilder::AddPenalties(const Sweep& sweep, const ParameterLayout& layout,
+                                 ceres::Problem* problem,
+                                 ParallelResidualEvaluator* evaluator) const {
   int blocks = 0;
   const BifurcationRangeOptions& range = options_.penalties.bifurcation_range;
   if (range.enabled) {
@@ -95,9 +98,7 @@ int ProblemBuilder::AddPenalties(const Sweep& sweep, double* parameters, ceres::
       if (std::find(range.enforce.begin(), range.enforce.end(), target) == range.enforce.end()) {
         continue;
       }
-      problem->AddResidualBlock(
-          Evaluated(MakeBifurcationRangePenalty(sweep, jump, range), evaluator), nullptr,
-          parameters);
+      Add(MakeBifurcationRangePenalty(sweep, jump, range), layout, problem, evaluator);
       ++blocks;
     }
   }
@@ -108,47 +109,13 @@ int ProblemBuilder::AddPenalties(const Sweep& sweep, double* parameters, ceres::
     const double lambda = stability.lambda / largest;  // [1/amplitude]
     for (const DwellPoint& point : sweep.points) {
       if (point.branch == Branch::kOnly) continue;
-      problem->AddResidualBlock(
-          Evaluated(BranchStabilityPenalty::Create(point.drive_frequency_rad_s, point.amplitude,
-                                                   point.branch, lambda, stability.weight),
-                    evaluator),
-          nullptr, parameters);
+      Add(BranchStabilityPenalty::Create(point.drive_frequency_rad_s, point.amplitude, point.branch,
+                                         lambda, stability.weight),
+          layout, problem, evaluator);
       ++blocks;
     }
   }
   return blocks;
-}
-
-void ProblemBuilder::ConfigureParameters(double* parameters, ceres::Problem* problem) const {
-  CHECK(problem->HasParameterBlock(parameters)) << "add residuals before configuring";
-  problem->SetParameterLowerBound(parameters, kEtaE, 0.0);
-  if (options_.bound_damping) {
-    for (int i : {kMu1, kMu2}) problem->SetParameterLowerBound(parameters, i, 0.0);
-  }
-  bool any_free = false;
-  for (bool f : options_.fixed) any_free = any_free || !f;
-  if (!any_free) {
-    problem->SetParameterBlockConstant(parameters);
-    return;
-  }
-  ParameterVector scale;
-  for (int i = 0; i < kNumParameters; ++i) {
-    scale[i] = options_.scale ? (*options_.scale)[i] : std::abs(parameters[i]);
-    if (!(scale[i] > 0.0)) scale[i] = 1.0;
-  }
-  problem->SetManifold(parameters, new ScaledSubsetManifold(scale, options_.fixed));
-}
-
-bool ReflectDampingIntoPhysicalRange(ParameterVector* parameters) {
-  ParameterVector& p = *parameters;
-  const ParameterVector before = p;
-  p[kEtaE] = std::abs(p[kEtaE]);
-  if (p[kMu1] <= 0.0 && p[kMu2] <= 0.0) {
-    p[kMu1] = -p[kMu1];
-    p[kMu2] = -p[kMu2];
-  }
-  for (int i : {kMu1, kMu2}) p[i] = std::max(p[i], 0.0);
-  return p != before;
 }
 
 }  // namespace dwellfit

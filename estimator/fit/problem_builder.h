@@ -1,5 +1,5 @@
-// ProblemBuilder: assembles the identification problem on a ceres::Problem and
-// a parameter block that the caller owns, so a larger estimator can embed it.
+// ProblemBuilder: the residual blocks of the identification problem, added to
+// a ceres::Problem on parameter blocks the caller owns.
 //
 // Mathematical formulation. With p = [eta_e, mu1, mu2, delta, alpha, omega]
 // (model_parameters.h) and the dwell points i of the chosen sweeps,
@@ -8,20 +8,25 @@
 //   subject to                            eta_e, mu1, mu2 >= 0
 //
 // where r_i is either the algebraic residual of eq. (3.11)
-// (residuals/functors/algebraic_residual.h) or the vertical error of section 3.2.4
-// (residuals/functors/vertical_error_residual.h). Fixed parameters keep their value;
-// the free ones are stepped in units of their scale (ScaledSubsetManifold).
+// (residuals/functors/algebraic_residual.h) or the vertical error of section
+// 3.2.4 (residuals/functors/vertical_error_residual.h).
+//
+// The six parameters may live in one 6-double block (the residual blocks
+// then read it directly) or in entries of several blocks, shared between
+// datasets (a ParameterLayout, fit_description.h; the residual blocks then
+// read those blocks through a MappedCostFunction). Bounds, fixed entries and
+// scaling are set by StageProblem (stage_problem.h), which assembles every
+// problem the staged solve and the covariance use.
 #ifndef DWELLFIT_ESTIMATOR_FIT_PROBLEM_BUILDER_H_
 #define DWELLFIT_ESTIMATOR_FIT_PROBLEM_BUILDER_H_
 
-#include <array>
-#include <optional>
 #include <string>
 
 #include "ceres/problem.h"
+#include "dwellfit/estimator/data/sweep.h"
+#include "dwellfit/estimator/fit/fit_description.h"
 #include "dwellfit/estimator/fit/identification_options.h"
 #include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
-#include "dwellfit/estimator/data/sweep.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 
 namespace dwellfit {
@@ -29,15 +34,10 @@ namespace dwellfit {
 struct ProblemBuilderOptions {
   ResidualKind residual = ResidualKind::kVertical;
   ResidualOptions residual_options;
-  std::array<bool, kNumParameters> fixed = {false, false, false, false, false, false};
-  // Typical magnitude of each parameter: one unit of solver step. Unset: the
-  // magnitude of the parameter's value when ConfigureParameters is called
-  // (1 where that value is 0).
-  std::optional<ParameterVector> scale;
-  // Bound mu1, mu2 >= 0 (eta_e is always bounded). The algebraic residual is
-  // invariant under (mu1, mu2) -> -(mu1, mu2), so a stage on it may run
-  // unbounded and reflect its result (ReflectDampingIntoPhysicalRange).
-  bool bound_damping = true;
+  // Multiplies every dwell's residual (on top of its point sigma): the
+  // covariance weighs the dwells by 1/s, s the residual noise, against the
+  // caller's standardised residual blocks. > 0.
+  double dwell_weight = 1.0;
   // Soft constraints of eqs. (3.17) and (3.19); AddPenalties adds them.
   PenaltyOptions penalties;
   bool IsValid(std::string* error) const;
@@ -45,41 +45,41 @@ struct ProblemBuilderOptions {
 
 class ProblemBuilder {
  public:
+  // `options` should be valid (IsValid); the staged solve checks them.
   explicit ProblemBuilder(const ProblemBuilderOptions& options);
 
-  // Adds one residual block per dwell of `sweep`, each reading the 6-double
-  // block `parameters` (owned by the caller, must outlive `problem`).
-  // Returns the number of residual blocks added. With an `evaluator` (the
-  // problem's evaluation callback, reading `parameters`) the blocks are
-  // evaluated through it, on its threads.
+  // Adds one residual block per dwell of `sweep`, each reading the six
+  // parameters where `layout` puts them (the blocks are owned by the caller
+  // and must outlive `problem`). Returns the number of residual blocks
+  // added. With an `evaluator` (the problem's evaluation callback, watching
+  // the layout's blocks) the blocks are evaluated through it, on its threads.
+  int AddSweep(const Sweep& sweep, const ParameterLayout& layout, ceres::Problem* problem,
+               ParallelResidualEvaluator* evaluator = nullptr) const;
+  // The same on one 6-double block `parameters` (SingleBlockLayout).
   int AddSweep(const Sweep& sweep, double* parameters, ceres::Problem* problem,
                ParallelResidualEvaluator* evaluator = nullptr) const;
 
   // Adds the enabled penalties for `sweep`: one BifurcationRangePenalty per
   // measured jump whose target is enforced, one BranchStabilityPenalty per
   // dwell labelled lower or upper. Returns the number of blocks added.
+  int AddPenalties(const Sweep& sweep, const ParameterLayout& layout, ceres::Problem* problem,
+                   ParallelResidualEvaluator* evaluator = nullptr) const;
   int AddPenalties(const Sweep& sweep, double* parameters, ceres::Problem* problem,
                    ParallelResidualEvaluator* evaluator = nullptr) const;
 
-  // Sets bounds (eta_e >= 0; mu1, mu2 >= 0 unless !bound_damping), fixed parameters and scaling on
-  // the block. Call once, after the block has residuals in `problem`.
-  void ConfigureParameters(double* parameters, ceres::Problem* problem) const;
-
-  // The cost function of one dwell (owned by the caller; Ceres takes it).
+  // The cost function of one dwell on one 6-double block (owned by the
+  // caller; Ceres takes it).
   ceres::CostFunction* MakeResidual(const DwellPoint& point) const;
 
   const ProblemBuilderOptions& options() const { return options_; }
 
  private:
+  // Adds `cost` (on one 6-double block) as a residual block on `layout`.
+  void Add(ceres::CostFunction* cost, const ParameterLayout& layout, ceres::Problem* problem,
+           ParallelResidualEvaluator* evaluator) const;
+
   ProblemBuilderOptions options_;
 };
-
-// G(a) of eq. (3.11) depends on mu1, mu2 only through k1^2, k2^2 and k1 k2,
-// and on eta_e only through 1/eta_e^2. Maps a point fitted on G alone to its
-// physical twin: eta_e -> |eta_e|, (mu1, mu2) -> -(mu1, mu2) when neither is
-// positive; a damping left negative after that (mixed signs: no physical twin)
-// is set to 0. Returns whether anything changed.
-bool ReflectDampingIntoPhysicalRange(ParameterVector* parameters);
 
 // Which enforceable target a measured jump of `sweep` is.
 JumpTarget TargetOf(const Sweep& sweep, const JumpBracket& jump);

@@ -1,31 +1,31 @@
-// ScaledSubsetManifold: the tangent space the solver steps in.
+// ScaledSubsetManifold: the tangent space the solver steps in, for a
+// parameter block of any size.
 //
 // The parameters span nine orders of magnitude (mu1 ~ 0.1, alpha ~ 1e9) and
 // some are held fixed. The parameter block stays in physical units; the
-// solver's step t has one entry per free parameter, in units of that
-// parameter's scale s:
-//   x [+] t = x + S t,   S (6 x k): S(free[j], j) = s_free[j], zero elsewhere
+// solver's step t has one entry per free entry, in units of that entry's
+// scale s:
+//   x [+] t = x + S t,   S (n x k): S(free[j], j) = s_free[j], zero elsewhere
 //   y [-] x = S^+ (y - x) = ((y - x)_free[j] / s_free[j])_j
 // so every step entry is a relative change of order one, and fixed entries
 // never move. Covariances in the ambient space carry zeros for fixed entries.
 #ifndef DWELLFIT_ESTIMATOR_FIT_SCALED_SUBSET_MANIFOLD_H_
 #define DWELLFIT_ESTIMATOR_FIT_SCALED_SUBSET_MANIFOLD_H_
 
-#include <array>
 #include <vector>
 
 #include "ceres/manifold.h"
-#include "dwellfit/residuals/model/model_parameters.h"
 
 namespace dwellfit {
 
 class ScaledSubsetManifold : public ceres::Manifold {
  public:
-  // `scale` entries of free parameters must be positive; at least one
-  // parameter must be free (hold a block with none free constant instead).
-  ScaledSubsetManifold(const ParameterVector& scale, const std::array<bool, kNumParameters>& fixed);
+  // One `scale` and one `fixed` flag per entry of the block; scales of free
+  // entries must be positive, and at least one entry must be free (hold a
+  // block with none free constant instead).
+  ScaledSubsetManifold(std::vector<double> scale, const std::vector<bool>& fixed);
 
-  int AmbientSize() const override { return kNumParameters; }
+  int AmbientSize() const override { return static_cast<int>(scale_.size()); }
   int TangentSize() const override { return static_cast<int>(free_.size()); }
   bool Plus(const double* x, const double* delta, double* x_plus_delta) const override;
   bool PlusJacobian(const double* x, double* jacobian) const override;
@@ -34,7 +34,7 @@ class ScaledSubsetManifold : public ceres::Manifold {
 
  private:
   std::vector<int> free_;  // ambient index of each tangent coordinate
-  ParameterVector scale_;
+  std::vector<double> scale_;
 };
 
 }  // namespace dwellfit

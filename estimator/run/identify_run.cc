@@ -17,10 +17,10 @@ namespace {
 // evaluate its cost (every start failed), or the estimate is not finite.
 void CheckUsable(const IdentifyConfig& config, const MultiStartResult& multi_start) {
   const IdentificationResult& result = multi_start.best;
-  if (!result.failure.empty()) {
+  if (!result.IsSolutionUsable()) {
     throw InputError(
         config.config_path, 0, "initial_guess",
-        "the fit cannot proceed: " + result.failure +
+        "the fit cannot proceed: " + result.message +
             (multi_start.starts.size() > 1 ? " (and every other start failed too)" : "") +
             "; give initial guesses closer to the data (initial_guess, config/README.md), or "
             "check the dwells named");

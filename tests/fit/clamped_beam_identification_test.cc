@@ -90,13 +90,15 @@ TEST_F(ClampedBeamIdentification, Mu2IsHeldOnItsBoundWhereTheCostPushesItOutward
     }
   }
   ASSERT_NE(held_stage, nullptr) << "no stage held mu2";
-  EXPECT_EQ(held_stage->parameters[kMu2], 0.0);
+  ASSERT_EQ(held_stage->values.size(), static_cast<size_t>(kNumParameters));
+  EXPECT_EQ(held_stage->values[kMu2], 0.0);
   EXPECT_GE(held_stage->solves, 2);
   ASSERT_GT(held_stage->penalty_unit, 0.0);
 
   // The stage's cost, rebuilt: the data and the bifurcation-range penalty
   // with the stage's exponent and weight, no bounds and no manifold.
-  ParameterVector p = held_stage->parameters;
+  ParameterVector p;
+  std::copy(held_stage->values.begin(), held_stage->values.end(), p.begin());
   ProblemBuilderOptions options;
   options.residual_options = config_->identification.residual;
   options.penalties = config_->identification.penalties;

@@ -168,8 +168,9 @@ TEST_F(HostileInput, AFailedStageEndsTheFitWithItsFailure) {
   const IdentificationResult result = Identify(fitted, options);
   ASSERT_EQ(result.stages.size(), 1u);  // the vertical stage did not run
   EXPECT_FALSE(result.converged);
-  EXPECT_THAT(result.failure, StartsWith("the algebraic stage cannot evaluate its cost at"));
-  EXPECT_EQ(result.failure, result.stages[0].failure);
+  EXPECT_EQ(result.status, FitStatus::kFailure);
+  EXPECT_FALSE(result.IsSolutionUsable());
+  EXPECT_THAT(result.message, StartsWith("the algebraic stage cannot evaluate its cost at"));
 }
 
 TEST_F(HostileInput, AFailedStartIsNeverTheBest) {
@@ -185,14 +186,15 @@ TEST_F(HostileInput, AFailedStartIsNeverTheBest) {
   const MultiStartResult result = IdentifyMultiStart(fitted, options, reachable, multi_start);
   EXPECT_EQ(result.failed, 1);
   EXPECT_EQ(result.best_start, 1);
-  EXPECT_TRUE(result.best.failure.empty());
+  EXPECT_TRUE(result.best.IsSolutionUsable()) << result.best.message;
   EXPECT_GT(result.best.final_cost, 0.0);
   EXPECT_EQ(result.reached_best, 1);
 
   multi_start.starts = 1;  // start 0 alone: the failure is the result
   const MultiStartResult alone = IdentifyMultiStart(fitted, options, reachable, multi_start);
   EXPECT_EQ(alone.failed, 1);
-  EXPECT_THAT(alone.best.failure, HasSubstr("alpha 1e+300"));
+  EXPECT_EQ(alone.best.status, FitStatus::kFailure);
+  EXPECT_THAT(alone.best.message, HasSubstr("alpha 1e+300"));
 }
 
 TEST_F(HostileInput, ResultFilesAreByteIdenticalAcrossThreadCounts) {

@@ -1,0 +1,330 @@
+#include "dwellfit/estimator/analysis/block_covariance.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "Eigen/SVD"
+#include "boost/math/distributions/normal.hpp"
+#include "boost/math/distributions/students_t.hpp"
+#include "ceres/covariance.h"
+#include "ceres/crs_matrix.h"
+#include "dwellfit/estimator/fit/scaled_subset_manifold.h"
+#include "dwellfit/estimator/fit/stage_problem.h"
+
+namespace dwellfit {
+namespace {
+
+// printf-style formatting into a std::string.
+template <typename... Args>
+std::string Format(const char* format, Args... args) {
+  char buffer[512];
+  std::snprintf(buffer, sizeof(buffer), format, args...);
+  return buffer;
+}
+
+// A normalised coordinate's entry of a null direction smaller than this (the
+// direction has unit length) does not implicate its entry.
+constexpr double kNullDirectionShare = 0.1;
+
+// The vertical-error problem at the blocks' current values, one tangent unit
+// per entry's magnitude (1 for 0), every dwell weighted by `dwell_weight`;
+// the caller's residual blocks when `with_caller`, whose own blocks are held.
+std::unique_ptr<StageProblem> AssembleDataProblem(const FitDescription& fit,
+                                                  const ResidualOptions& residual,
+                                                  double dwell_weight, bool with_caller) {
+  StageSetup setup;
+  setup.residuals.residual = ResidualKind::kVertical;
+  setup.residuals.residual_options = residual;
+  setup.residuals.dwell_weight = dwell_weight;
+  setup.threaded_evaluation = false;  // evaluated twice: no threads needed
+  for (double value : fit.Values()) setup.scale.push_back(value != 0.0 ? std::abs(value) : 1.0);
+  auto problem = std::make_unique<StageProblem>(fit, setup);
+  if (with_caller) problem->AddCallerResiduals();
+  problem->Configure();
+  std::vector<double*> blocks;
+  problem->problem()->GetParameterBlocks(&blocks);
+  for (double* block : blocks) {
+    if (fit.BlockOf(block) < 0) problem->problem()->SetParameterBlockConstant(block);
+  }
+  return problem;
+}
+
+// The described blocks with a free entry, in order.
+std::vector<double*> FreeBlocks(const FitDescription& fit) {
+  const std::vector<bool> fixed = fit.FixedEntries();
+  std::vector<double*> blocks;
+  for (size_t b = 0; b < fit.blocks.size(); ++b) {
+    const int offset = fit.Offset(static_cast<int>(b));
+    for (int i = 0; i < fit.blocks[b].size; ++i) {
+      if (!fixed[offset + i]) {
+        blocks.push_back(fit.blocks[b].values);
+        break;
+      }
+    }
+  }
+  return blocks;
+}
+
+// F = (1/2) sum r^2 over `rows` and their Jacobian in the tangent
+// coordinates of `blocks` (one column per free entry, in order).
+bool EvaluateJacobian(StageProblem* problem, const std::vector<ceres::ResidualBlockId>& rows,
+                      const std::vector<double*>& blocks, double* cost, Eigen::MatrixXd* jacobian) {
+  ceres::Problem::EvaluateOptions options;
+  options.residual_blocks = rows;
+  options.parameter_blocks = blocks;
+  ceres::CRSMatrix crs;
+  if (!problem->problem()->Evaluate(options, cost, nullptr, nullptr, &crs)) return false;
+  jacobian->setZero(crs.num_rows, crs.num_cols);
+  for (int row = 0; row < crs.num_rows; ++row) {
+    for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) {
+      (*jacobian)(row, crs.cols[k]) = crs.values[k];
+    }
+  }
+  return std::isfinite(*cost) && jacobian->allFinite();
+}
+
+// Student's t (s estimated) or the normal (s known) 0.975 quantile.
+double IntervalQuantile(bool noise_known, int degrees_of_freedom) {
+  if (noise_known) return boost::math::quantile(boost::math::normal_distribution<double>(), 0.975);
+  return boost::math::quantile(boost::math::students_t_distribution<double>(degrees_of_freedom),
+                               0.975);
+}
+
+BlockCovariance Unavailable(BlockCovariance c, const std::string& message) {
+  c.available = false;
+  c.message = message;
+  if (!std::isfinite(c.noise_sigma)) c.noise_sigma = 0.0;
+  if (!std::isfinite(c.reduced_chi_square)) c.reduced_chi_square = 0.0;
+  if (std::isnan(c.collinearity)) c.collinearity = 0.0;
+  return c;
+}
+
+// A valid description, counts, free entries, zeroed results and the
+// point-sigma flags; false when there is nothing to estimate (`c->message`
+// says why).
+bool Prepare(const FitDescription& fit, const ResidualOptions& residual, BlockCovariance* c) {
+  if (!fit.IsValid(&c->message) || !residual.IsValid(&c->message)) return false;
+  c->values = fit.Values();
+  const int n = static_cast<int>(c->values.size());
+  c->standard_error.assign(n, 0.0);
+  c->ci95_low.assign(n, 0.0);
+  c->ci95_high.assign(n, 0.0);
+  c->covariance.setZero(n, n);
+  const std::vector<bool> fixed = fit.FixedEntries();
+  for (int i = 0; i < n; ++i) {
+    if (!fixed[i]) c->free.push_back(i);
+  }
+  c->num_free = static_cast<int>(c->free.size());
+  int with_sigma = 0;
+  for (const FitDataset& dataset : fit.datasets) {
+    for (const Sweep* sweep : dataset.sweeps) {
+      c->num_points += static_cast<int>(sweep->points.size());
+      for (const DwellPoint& point : sweep->points) with_sigma += point.sigma.has_value();
+    }
+  }
+  c->degrees_of_freedom = c->num_points - c->num_free;
+  const bool use_sigma = residual.use_point_sigma;
+  c->all_standardised = use_sigma && c->num_points > 0 && with_sigma == c->num_points;
+  c->some_standardised = use_sigma && with_sigma > 0;
+  if (c->num_free > 0) return true;
+  c->message = "every parameter is fixed: nothing was estimated";
+  return false;
+}
+
+// s from the dwells' cost; false when it cannot be estimated.
+bool EstimateNoise(BlockCovariance* c) {
+  if (c->degrees_of_freedom > 0) c->reduced_chi_square = 2.0 * c->data_cost / c->degrees_of_freedom;
+  if (c->all_standardised) {
+    c->noise_sigma = 1.0;
+  } else if (c->degrees_of_freedom > 0) {
+    c->noise_sigma = std::sqrt(c->reduced_chi_square);
+  } else {
+    c->message = Format(
+        "%d points for %d free parameters leave no degrees of freedom to estimate the noise: add "
+        "dwells or fix parameters",
+        c->num_points, c->num_free);
+    return false;
+  }
+  return true;
+}
+
+// Normalises the columns of `jacobian` into c->columns and sets
+// c->unit_scale; false for a column without effect.
+bool NormaliseColumns(const FitDescription& fit, const Eigen::MatrixXd& jacobian,
+                      const std::vector<double>& tangent_scale, BlockCovariance* c) {
+  const int k = c->num_free;
+  c->unit_scale.resize(k);
+  c->columns = jacobian;
+  for (int j = 0; j < k; ++j) {
+    const int entry = c->free[j];
+    const double norm = jacobian.col(j).norm();
+    if (!(norm > 0.0)) {
+      // E.g. mu1 with mu1 = mu2 = 0: G depends on the damping through k1^2,
+      // k2^2 and k1 k2 only, so its first derivative vanishes there.
+      const std::string advice =
+          c->values[entry] == 0.0
+              ? " = 0 has no first-order effect on the fitted amplitudes, so no interval can be "
+                "given; check the start and the data, or fix it"
+              : " does not change the fitted amplitudes at all: fix it or add a sweep it affects";
+      c->message = fit.EntryName(entry) + advice;
+      return false;
+    }
+    c->columns.col(j) /= norm;
+    c->unit_scale[j] = tangent_scale[entry] / norm;
+  }
+  return true;
+}
+
+// The collinearity of the normalised columns; false above kMaxCollinearity,
+// with the null directions and a message naming the entries they involve.
+bool CheckCollinearity(const FitDescription& fit, BlockCovariance* c) {
+  const int k = c->num_free;
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(c->columns, Eigen::ComputeThinV);
+  const Eigen::VectorXd& singular = svd.singularValues();
+  c->collinearity = singular[0] / singular[k - 1];
+  if (c->collinearity <= kMaxCollinearity) return true;
+  int rank = k;
+  while (rank > 1 && !(singular[0] / singular[rank - 1] <= kMaxCollinearity)) --rank;
+  c->null_space = svd.matrixV().rightCols(k - rank);
+  std::string names;
+  int involved = 0;
+  for (int j = 0; j < k; ++j) {
+    if (c->null_space.row(j).norm() < kNullDirectionShare) continue;
+    names += (involved++ > 0 ? ", " : "") + fit.EntryName(c->free[j]);
+  }
+  c->message = Format(
+      "%s cannot be told apart by these data: %d combination(s) of them are not determined; fix "
+      "%d of them, add data that affect them differently, or a prior (collinearity %.3g, limit "
+      "%.3g)",
+      names.c_str(), k - rank, k - rank, c->collinearity, kMaxCollinearity);
+  return false;
+}
+
+// (J^T J)^-1 by ceres::Covariance with every free block stepping in its
+// normalised units, in physical units, into c->covariance (times `factor`).
+bool ComputeCovariance(const FitDescription& fit, double factor, StageProblem* problem,
+                       BlockCovariance* c) {
+  const std::vector<bool> fixed = fit.FixedEntries();
+  std::vector<double> unit(fixed.size(), 1.0);
+  for (int j = 0; j < c->num_free; ++j) unit[c->free[j]] = c->unit_scale[j];
+  const std::vector<double*> blocks = FreeBlocks(fit);
+  std::vector<int> offsets;
+  int rows = 0;
+  for (double* values : blocks) {
+    const int b = fit.BlockOf(values);
+    const int offset = fit.Offset(b);
+    const auto first = fixed.begin() + offset;
+    problem->problem()->SetManifold(
+        values,
+        new ScaledSubsetManifold(
+            std::vector<double>(unit.begin() + offset, unit.begin() + offset + fit.blocks[b].size),
+            std::vector<bool>(first, first + fit.blocks[b].size)));
+    offsets.push_back(offset);
+    rows += fit.blocks[b].size;
+  }
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::DENSE_SVD;
+  options.min_reciprocal_condition_number = 1.0 / (kMaxCollinearity * kMaxCollinearity);
+  options.null_space_rank = 0;  // rank deficient: fail, never truncate
+  ceres::Covariance covariance(options);
+  const std::vector<const double*> const_blocks(blocks.begin(), blocks.end());
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> inverse(rows, rows);
+  if (!covariance.Compute(const_blocks, problem->problem()) ||
+      !covariance.GetCovarianceMatrix(const_blocks, inverse.data()) || !inverse.allFinite()) {
+    return false;
+  }
+  int row = 0;
+  for (size_t a = 0; a < blocks.size(); ++a) {
+    const int size_a = fit.blocks[fit.BlockOf(blocks[a])].size;
+    int col = 0;
+    for (size_t b = 0; b < blocks.size(); ++b) {
+      const int size_b = fit.blocks[fit.BlockOf(blocks[b])].size;
+      c->covariance.block(offsets[a], offsets[b], size_a, size_b) =
+          factor * inverse.block(row, col, size_a, size_b);
+      col += size_b;
+    }
+    row += size_a;
+  }
+  return true;
+}
+
+void SetIntervals(BlockCovariance* c) {
+  c->interval_quantile = IntervalQuantile(c->all_standardised, c->degrees_of_freedom);
+  for (size_t i = 0; i < c->values.size(); ++i) c->ci95_low[i] = c->ci95_high[i] = c->values[i];
+  for (int i : c->free) {
+    c->standard_error[i] = std::sqrt(std::max(c->covariance(i, i), 0.0));
+    c->ci95_low[i] = c->values[i] - c->interval_quantile * c->standard_error[i];
+    c->ci95_high[i] = c->values[i] + c->interval_quantile * c->standard_error[i];
+  }
+  c->available = true;
+  c->message = Format(
+      "%d points, %d free parameters, %d degrees of freedom; noise sigma %.3g (%s); "
+      "collinearity %.3g",
+      c->num_points, c->num_free, c->degrees_of_freedom, c->noise_sigma,
+      c->all_standardised ? "point sigmas given" : "estimated from the residuals", c->collinearity);
+  if (c->caller_residuals > 0) {
+    c->message += Format("; with %d residual(s) of the caller's", c->caller_residuals);
+  }
+}
+
+}  // namespace
+
+BlockCovariance EstimateBlockCovariance(const FitDescription& fit,
+                                        const ResidualOptions& residual) {
+  BlockCovariance c;
+  if (!Prepare(fit, residual, &c)) return Unavailable(c, c.message);
+  if (c.some_standardised && !c.all_standardised) {
+    c.warnings.push_back(
+        "only some points have a sigma: residuals mix standardised and raw units, so the noise "
+        "estimate and the intervals are rough; give every point a sigma or none");
+  }
+  const std::vector<double*> blocks = FreeBlocks(fit);
+  std::vector<double> tangent_scale;
+  for (double value : c.values) tangent_scale.push_back(value != 0.0 ? std::abs(value) : 1.0);
+
+  // The dwells alone: their cost gives the noise.
+  std::unique_ptr<StageProblem> problem = AssembleDataProblem(fit, residual, 1.0, false);
+  Eigen::MatrixXd jacobian;
+  if (!EvaluateJacobian(problem.get(), problem->dwell_blocks(), blocks, &c.data_cost, &jacobian)) {
+    return Unavailable(c, "the model cannot be evaluated at the estimate on every fitted dwell");
+  }
+  c.evaluated = true;
+  if (!EstimateNoise(&c)) return Unavailable(c, c.message);
+
+  // With the caller's residual blocks: the dwells weighted by 1/s beside them.
+  double factor = c.noise_sigma * c.noise_sigma;
+  if (fit.add_residuals && !(c.noise_sigma > 0.0)) {
+    return Unavailable(c,
+                       "the dwells fit exactly (noise sigma 0): there is no scale to weigh them "
+                       "against the caller's residual blocks");
+  }
+  if (fit.add_residuals) {
+    problem = AssembleDataProblem(fit, residual, 1.0 / c.noise_sigma, true);
+    std::vector<ceres::ResidualBlockId> rows = problem->dwell_blocks();
+    for (ceres::ResidualBlockId id : problem->caller_blocks()) {
+      rows.push_back(id);
+      c.caller_residuals +=
+          problem->problem()->GetCostFunctionForResidualBlock(id)->num_residuals();
+    }
+    double cost = 0.0;
+    if (!EvaluateJacobian(problem.get(), rows, blocks, &cost, &jacobian)) {
+      return Unavailable(c, "the caller's residual blocks cannot be evaluated at the estimate");
+    }
+    factor = 1.0;
+  }
+  if (!NormaliseColumns(fit, jacobian, tangent_scale, &c) || !CheckCollinearity(fit, &c)) {
+    return Unavailable(c, c.message);
+  }
+  if (!ComputeCovariance(fit, factor, problem.get(), &c)) {
+    return Unavailable(
+        c, Format("the covariance could not be computed (collinearity %.3g)", c.collinearity));
+  }
+  SetIntervals(&c);
+  return c;
+}
+
+}  // namespace dwellfit

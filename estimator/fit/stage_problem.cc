@@ -1,0 +1,227 @@
+#include "dwellfit/estimator/fit/stage_problem.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <sstream>
+#include <utility>
+
+#include "ceres/loss_function.h"
+#include "dwellfit/estimator/fit/scaled_subset_manifold.h"
+#include "glog/logging.h"
+
+namespace dwellfit {
+
+ceres::Problem::Options StageProblem::ProblemOptions(ParallelResidualEvaluator* evaluator,
+                                                     bool threaded) {
+  ceres::Problem::Options options;
+  if (threaded) options.evaluation_callback = evaluator;
+  return options;
+}
+
+std::vector<ParallelResidualEvaluator::Block> StageProblem::EvaluatedBlocks(
+    const FitDescription& fit) {
+  std::vector<ParallelResidualEvaluator::Block> blocks;
+  for (const FitBlock& block : fit.blocks) blocks.push_back({block.values, block.size});
+  return blocks;
+}
+
+StageProblem::StageProblem(const FitDescription& fit, const StageSetup& setup)
+    : fit_(fit),
+      setup_(setup),
+      builder_(setup.residuals),
+      eta_e_entries_(fit.EntriesHolding(kEtaE)),
+      damping_entries_(fit.EntriesHolding(kMu1)),
+      fixed_(fit.FixedEntries()),
+      evaluator_(EvaluatedBlocks(fit), setup.num_threads),
+      problem_(ProblemOptions(&evaluator_, setup.threaded_evaluation)) {
+  const std::vector<bool> mu2 = fit.EntriesHolding(kMu2);
+  for (size_t i = 0; i < mu2.size(); ++i) damping_entries_[i] = damping_entries_[i] || mu2[i];
+  CHECK_EQ(setup.scale.size(), fixed_.size());
+  for (const FitBlock& block : fit.blocks) problem_.AddParameterBlock(block.values, block.size);
+  for (const FitDataset& dataset : fit.datasets) {
+    layouts_.push_back(LayoutOf(fit, dataset.parameters));
+    for (const Sweep* sweep : dataset.sweeps) {
+      dwells_ += builder_.AddSweep(*sweep, layouts_.back(), &problem_, Evaluator());
+    }
+  }
+  problem_.GetResidualBlocks(&dwell_blocks_);
+}
+
+void StageProblem::AddPenalties(const PenaltyOptions& penalties) {
+  ProblemBuilderOptions options = builder_.options();
+  options.penalties = penalties;
+  const ProblemBuilder penalty_builder(options);
+  for (size_t d = 0; d < fit_.datasets.size(); ++d) {
+    for (const Sweep* sweep : fit_.datasets[d].sweeps) {
+      penalty_builder.AddPenalties(*sweep, layouts_[d], &problem_, Evaluator());
+    }
+  }
+}
+
+void StageProblem::AddCallerResiduals() {
+  if (!fit_.add_residuals) return;
+  const int before = problem_.NumResidualBlocks();
+  fit_.add_residuals(&problem_);
+  std::vector<ceres::ResidualBlockId> all;
+  problem_.GetResidualBlocks(&all);
+  caller_blocks_.assign(all.begin() + before, all.end());
+}
+
+bool StageProblem::IsBounded(int entry) const {
+  return eta_e_entries_[entry] || (setup_.bound_damping && damping_entries_[entry]);
+}
+
+bool StageProblem::IsHeld(int entry) const {
+  return fixed_[entry] || (!setup_.held.empty() && setup_.held[entry]);
+}
+
+void StageProblem::Configure() {
+  for (size_t b = 0; b < fit_.blocks.size(); ++b) {
+    const FitBlock& block = fit_.blocks[b];
+    const int offset = fit_.Offset(static_cast<int>(b));
+    std::vector<bool> held(block.size);
+    std::vector<double> scale(block.size);
+    bool any_free = false;
+    for (int i = 0; i < block.size; ++i) {
+      if (IsBounded(offset + i)) problem_.SetParameterLowerBound(block.values, i, 0.0);
+      held[i] = IsHeld(offset + i);
+      scale[i] = setup_.scale[offset + i];
+      any_free = any_free || !held[i];
+    }
+    if (!any_free) {
+      problem_.SetParameterBlockConstant(block.values);
+      continue;
+    }
+    problem_.SetManifold(block.values, new ScaledSubsetManifold(scale, held));
+  }
+}
+
+double StageProblem::DataCost() {
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.residual_blocks = dwell_blocks_;
+  double cost = 0.0;
+  problem_.Evaluate(evaluate, &cost, nullptr, nullptr, nullptr);
+  return cost;
+}
+
+bool StageProblem::CostGradient(std::vector<double>* gradient) {
+  std::vector<ceres::ResidualBlockId> direct = caller_blocks_;
+  if (setup_.threaded_evaluation) {
+    const std::vector<double> point = fit_.Values();
+    if (!evaluator_.CostGradient(point.data(), gradient)) return false;
+  } else {
+    gradient->assign(fit_.NumEntries(), 0.0);
+    problem_.GetResidualBlocks(&direct);
+  }
+  // Blocks the evaluator does not hold add rho'(|r|^2) J^T r each.
+  for (ceres::ResidualBlockId id : direct) {
+    const ceres::CostFunction* cost = problem_.GetCostFunctionForResidualBlock(id);
+    std::vector<double*> blocks;
+    problem_.GetParameterBlocksForResidualBlock(id, &blocks);
+    const int rows = cost->num_residuals();
+    std::vector<double> residuals(rows);
+    std::vector<std::vector<double>> jacobians(blocks.size());
+    std::vector<double*> jacobian_pointers(blocks.size());
+    for (size_t j = 0; j < blocks.size(); ++j) {
+      jacobians[j].resize(static_cast<size_t>(rows) * cost->parameter_block_sizes()[j]);
+      jacobian_pointers[j] = jacobians[j].data();
+    }
+    if (!cost->Evaluate(blocks.data(), residuals.data(), jacobian_pointers.data())) return false;
+    double weight = 1.0;
+    if (const ceres::LossFunction* loss = problem_.GetLossFunctionForResidualBlock(id)) {
+      double squared_norm = 0.0;
+      for (double r : residuals) squared_norm += r * r;
+      double rho[3];
+      loss->Evaluate(squared_norm, rho);
+      weight = rho[1];
+    }
+    for (size_t j = 0; j < blocks.size(); ++j) {
+      const int b = fit_.BlockOf(blocks[j]);
+      if (b < 0) continue;  // a block of the caller's own
+      const int size = fit_.blocks[b].size;
+      for (int row = 0; row < rows; ++row) {
+        for (int col = 0; col < size; ++col) {
+          (*gradient)[fit_.Offset(b) + col] +=
+              weight * jacobians[j][row * size + col] * residuals[row];
+        }
+      }
+    }
+  }
+  return true;
+}
+
+std::vector<BoundRestWatcher::Entry> StageProblem::WatchedBounds() const {
+  std::vector<BoundRestWatcher::Entry> watched;
+  for (size_t b = 0; b < fit_.blocks.size(); ++b) {
+    const int offset = fit_.Offset(static_cast<int>(b));
+    for (int i = 0; i < fit_.blocks[b].size; ++i) {
+      if (IsBounded(offset + i) && !IsHeld(offset + i)) {
+        watched.push_back({fit_.blocks[b].values + i, 0.0, offset + i});
+      }
+    }
+  }
+  return watched;
+}
+
+bool StageProblem::EvaluatesFinite(ceres::ResidualBlockId block) {
+  const ceres::CostFunction* cost = problem_.GetCostFunctionForResidualBlock(block);
+  std::vector<double*> blocks;
+  problem_.GetParameterBlocksForResidualBlock(block, &blocks);
+  std::vector<double> residuals(cost->num_residuals());
+  std::vector<std::vector<double>> jacobian(blocks.size());
+  std::vector<double*> jacobians;
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    jacobian[b].resize(cost->num_residuals() * cost->parameter_block_sizes()[b]);
+    jacobians.push_back(jacobian[b].data());
+  }
+  std::vector<const double*> point(blocks.begin(), blocks.end());
+  if (!cost->Evaluate(point.data(), residuals.data(), jacobians.data())) return false;
+  bool finite = true;
+  for (double r : residuals) finite = finite && std::isfinite(r);
+  for (const std::vector<double>& j : jacobian) {
+    for (double v : j) finite = finite && std::isfinite(v);
+  }
+  return finite;
+}
+
+std::string StageProblem::DescribeFailure(const std::string& ceres_message) {
+  std::vector<std::pair<const Sweep*, const DwellPoint*>> dwells;
+  for (const FitDataset& dataset : fit_.datasets) {
+    for (const Sweep* sweep : dataset.sweeps) {
+      for (const DwellPoint& point : sweep->points) dwells.emplace_back(sweep, &point);
+    }
+  }
+  CHECK_EQ(dwells.size(), dwell_blocks_.size()) << "one residual block per dwell";
+  std::vector<ceres::ResidualBlockId> blocks;
+  problem_.GetResidualBlocks(&blocks);
+  int bad_dwells = 0;
+  int first_bad = -1;
+  bool bad_other = false;
+  for (size_t i = 0; i < blocks.size(); ++i) {
+    if (EvaluatesFinite(blocks[i])) continue;
+    if (i >= dwells.size()) {
+      bad_other = true;
+    } else if (bad_dwells++ == 0) {
+      first_bad = static_cast<int>(i);
+    }
+  }
+  if (first_bad < 0) {
+    return bad_other ? "a penalty or caller's term is not finite there (penalties, "
+                       "config/README.md)"
+                     : "Ceres: " + ceres_message;
+  }
+  const auto [sweep, point] = dwells[first_bad];
+  std::ostringstream text;
+  text << (bad_dwells == static_cast<int>(dwells.size())
+               ? "no dwell's residual is finite there, so the parameters are at fault (the "
+                 "first dwell: "
+               : std::to_string(bad_dwells) + " dwell(s) have a residual that is not finite " +
+                     "there (the first: ")
+       << sweep->source_file << ":" << point->source_line << ", sweep " << sweep->Name() << ", "
+       << RadPerSecondToHz(point->drive_frequency_rad_s) << " Hz, a_base " << point->a_base
+       << ", a " << point->amplitude << ")";
+  return text.str();
+}
+
+}  // namespace dwellfit

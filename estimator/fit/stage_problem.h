@@ -1,0 +1,112 @@
+// StageProblem: the one place a ceres::Problem is assembled from a
+// FitDescription. Every solve of every stage of SolveStaged (staged_solve.h)
+// and the covariance (estimator/analysis/block_covariance.h) build theirs
+// here.
+//
+// In order: every described block (AddParameterBlock, blocks in order); one
+// residual block per dwell of every dataset (ProblemBuilder::AddSweep on the
+// dataset's layout), evaluated on the threads of a ParallelResidualEvaluator
+// that watches every described block (unless !threaded_evaluation); then, when asked, the penalties
+// (AddPenalties) and the caller's residual blocks (AddCallerResiduals); and
+// last the entries' configuration (Configure):
+//   - lower bound 0 on every entry holding eta_e of some dataset, and on
+//     every entry holding mu1 or mu2 when `bound_damping`;
+//   - fixed and held entries do not move; a block with none free is held
+//     constant, the others step in units of their scale
+//     (ScaledSubsetManifold).
+#ifndef DWELLFIT_ESTIMATOR_FIT_STAGE_PROBLEM_H_
+#define DWELLFIT_ESTIMATOR_FIT_STAGE_PROBLEM_H_
+
+#include <string>
+#include <vector>
+
+#include "ceres/problem.h"
+#include "dwellfit/estimator/fit/bound_rest_watcher.h"
+#include "dwellfit/estimator/fit/fit_description.h"
+#include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
+#include "dwellfit/estimator/fit/problem_builder.h"
+
+namespace dwellfit {
+
+struct StageSetup {
+  // The dwells' residual (ProblemBuilderOptions::penalties is not used:
+  // AddPenalties takes them).
+  ProblemBuilderOptions residuals;
+  // Per ambient entry: the physical change of one solver step unit.
+  std::vector<double> scale;
+  // Per ambient entry: held at its value in addition to the fixed entries
+  // (empty: none).
+  std::vector<bool> held;
+  bool bound_damping = true;  // mu1, mu2 >= 0 (eta_e >= 0 always)
+  // Evaluate the dwells and penalties through the ParallelResidualEvaluator
+  // on `num_threads` (>= 1) threads; false: Ceres evaluates every residual
+  // block itself, each time it asks (the covariance, which evaluates twice).
+  bool threaded_evaluation = true;
+  int num_threads = 1;
+};
+
+class StageProblem {
+ public:
+  // Adds the blocks and the dwells. `fit` must be valid and outlive this.
+  StageProblem(const FitDescription& fit, const StageSetup& setup);
+
+  // Adds `penalties` (weights in the cost's own units) for every sweep.
+  void AddPenalties(const PenaltyOptions& penalties);
+  // Calls FitDescription::add_residuals, when set.
+  void AddCallerResiduals();
+  // Bounds, fixed and held entries, scaling. Call once, after the residuals.
+  void Configure();
+
+  // The cost of the dwells alone at the blocks' current values.
+  double DataCost();
+  // The gradient of the whole cost (every residual block, the caller's
+  // included) in the described entries, ambient order, at their current
+  // values: no manifold, no bounds, no held entries. False if a residual
+  // block cannot be evaluated.
+  bool CostGradient(std::vector<double>* gradient);
+  // The bounded entries that are neither fixed nor held, for a
+  // BoundRestWatcher (id: the ambient index). Valid after Configure.
+  std::vector<BoundRestWatcher::Entry> WatchedBounds() const;
+
+  ceres::Problem* problem() { return &problem_; }
+  int dwells() const { return dwells_; }
+  // Why a solve could not evaluate its cost: the dwells (or penalties) whose
+  // residual or Jacobian is not finite at the blocks' current values, named
+  // by file, line and sweep, or else `ceres_message`.
+  std::string DescribeFailure(const std::string& ceres_message);
+  const std::vector<ceres::ResidualBlockId>& dwell_blocks() const { return dwell_blocks_; }
+  // The caller's residual blocks (after AddCallerResiduals).
+  const std::vector<ceres::ResidualBlockId>& caller_blocks() const { return caller_blocks_; }
+
+ private:
+  // Whether the residual block evaluates, with finite residuals and Jacobian.
+  bool EvaluatesFinite(ceres::ResidualBlockId block);
+
+  static ceres::Problem::Options ProblemOptions(ParallelResidualEvaluator* evaluator,
+                                                bool threaded);
+  static std::vector<ParallelResidualEvaluator::Block> EvaluatedBlocks(const FitDescription& fit);
+  // The evaluator the dwells and penalties go through, or none.
+  ParallelResidualEvaluator* Evaluator() {
+    return setup_.threaded_evaluation ? &evaluator_ : nullptr;
+  }
+  // Whether an entry has the lower bound 0.
+  bool IsBounded(int entry) const;
+  bool IsHeld(int entry) const;
+
+  const FitDescription& fit_;
+  const StageSetup setup_;
+  const ProblemBuilder builder_;
+  std::vector<ParameterLayout> layouts_;  // per dataset
+  std::vector<bool> eta_e_entries_;       // per ambient entry
+  std::vector<bool> damping_entries_;
+  std::vector<bool> fixed_;
+  ParallelResidualEvaluator evaluator_;  // outlives problem_, which calls it
+  ceres::Problem problem_;
+  std::vector<ceres::ResidualBlockId> dwell_blocks_;
+  std::vector<ceres::ResidualBlockId> caller_blocks_;
+  int dwells_ = 0;
+};
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_ESTIMATOR_FIT_STAGE_PROBLEM_H_

@@ -1,0 +1,117 @@
+// StageProblem, the one assembly of a ceres::Problem from a description:
+// bounds on the entries holding eta_e, mu1, mu2 (shared or not), fixed and
+// held entries, scaling per block, and the cost gradient with the caller's
+// residual blocks.
+#include "dwellfit/estimator/fit/stage_problem.h"
+
+#include <limits>
+#include <vector>
+
+#include "ceres/normal_prior.h"
+#include "gtest/gtest.h"
+#include "tests/fit_test_support.h"
+
+namespace dwellfit {
+namespace {
+
+constexpr double kNoBound = -std::numeric_limits<double>::max();
+
+StageSetup SetupFor(const FitDescription& fit, ResidualKind kind) {
+  StageSetup setup;
+  setup.residuals.residual = kind;
+  for (double value : fit.Values()) setup.scale.push_back(std::abs(value));
+  setup.bound_damping = kind == ResidualKind::kVertical;
+  return setup;
+}
+
+TEST(StageProblem, OneBlockGetsBoundsFixedEntriesAndScaling) {
+  const std::vector<Sweep> sweeps = SimulateDataset(kThesisTruth, 0.0, 0);
+  ParameterVector p = kThesisTruth;
+  const FitDescription fit =
+      SingleBlockFit(Pointers(sweeps), {false, false, false, true, false, true}, &p);
+  StageProblem vertical(fit, SetupFor(fit, ResidualKind::kVertical));
+  vertical.Configure();
+  ceres::Problem& problem = *vertical.problem();
+  EXPECT_EQ(vertical.dwells(), fit.NumDwells());
+  EXPECT_EQ(problem.NumResidualBlocks(), fit.NumDwells());
+  EXPECT_EQ(problem.ParameterBlockTangentSize(p.data()), 4);
+  for (int i : {kEtaE, kMu1, kMu2}) EXPECT_EQ(problem.GetParameterLowerBound(p.data(), i), 0.0);
+  EXPECT_EQ(problem.GetParameterLowerBound(p.data(), kDelta), kNoBound);
+  std::vector<BoundRestWatcher::Entry> watched = vertical.WatchedBounds();
+  ASSERT_EQ(watched.size(), 3u);
+  EXPECT_EQ(watched[1].id, kMu1);
+  EXPECT_EQ(watched[1].value, &p[kMu1]);
+
+  // The algebraic stage leaves the damping unbounded; a held entry leaves
+  // the tangent space and the watcher.
+  StageSetup algebraic_setup = SetupFor(fit, ResidualKind::kAlgebraic);
+  algebraic_setup.held = {true, false, false, false, false, false};
+  StageProblem algebraic(fit, algebraic_setup);
+  algebraic.Configure();
+  EXPECT_EQ(algebraic.problem()->GetParameterLowerBound(p.data(), kMu1), kNoBound);
+  EXPECT_EQ(algebraic.problem()->ParameterBlockTangentSize(p.data()), 3);
+  EXPECT_TRUE(algebraic.WatchedBounds().empty());
+
+  // Every entry fixed: the block is held constant.
+  ParameterVector q = kThesisTruth;
+  std::array<bool, kNumParameters> all;
+  all.fill(true);
+  const FitDescription fixed = SingleBlockFit(Pointers(sweeps), all, &q);
+  StageProblem constant(fixed, SetupFor(fixed, ResidualKind::kVertical));
+  constant.Configure();
+  EXPECT_TRUE(constant.problem()->IsParameterBlockConstant(q.data()));
+}
+
+TEST(StageProblem, SharedEntriesAreBoundedAndEachBlockIsScaled) {
+  ParameterVector truth_b = kThesisTruth;
+  truth_b[kOmega] = HzToRadPerSecond(43.0);
+  const std::vector<Sweep> a = SimulateDataset(kThesisTruth, 0.0, 0);
+  const std::vector<Sweep> b = SimulateDataset(truth_b, 0.0, 0);
+  SharedModel model(kThesisTruth, truth_b[kOmega]);
+  const FitDescription fit = model.Describe(Pointers(a), Pointers(b));
+  StageProblem stage(fit, SetupFor(fit, ResidualKind::kVertical));
+  stage.Configure();
+  ceres::Problem& problem = *stage.problem();
+  EXPECT_EQ(problem.NumParameterBlocks(), 3);
+  EXPECT_EQ(problem.NumResidualBlocks(), fit.NumDwells());
+  EXPECT_EQ(problem.ParameterBlockTangentSize(model.shared), 5);
+  EXPECT_EQ(problem.ParameterBlockTangentSize(model.w_b), 1);
+  for (int i : {0, 1, 2}) EXPECT_EQ(problem.GetParameterLowerBound(model.shared, i), 0.0);
+  EXPECT_EQ(problem.GetParameterLowerBound(model.shared, 3), kNoBound);
+  EXPECT_EQ(problem.GetParameterLowerBound(model.w_a, 0), kNoBound);
+  // Noise-free data at the truth: no cost, and so no gradient.
+  EXPECT_LT(stage.DataCost(), 1e-25);
+}
+
+// The release test of the active set sees the caller's residual blocks: a
+// prior pulling mu1 up makes d cost / d mu1 negative by its own gradient.
+TEST(StageProblem, CostGradientIncludesTheCallersResidualBlocks) {
+  const std::vector<Sweep> sweeps = SimulateDataset(kThesisTruth, 0.0, 0);
+  ParameterVector p = kThesisTruth;
+  FitDescription fit = SingleBlockFit(Pointers(sweeps), {}, &p);
+  const double sigma = 0.01;  // 1/s
+  fit.add_residuals = [&](ceres::Problem* problem) {
+    ceres::Matrix inverse_sigma = ceres::Matrix::Zero(1, kNumParameters);
+    inverse_sigma(0, kMu1) = 1.0 / sigma;
+    ceres::Vector mean(kNumParameters);
+    for (int i = 0; i < kNumParameters; ++i) mean[i] = kThesisTruth[i];
+    mean[kMu1] = 0.3;
+    problem->AddResidualBlock(new ceres::NormalPrior(inverse_sigma, mean), nullptr, p.data());
+  };
+  for (bool threaded : {true, false}) {
+    StageSetup setup = SetupFor(fit, ResidualKind::kVertical);
+    setup.threaded_evaluation = threaded;
+    StageProblem stage(fit, setup);
+    stage.AddCallerResiduals();
+    ASSERT_EQ(stage.caller_blocks().size(), 1u);
+    std::vector<double> gradient;
+    ASSERT_TRUE(stage.CostGradient(&gradient));
+    ASSERT_EQ(gradient.size(), static_cast<size_t>(kNumParameters));
+    // The dwells are exact at the truth; the prior's r = (0.2 - 0.3) / sigma.
+    EXPECT_NEAR(gradient[kMu1], (0.2 - 0.3) / (sigma * sigma), 1e-6) << threaded;
+    EXPECT_NEAR(gradient[kEtaE], 0.0, 1e-9) << threaded;
+  }
+}
+
+}  // namespace
+}  // namespace dwellfit
