@@ -75,7 +75,7 @@ ParameterVector ReadTruth(const ConfigValue& value, const ConfigSource& source) 
   truth[kMu2] = ReadNonNegative(get({"mu2", "quadratic damping (>= 0)"}), source);
   truth[kDelta] = ReadFiniteDouble(get({"delta", "nonlinear inertia"}), source);
   truth[kAlpha] = ReadFiniteDouble(get({"alpha", "cubic stiffness"}), source);
-  truth[kOmega] = HzToRadPerSecond(
+  truth[kNaturalFrequency] = HzToRadPerSecond(
       ReadPositive(get({"omega_hz", "linear natural frequency [Hz] (> 0)"}), source));
   return truth;
 }

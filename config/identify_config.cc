@@ -156,7 +156,7 @@ KnownParameters ReadInitialGuess(const ConfigValue& value, const ConfigSource& s
       {kMu2, "mu2", "quadratic damping, >= 0"},
       {kDelta, "delta", "nonlinear inertia"},
       {kAlpha, "alpha", "cubic stiffness"},
-      {kOmega, "omega_hz", "linear natural frequency [Hz], > 0"},
+      {kNaturalFrequency, "omega_hz", "linear natural frequency [Hz], > 0"},
   }};
   KnownParameters known;
   if (value.node.IsScalar() && value.node.Scalar() == "auto") return known;
@@ -167,7 +167,7 @@ KnownParameters ReadInitialGuess(const ConfigValue& value, const ConfigSource& s
     const auto entry = block.Optional(key.name);
     if (!entry || (entry->node.IsScalar() && entry->node.Scalar() == "auto")) continue;
     const double number = ReadFiniteDouble(*entry, source);
-    const bool must_be_positive = key.index == kEtaE || key.index == kOmega;
+    const bool must_be_positive = key.index == kEtaE || key.index == kNaturalFrequency;
     const bool must_be_non_negative = key.index == kMu1 || key.index == kMu2;
     if (must_be_positive && !(number > 0.0)) {
       throw source.Error(entry->path, entry->mark,
@@ -181,7 +181,7 @@ KnownParameters ReadInitialGuess(const ConfigValue& value, const ConfigSource& s
                          "below by 0), got " +
                              entry->node.Scalar());
     }
-    known[key.index] = key.index == kOmega ? HzToRadPerSecond(number) : number;
+    known[key.index] = key.index == kNaturalFrequency ? HzToRadPerSecond(number) : number;
   }
   return known;
 }
@@ -254,7 +254,7 @@ std::array<bool, kNumParameters> ReadFixed(const ConfigValue& value, const Confi
       throw EntryError(entry, source, "parameter '" + name + "' is listed twice; keep one");
     }
     if (!known[index]) {
-      const std::string key = index == kOmega ? "omega_hz" : name;
+      const std::string key = index == kNaturalFrequency ? "omega_hz" : name;
       throw EntryError(entry, source,
                        "parameter '" + name +
                            "' is fixed but has no initial guess, and a fixed parameter is held "

@@ -92,8 +92,8 @@ void EmitInitialGuess(YAML::Emitter& out, const IdentifyConfig& config) {
   out << YAML::Key << "initial_guess" << YAML::Value << YAML::BeginMap;
   for (int i = 0; i < kNumParameters; ++i) {
     if (!config.initial_guess[i]) {
-      out << YAML::Key << (i == kOmega ? "omega_hz" : ParameterName(i)) << YAML::Value << "auto";
-    } else if (i == kOmega) {
+      out << YAML::Key << (i == kNaturalFrequency ? "omega_hz" : ParameterName(i)) << YAML::Value << "auto";
+    } else if (i == kNaturalFrequency) {
       out << YAML::Key << "omega_hz" << YAML::Value << ConvertedNumber(RadPerSecondToHz(initial[i]))
           << YAML::Comment(ExactNumber(initial[i]) + " rad/s");
     } else {

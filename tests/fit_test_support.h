@@ -24,7 +24,7 @@ inline const ParameterVector kThesisTruth = {100.0, 0.2, 300.0, 1e4, 9e8, HzToRa
 // simulator's own labels stand.
 inline std::vector<Sweep> SimulateDataset(const ParameterVector& truth, double relative_sigma,
                                           std::uint64_t seed) {
-  const double f0 = RadPerSecondToHz(truth[kOmega]);
+  const double f0 = RadPerSecondToHz(truth[kNaturalFrequency]);
   SweepPlan frequency;
   frequency.id = "F";
   frequency.kind = SweepKind::kFrequency;
@@ -71,7 +71,7 @@ struct ThreeBlocks {
   double rest[3];
 
   explicit ThreeBlocks(const ParameterVector& p)
-      : eta_e{p[kEtaE]}, damping{p[kMu1], p[kMu2]}, rest{p[kDelta], p[kAlpha], p[kOmega]} {}
+      : eta_e{p[kEtaE]}, damping{p[kMu1], p[kMu2]}, rest{p[kDelta], p[kAlpha], p[kNaturalFrequency]} {}
 
   ParameterVector Values() const {
     return {eta_e[0], damping[0], damping[1], rest[0], rest[1], rest[2]};
@@ -96,7 +96,7 @@ struct SharedModel {
   double w_b[1];
 
   SharedModel(const ParameterVector& a, double w_b_rad_s)
-      : shared{a[kEtaE], a[kMu1], a[kMu2], a[kDelta], a[kAlpha]}, w_a{a[kOmega]}, w_b{w_b_rad_s} {}
+      : shared{a[kEtaE], a[kMu1], a[kMu2], a[kDelta], a[kAlpha]}, w_a{a[kNaturalFrequency]}, w_b{w_b_rad_s} {}
 
   ParameterMap MapOf(double* w) {
     return {{{shared, 0}, {shared, 1}, {shared, 2}, {shared, 3}, {shared, 4}, {w, 0}}};

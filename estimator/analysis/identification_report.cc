@@ -18,7 +18,7 @@ IdentificationReport MakeIdentificationReport(const std::string& config_path,
   report.config_path = config_path;
   report.options = options;
   report.result = result;
-  report.omega_ref_rad_s = omega_ref_rad_s > 0.0 ? omega_ref_rad_s : result.parameters[kOmega];
+  report.omega_ref_rad_s = omega_ref_rad_s > 0.0 ? omega_ref_rad_s : result.parameters[kNaturalFrequency];
   for (const Sweep* sweep : fitted) {
     report.predictions.push_back(PredictSweep(result.parameters, *sweep, /*fitted=*/true));
   }
@@ -63,11 +63,11 @@ void EmitParameters(const IdentificationReport& report, YAML::Emitter* out) {
       *out << YAML::Key << "standard_error" << YAML::Value << u.standard_error[i];
       EmitInterval(u.ci95_low[i], u.ci95_high[i], out);
     }
-    if (i == kOmega) *out << YAML::Key << "unit" << YAML::Value << "rad/s";
+    if (i == kNaturalFrequency) *out << YAML::Key << "unit" << YAML::Value << "rad/s";
     *out << YAML::EndMap;
   }
   *out << YAML::EndMap;
-  *out << YAML::Key << "natural_frequency_hz" << YAML::Value << RadPerSecondToHz(p[kOmega]);
+  *out << YAML::Key << "natural_frequency_hz" << YAML::Value << RadPerSecondToHz(p[kNaturalFrequency]);
   *out << YAML::Key << "effective_nonlinearity" << YAML::Value << YAML::BeginMap;
   *out << YAML::Key << "definition" << YAML::Value << "-(1/3)(2 delta Omega_ref^2 - 3 alpha)";
   *out << YAML::Key << "value" << YAML::Value << EffectiveNonlinearity(p, report.omega_ref_rad_s);
@@ -259,7 +259,7 @@ void PrintParameters(const IdentificationReport& report, std::ostream& out) {
   }
   out << StringPrintf(
       "natural frequency %.8g Hz; effective nonlinearity %.8g at Omega_ref %.6g rad/s\n",
-      RadPerSecondToHz(result.parameters[kOmega]),
+      RadPerSecondToHz(result.parameters[kNaturalFrequency]),
       EffectiveNonlinearity(result.parameters, report.omega_ref_rad_s), report.omega_ref_rad_s);
   if (u.available) {
     out << StringPrintf("  effective nonlinearity std.error %.3g, 95%% interval [%.6g, %.6g]\n",

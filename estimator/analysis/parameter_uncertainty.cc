@@ -235,7 +235,7 @@ ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted
                                          const IdentificationOptions& options,
                                          const ParameterVector& estimate, double omega_ref_rad_s) {
   ParameterUncertainty u;
-  if (!(omega_ref_rad_s > 0.0)) omega_ref_rad_s = estimate[kOmega];
+  if (!(omega_ref_rad_s > 0.0)) omega_ref_rad_s = estimate[kNaturalFrequency];
   u.omega_ref_rad_s = omega_ref_rad_s;
   u.effective_nonlinearity = EffectiveNonlinearity(estimate, omega_ref_rad_s);
   if (!std::isfinite(u.effective_nonlinearity)) u.effective_nonlinearity = 0.0;

@@ -13,8 +13,8 @@ PredictedJump PredictJump(const ParameterVector& p, const Sweep& sweep, JumpKind
                           double guess_control) {
   PredictedJump predicted;
   predicted.kind = kind;
-  const FoldKind fold_kind =
-      kind == JumpKind::kJumpUp ? FoldKind::kLowerBranchEnd : FoldKind::kUpperBranchEnd;
+  const JumpKind fold_kind =
+      kind == JumpKind::kJumpUp ? JumpKind::kJumpUp : JumpKind::kJumpDown;
   const DwellPoint& first = sweep.points.front();
   FoldPoint fold;
   if (sweep.kind == SweepKind::kFrequency) {

@@ -4,10 +4,6 @@
 
 namespace dwellfit {
 
-const char* SweepKindName(SweepKind kind) {
-  return kind == SweepKind::kFrequency ? "frequency" : "amplitude";
-}
-
 const char* SweepDirectionName(SweepDirection direction) {
   return direction == SweepDirection::kUp ? "up" : "down";
 }
@@ -22,10 +18,6 @@ bool SweepDirectionFromName(const std::string& name, SweepDirection* direction) 
     return true;
   }
   return false;
-}
-
-const char* JumpKindName(JumpKind kind) {
-  return kind == JumpKind::kJumpUp ? "jump_up" : "jump_down";
 }
 
 double JumpBracket::half_width() const { return 0.5 * std::abs(control_after - control_before); }

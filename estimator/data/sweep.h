@@ -12,13 +12,12 @@
 #include <vector>
 
 #include "dwellfit/residuals/model/stable_root.h"
+#include "dwellfit/residuals/model/sweep_vocabulary.h"
 
 namespace dwellfit {
 
-enum class SweepKind { kFrequency, kAmplitude };
 enum class SweepDirection { kUp, kDown };
 
-const char* SweepKindName(SweepKind kind);
 const char* SweepDirectionName(SweepDirection direction);
 bool SweepDirectionFromName(const std::string& name, SweepDirection* direction);
 
@@ -32,9 +31,6 @@ struct DwellPoint {
   Branch branch = Branch::kOnly;       // stable branch it was measured on
   int source_line = 0;                 // 1-based line in the source file (0: generated)
 };
-
-enum class JumpKind { kJumpUp, kJumpDown };
-const char* JumpKindName(JumpKind kind);
 
 // A jump between two consecutive dwells: the model's fold lies between the two
 // control values (eq. 3.17 uses the bracket's centre and half-width).

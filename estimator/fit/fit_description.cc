@@ -82,7 +82,7 @@ bool BlockIsValid(const FitDescription& fit, int b, std::string* error) {
 bool IsInModelRange(const FitDescription& fit, const FitDataset& dataset, int i,
                     const ParameterSlot& slot, std::string* error) {
   const double value = slot.block[slot.index];
-  const bool positive = i == kEtaE || i == kOmega;
+  const bool positive = i == kEtaE || i == kNaturalFrequency;
   const bool non_negative = i == kMu1 || i == kMu2;
   if ((positive && value > 0.0) || (non_negative && value >= 0.0) || !(positive || non_negative)) {
     return true;

@@ -145,7 +145,7 @@ bool IdentificationOptions::IsValid(std::string* error) const {
       *error = field + " must be a finite number, got " + ToText(initial[i]);
       return false;
     }
-    const bool positive = i == kEtaE || i == kOmega;
+    const bool positive = i == kEtaE || i == kNaturalFrequency;
     if (positive && !(initial[i] > 0.0)) {
       *error = field + " must be positive (> 0), got " + ToText(initial[i]);
       return false;

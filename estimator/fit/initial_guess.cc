@@ -374,7 +374,7 @@ BackboneFit FitBackbone(const std::vector<const Sweep*>& sweeps,
     y.push_back(ordinate(point.omega, point.a));
   }
   std::optional<double> known_w2, known_b;
-  if (known[kOmega]) known_w2 = *known[kOmega] * *known[kOmega];
+  if (known[kNaturalFrequency]) known_w2 = *known[kNaturalFrequency] * *known[kNaturalFrequency];
   if (known[kAlpha]) known_b = 0.75 * *known[kAlpha];
   BackboneFit fit;
   if (known_w2 || known_b || HasSpread(a2)) {
@@ -416,13 +416,13 @@ void SetStiffness(const BackboneFit& fit, const KnownParameters& known,
                   InitialGuessReport* report) {
   ParameterVector& guess = report->guess;
   std::vector<std::string>& steps = report->steps;
-  if (known[kOmega]) {
-    guess[kOmega] = *known[kOmega];
-    steps.push_back(StringPrintf("omega = %s: given", RadPerSecondText(guess[kOmega]).c_str()));
+  if (known[kNaturalFrequency]) {
+    guess[kNaturalFrequency] = *known[kNaturalFrequency];
+    steps.push_back(StringPrintf("omega = %s: given", RadPerSecondText(guess[kNaturalFrequency]).c_str()));
   } else {
-    guess[kOmega] = std::sqrt(fit.w2);
+    guess[kNaturalFrequency] = std::sqrt(fit.w2);
     steps.push_back(StringPrintf("omega = %s: %s; w^2 is its value at a = 0",
-                                 RadPerSecondText(guess[kOmega]).c_str(), fit.how.c_str()));
+                                 RadPerSecondText(guess[kNaturalFrequency]).c_str(), fit.how.c_str()));
   }
   if (known[kAlpha]) {
     guess[kAlpha] = *known[kAlpha];

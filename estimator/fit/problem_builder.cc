@@ -73,13 +73,11 @@ ceres::CostFunction* MakeBifurcationRangePenalty(const Sweep& sweep, const JumpB
                                                  const BifurcationRangeOptions& options) {
   const DwellPoint& before = sweep.points[jump.index_before];
   const bool frequency = sweep.kind == SweepKind::kFrequency;
-  // A jump-up ends the lower branch, a jump-down the upper one; the dwell
-  // before the jump sits on the branch that ends.
-  return BifurcationRangePenalty::Create(
-      frequency ? ControlKind::kDriveFrequency : ControlKind::kBaseLevel,
-      jump.kind == JumpKind::kJumpUp ? FoldKind::kLowerBranchEnd : FoldKind::kUpperBranchEnd,
-      frequency ? before.a_base : before.drive_frequency_rad_s, jump.control_before,
-      jump.control_after, jump.amplitude_before, options.exponent, options.weight);
+  // The dwell before the jump sits on the branch that ends.
+  return BifurcationRangePenalty::Create(sweep.kind, jump.kind,
+                                         frequency ? before.a_base : before.drive_frequency_rad_s,
+                                         jump.control_before, jump.control_after,
+                                         jump.amplitude_before, options.exponent, options.weight);
 }
 
 int ProblemBuilder::AddPenalties(const Sweep& sweep, double* parameters, ceres::Problem* problem,

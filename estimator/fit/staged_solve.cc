@@ -183,7 +183,7 @@ void RecordSolve(const ceres::Solver::Summary& summary, int round, StageProblem*
 // "eta_e 100, mu1 0.2, ..., omega 251.3 rad/s": every entry of `fit` at
 // `values`, natural frequencies with their unit.
 std::string DescribeValues(const FitDescription& fit, const std::vector<double>& values) {
-  const std::vector<bool> natural_frequency = fit.EntriesHolding(kOmega);
+  const std::vector<bool> natural_frequency = fit.EntriesHolding(kNaturalFrequency);
   std::ostringstream text;
   for (size_t i = 0; i < values.size(); ++i) {
     text << (i > 0 ? ", " : "") << fit.EntryName(static_cast<int>(i)) << " " << values[i]

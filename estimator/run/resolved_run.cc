@@ -86,7 +86,7 @@ void CheckEnoughDwells(const IdentifyConfig& config, const std::vector<const Swe
 void CheckFixedAreGiven(const IdentifyConfig& config) {
   for (int i = 0; i < kNumParameters; ++i) {
     if (!config.identification.fixed[i] || config.initial_guess[i]) continue;
-    const std::string key = i == kOmega ? "omega_hz" : ParameterName(i);
+    const std::string key = i == kNaturalFrequency ? "omega_hz" : ParameterName(i);
     throw InputError(config.config_path, 0, "fixed",
                      std::string(ParameterName(i)) +
                          " is held fixed but its initial guess is left to the data (auto); give "

@@ -134,8 +134,8 @@ bool DwellPlan::IsValid(std::string* error) const {
     *error = "truth eta_e must be positive, got " + G12(truth[kEtaE]);
     return false;
   }
-  if (!(truth[kOmega] > 0.0)) {
-    *error = "truth omega must be positive, got " + G12(truth[kOmega]) + " rad/s";
+  if (!(truth[kNaturalFrequency] > 0.0)) {
+    *error = "truth omega must be positive, got " + G12(truth[kNaturalFrequency]) + " rad/s";
     return false;
   }
   if (truth[kMu1] < 0.0 || truth[kMu2] < 0.0) {
@@ -287,7 +287,7 @@ void DescribeSimulation(const DwellPlan& plan, const std::vector<Sweep>& sweeps,
   const ParameterVector& p = plan.truth;
   *out << "truth: eta_e " << G12(p[kEtaE]) << ", mu1 " << G12(p[kMu1]) << " 1/s, mu2 "
        << G12(p[kMu2]) << ", delta " << G12(p[kDelta]) << ", alpha " << G12(p[kAlpha]) << ", w "
-       << G12(p[kOmega]) << " rad/s (" << G12(RadPerSecondToHz(p[kOmega])) << " Hz)\n";
+       << G12(p[kNaturalFrequency]) << " rad/s (" << G12(RadPerSecondToHz(p[kNaturalFrequency])) << " Hz)\n";
   if (plan.noise.relative_sigma > 0.0) {
     *out << "noise: relative_sigma " << G12(plan.noise.relative_sigma) << ", seed "
          << plan.noise.seed << "\n";

@@ -33,7 +33,7 @@ PairedFit FitBothWays(const IdentifyConfig& config) {
   fit.data.options.penalties.branch_stability.enabled = false;
   fit.without_penalty = FitRun(fit.data).best;
   fit.data.options.penalties = configured;
-  fit.omega_ref_rad_s = config.omega_ref_rad_s.value_or(fit.with_penalty.parameters[kOmega]);
+  fit.omega_ref_rad_s = config.omega_ref_rad_s.value_or(fit.with_penalty.parameters[kNaturalFrequency]);
   return fit;
 }
 
@@ -50,8 +50,8 @@ std::vector<Row> Rows(const PairedFit& fit, const IdentificationOptions& options
                       const ParameterVector& truth) {
   std::vector<Row> rows;
   for (int i = 0; i < kNumParameters; ++i) {
-    if (i == kOmega && options.fixed[kOmega]) continue;
-    const bool omega = i == kOmega;
+    if (i == kNaturalFrequency && options.fixed[kNaturalFrequency]) continue;
+    const bool omega = i == kNaturalFrequency;
     rows.push_back(
         {omega ? "w [Hz]" : ParameterName(i),
          omega ? RadPerSecondToHz(fit.with_penalty.parameters[i]) : fit.with_penalty.parameters[i],

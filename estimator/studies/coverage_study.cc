@@ -81,7 +81,7 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
   const auto start = std::chrono::steady_clock::now();
   CoverageStudy study;
   study.replicas = options.replicas;
-  study.omega_ref_rad_s = config.omega_ref_rad_s ? *config.omega_ref_rad_s : plan.truth[kOmega];
+  study.omega_ref_rad_s = config.omega_ref_rad_s ? *config.omega_ref_rad_s : plan.truth[kNaturalFrequency];
 
   // Rows: the free parameters, then alpha_e (index kNumParameters).
   std::vector<int> rows;

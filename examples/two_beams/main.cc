@@ -49,7 +49,7 @@ ParameterVector Truth(double hz) {
 // Hz and an amplitude sweep at f0 + 1.5 Hz, up and down, 1 % noise, branches
 // labelled from the data as for a measured beam.
 std::vector<dwellfit::Sweep> Measure(const ParameterVector& truth, std::uint64_t seed) {
-  const double f0 = dwellfit::RadPerSecondToHz(truth[dwellfit::kOmega]);
+  const double f0 = dwellfit::RadPerSecondToHz(truth[dwellfit::kNaturalFrequency]);
   dwellfit::SweepPlan frequency;
   frequency.id = "F";
   frequency.kind = dwellfit::SweepKind::kFrequency;
@@ -98,7 +98,7 @@ struct Blocks {
     for (const Beam* beam : beams) {
       eta_e[0] += beam->guess[dwellfit::kEtaE] / n;
       for (int i = 0; i < 4; ++i) material[i] += beam->guess[dwellfit::kMu1 + i] / n;
-      w.push_back(beam->guess[dwellfit::kOmega]);
+      w.push_back(beam->guess[dwellfit::kNaturalFrequency]);
     }
   }
 
@@ -171,7 +171,7 @@ bool PrintIntervals(const std::vector<const Beam*>& beams, const FitResult& join
     // fits have one w, at entry 5.
     const bool is_w = i >= 5;
     const Beam& beam = *beams[is_w ? i - 5 : 0];
-    const double truth = is_w ? beam.truth[dwellfit::kOmega] : beam.truth[i];
+    const double truth = is_w ? beam.truth[dwellfit::kNaturalFrequency] : beam.truth[i];
     const std::string name = is_w ? "w_" + beam.name + " rad/s" : names[i];
     covered = covered && joint.low[i] <= truth && truth <= joint.high[i];
     std::printf("%-9s %11.6g  %s  %s  %s\n", name.c_str(), truth, Interval(joint, i).c_str(),

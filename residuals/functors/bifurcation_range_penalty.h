@@ -25,8 +25,6 @@
 
 namespace dwellfit {
 
-enum class ControlKind { kDriveFrequency, kBaseLevel };
-
 class BifurcationRangePenalty {
  public:
   // u for a fold that does not exist: a fold this many half-widths away costs
@@ -36,7 +34,7 @@ class BifurcationRangePenalty {
   // `control_kind`: which control the jump's bracket is in. `held`: the other
   // control (a_base for a frequency sweep, Omega [rad/s] for an amplitude
   // sweep). `a_jump`: the measured amplitude on the branch that ends.
-  BifurcationRangePenalty(ControlKind control_kind, FoldKind fold_kind, double held,
+  BifurcationRangePenalty(SweepKind control_kind, JumpKind fold_kind, double held,
                           double control_before, double control_after, double a_jump, int exponent,
                           double weight)
       : control_kind_(control_kind),
@@ -55,9 +53,8 @@ class BifurcationRangePenalty {
     T u;
     const FoldPoint fold = SolveFold(value);
     if (fold.exists) {
-      const T c_model = control_kind_ == ControlKind::kDriveFrequency
-                            ? LiftFrequencyFold(p, held_, fold)
-                            : LiftAmplitudeFold(p, held_, fold);
+      const T c_model = control_kind_ == SweepKind::kFrequency ? LiftFrequencyFold(p, held_, fold)
+                                                               : LiftAmplitudeFold(p, held_, fold);
       u = (c_model - centre_) / half_width_;
     } else {
       u = kNoFoldDistance + FoldSlack(p);
@@ -70,14 +67,14 @@ class BifurcationRangePenalty {
 
   // The model's fold for this bracket, in double.
   FoldPoint SolveFold(const ParameterVector& p) const {
-    if (control_kind_ == ControlKind::kDriveFrequency) {
+    if (control_kind_ == SweepKind::kFrequency) {
       return SolveFrequencyFold(p.data(), held_, fold_kind_, centre_,
                                 std::max(half_width_, 1e-4 * centre_));
     }
     return SolveAmplitudeFold(p.data(), held_, fold_kind_);
   }
 
-  static ceres::CostFunction* Create(ControlKind control_kind, FoldKind fold_kind, double held,
+  static ceres::CostFunction* Create(SweepKind control_kind, JumpKind fold_kind, double held,
                                      double control_before, double control_after, double a_jump,
                                      int exponent, double weight) {
     return new ceres::AutoDiffCostFunction<BifurcationRangePenalty, 1, kNumParameters>(
@@ -88,15 +85,15 @@ class BifurcationRangePenalty {
  private:
   template <typename T>
   T FoldSlack(const T* p) const {
-    const double omega = control_kind_ == ControlKind::kDriveFrequency ? centre_ : held_;
+    const double omega = control_kind_ == SweepKind::kFrequency ? centre_ : held_;
     const auto k = ResponseCoefficients<T>::FromParameters(p, omega);
     const T a(a_jump_);
     const T slack = k.h(a) / (2.0 * k.c2());
     return slack > 0.0 ? slack : T(0.0);
   }
 
-  const ControlKind control_kind_;
-  const FoldKind fold_kind_;
+  const SweepKind control_kind_;
+  const JumpKind fold_kind_;
   const double held_;
   const double centre_;
   const double half_width_;

@@ -28,14 +28,9 @@
 #include "dwellfit/residuals/model/bracketed_newton.h"
 #include "dwellfit/residuals/model/response_model.h"
 #include "dwellfit/residuals/model/stable_root.h"
+#include "dwellfit/residuals/model/sweep_vocabulary.h"
 
 namespace dwellfit {
-
-// Which branch ends at the fold.
-enum class FoldKind {
-  kLowerBranchEnd,  // jump-up: local maximum of G
-  kUpperBranchEnd,  // jump-down: local minimum of G
-};
 
 // dG/dOmega at fixed a, from dk1/dOmega = k1/Omega, dk2/dOmega = k2/Omega,
 // dk3/dOmega = -Omega/eta_e, dk4/dOmega = -delta Omega/(2 eta_e).
@@ -48,8 +43,8 @@ T DerivativeOfGInDriveFrequency(const T* p, double omega_drive_rad_s,
   return 2.0 * (k.P(a) * dp + k.Q(a) * dq);
 }
 
-inline double TurningAmplitude(const TurningPoints& tp, FoldKind kind) {
-  return kind == FoldKind::kLowerBranchEnd ? tp.a_lower_end : tp.a_upper_end;
+inline double TurningAmplitude(const TurningPoints& tp, JumpKind kind) {
+  return kind == JumpKind::kJumpUp ? tp.a_lower_end : tp.a_upper_end;
 }
 
 struct FoldPoint {
@@ -59,7 +54,7 @@ struct FoldPoint {
 };
 
 // Amplitude sweep at `omega_drive_rad_s`: the a_base where `kind` ends.
-inline FoldPoint SolveAmplitudeFold(const double* p, double omega_drive_rad_s, FoldKind kind) {
+inline FoldPoint SolveAmplitudeFold(const double* p, double omega_drive_rad_s, JumpKind kind) {
   FoldPoint fold;
   const auto k = ResponseCoefficients<double>::FromParameters(p, omega_drive_rad_s);
   const TurningPoints tp = FindTurningPoints(k);
@@ -82,7 +77,7 @@ T LiftAmplitudeFold(const T* p, double omega_drive_rad_s, const FoldPoint& fold)
 // Frequency sweep at `a_base`: the Omega [rad/s] where `kind` ends, searched
 // outward from `omega_guess` (the measured bracket's centre) in steps that
 // start at `first_step` and double, within a factor 2 of the guess.
-inline FoldPoint SolveFrequencyFold(const double* p, double a_base, FoldKind kind,
+inline FoldPoint SolveFrequencyFold(const double* p, double a_base, JumpKind kind,
                                     double omega_guess, double first_step) {
   FoldPoint fold;
   const double target = a_base * a_base;

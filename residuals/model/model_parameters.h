@@ -23,7 +23,7 @@ enum ParameterIndex : int {
   kMu2 = 2,
   kDelta = 3,
   kAlpha = 4,
-  kOmega = 5,
+  kNaturalFrequency = 5,
   kNumParameters = 6,
 };
 

@@ -30,7 +30,7 @@ struct ResponseCoefficients {
   static ResponseCoefficients FromParameters(const T* p, const D& omega_drive) {
     ResponseCoefficients k;
     const T& eta_e = p[kEtaE];
-    const T& w = p[kOmega];
+    const T& w = p[kNaturalFrequency];
     k.k1 = omega_drive * p[kMu1] / eta_e;
     k.k2 = (4.0 / (3.0 * kPi)) * p[kMu2] * omega_drive / eta_e;
     k.k3 = -(omega_drive * omega_drive - w * w) / (2.0 * eta_e);

@@ -32,7 +32,7 @@ class NoisyDatasets : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     truth_b_ = kThesisTruth;
-    truth_b_[kOmega] = HzToRadPerSecond(43.0);
+    truth_b_[kNaturalFrequency] = HzToRadPerSecond(43.0);
     a_ = new std::vector<Sweep>(SimulateDataset(kThesisTruth, 0.01, 11));
     b_ = new std::vector<Sweep>(SimulateDataset(truth_b_, 0.01, 12));
   }
@@ -53,7 +53,7 @@ std::vector<Sweep>* NoisyDatasets::b_ = nullptr;
 TEST_F(NoisyDatasets, IdentityMappedBlocksGiveTheOneBlocksCovariance) {
   IdentificationOptions options;
   options.initial = ThesisStart(kThesisTruth);
-  options.fixed[kOmega] = true;
+  options.fixed[kNaturalFrequency] = true;
   options.residual.error = ErrorMeasure::kRelative;
   const IdentificationResult fit = Identify(Pointers(*a_), options);
   ASSERT_TRUE(fit.IsSolutionUsable()) << fit.message;
@@ -74,7 +74,7 @@ TEST_F(NoisyDatasets, IdentityMappedBlocksGiveTheOneBlocksCovariance) {
           << ParameterName(i) << ", " << ParameterName(j);
     }
   }
-  EXPECT_EQ(mapped.standard_error[kOmega], 0.0);  // fixed
+  EXPECT_EQ(mapped.standard_error[kNaturalFrequency], 0.0);  // fixed
 }
 
 // Joint fit: eta_e, mu1, mu2, delta, alpha shared, one w each. On the
@@ -83,8 +83,8 @@ TEST_F(NoisyDatasets, IdentityMappedBlocksGiveTheOneBlocksCovariance) {
 // the shared eta_e is known better than from either dataset alone.
 TEST_F(NoisyDatasets, JointCovarianceSucceedsScaledAndNarrowsTheSharedEtaE) {
   ParameterVector start = ThesisStart(kThesisTruth);
-  start[kOmega] *= 1.005;
-  SharedModel model(start, truth_b_[kOmega] * 0.995);
+  start[kNaturalFrequency] *= 1.005;
+  SharedModel model(start, truth_b_[kNaturalFrequency] * 0.995);
   const FitDescription fit = model.Describe(Pointers(*a_), Pointers(*b_));
   const FitSummary summary = SolveStaged(fit, RelativeError());
   ASSERT_TRUE(summary.IsSolutionUsable()) << summary.message;
@@ -111,11 +111,11 @@ TEST_F(NoisyDatasets, JointCovarianceSucceedsScaledAndNarrowsTheSharedEtaE) {
   const int w_b = fit.AmbientIndex({model.w_b, 0});
   EXPECT_GT(joint.standard_error[eta_e], 0.0);
   EXPECT_LT(std::abs(model.shared[0] - kThesisTruth[kEtaE]), 4.0 * joint.standard_error[eta_e]);
-  EXPECT_LT(std::abs(model.w_b[0] - truth_b_[kOmega]), 4.0 * joint.standard_error[w_b]);
+  EXPECT_LT(std::abs(model.w_b[0] - truth_b_[kNaturalFrequency]), 4.0 * joint.standard_error[w_b]);
 
   for (const std::vector<Sweep>* data : {a_, b_}) {
     ParameterVector alone = start;
-    alone[kOmega] = data == a_ ? start[kOmega] : truth_b_[kOmega] * 0.995;
+    alone[kNaturalFrequency] = data == a_ ? start[kNaturalFrequency] : truth_b_[kNaturalFrequency] * 0.995;
     const FitDescription single = SingleBlockFit(Pointers(*data), {}, &alone);
     ASSERT_TRUE(SolveStaged(single, RelativeError()).IsSolutionUsable());
     const BlockCovariance c = EstimateBlockCovariance(single, RelativeError().residual);
@@ -129,7 +129,7 @@ TEST_F(NoisyDatasets, JointCovarianceSucceedsScaledAndNarrowsTheSharedEtaE) {
 TEST_F(NoisyDatasets, APriorNarrowsItsEntryBelowTheDataAndThePrior) {
   IdentificationOptions options;
   options.initial = ThesisStart(kThesisTruth);
-  options.fixed[kOmega] = true;
+  options.fixed[kNaturalFrequency] = true;
   options.residual.error = ErrorMeasure::kRelative;
   ParameterVector p = Identify(Pointers(*a_), options).parameters;
   FitDescription fit = SingleBlockFit(Pointers(*a_), options.fixed, &p);

@@ -200,7 +200,7 @@ TEST_F(UncertaintyThesisNumerical, AmplitudeSweepAloneCannotSeparateDeltaAndAlph
   // With omega free as well, eta_e rescales with omega^2 - Omega^2: a second
   // lost direction.
   IdentificationOptions omega_free = config_.identification;
-  omega_free.fixed[kOmega] = false;
+  omega_free.fixed[kNaturalFrequency] = false;
   const ParameterUncertainty two =
       EstimateUncertainty(Named(exact_, {"A41.5"}), omega_free, kTruth, omega_ref_);
   EXPECT_FALSE(two.available);
@@ -247,7 +247,7 @@ TEST_F(UncertaintyThesisNumerical, FixedParametersHaveZeroErrorAndStayOutOfWarni
   ASSERT_TRUE(u.available) << u.message;
   ExpectAllFinite(u);
   EXPECT_EQ(u.num_free, 4);
-  for (int i : {kDelta, kOmega}) {
+  for (int i : {kDelta, kNaturalFrequency}) {
     EXPECT_EQ(u.standard_error[i], 0.0) << ParameterName(i);
     EXPECT_EQ(u.ci95_low[i], result.parameters[i]) << ParameterName(i);
     EXPECT_EQ(u.ci95_high[i], result.parameters[i]) << ParameterName(i);

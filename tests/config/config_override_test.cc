@@ -362,7 +362,7 @@ TEST(ConfigOverrides, SetOnAnAliasedValueChangesOnlyThatKey) {
       "effective_nonlinearity_reference_hz: 41", "effective_nonlinearity_reference_hz: *f"));
   const IdentifyConfig config =
       LoadIdentifyConfig(path, ParseSetFlag("initial_guess.omega_hz=40", "--set"));
-  EXPECT_DOUBLE_EQ(config.identification.initial[kOmega], HzToRadPerSecond(40.0));
+  EXPECT_DOUBLE_EQ(config.identification.initial[kNaturalFrequency], HzToRadPerSecond(40.0));
   EXPECT_DOUBLE_EQ(*config.omega_ref_rad_s, HzToRadPerSecond(41.0));
 }
 

@@ -64,7 +64,7 @@ TEST(LoadIdentifyConfig, ValidConfigLandsInTheStructs) {
   EXPECT_EQ(options.initial[kMu2], 390.0);
   EXPECT_EQ(options.initial[kDelta], 1.3e4);
   EXPECT_EQ(options.initial[kAlpha], 1.17e9);
-  EXPECT_DOUBLE_EQ(options.initial[kOmega], 2.0 * M_PI * 40.0);  // Hz -> rad/s
+  EXPECT_DOUBLE_EQ(options.initial[kNaturalFrequency], 2.0 * M_PI * 40.0);  // Hz -> rad/s
   EXPECT_THAT(options.fixed, ElementsAre(false, false, false, false, false, true));
   EXPECT_THAT(options.stages, ElementsAre(ResidualKind::kAlgebraic, ResidualKind::kVertical));
   EXPECT_EQ(options.residual.error, ErrorMeasure::kRelative);
@@ -180,7 +180,7 @@ TEST(ConfigReadme, AnnotatedExampleLoads) {
   const ConfigDirectory dir;
   const IdentifyConfig config = LoadIdentifyConfig(dir.WriteConfig(ReadmeExample()));
   EXPECT_THAT(Names(config.fit_sweeps), ElementsAre("F0.01", "A41.5"));
-  EXPECT_DOUBLE_EQ(config.identification.initial[kOmega], HzToRadPerSecond(40.0));
+  EXPECT_DOUBLE_EQ(config.identification.initial[kNaturalFrequency], HzToRadPerSecond(40.0));
   EXPECT_EQ(config.identification.solver.max_iterations, 200);
   EXPECT_TRUE(config.identification.penalties.bifurcation_range.enabled);
   EXPECT_FALSE(config.identification.penalties.branch_stability.enabled);

@@ -133,8 +133,8 @@ TEST_F(ClampedBeamIdentification, SameMinimumWithoutNonmonotonicStepsOrTheAlgebr
     std::cout << "final cost " << fit.final_cost << " against " << committed_->final_cost << "\n";
     EXPECT_TRUE(fit.converged);
     EXPECT_NEAR(fit.final_cost, committed_->final_cost, 1e-4 * committed_->final_cost);
-    EXPECT_NEAR(fit.parameters[kOmega], committed_->parameters[kOmega],
-                1e-4 * committed_->parameters[kOmega]);
+    EXPECT_NEAR(fit.parameters[kNaturalFrequency], committed_->parameters[kNaturalFrequency],
+                1e-4 * committed_->parameters[kNaturalFrequency]);
   }
 }
 

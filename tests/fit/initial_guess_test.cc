@@ -45,7 +45,7 @@ std::vector<const Sweep*> Select(const std::vector<Sweep>& sweeps,
 
 KnownParameters OmegaKnown() {
   KnownParameters known;
-  known[kOmega] = kTruth[kOmega];
+  known[kNaturalFrequency] = kTruth[kNaturalFrequency];
   return known;
 }
 
@@ -58,8 +58,8 @@ void PrintParameters(const std::string& title, const ParameterVector& p, double 
   std::printf(
       "%s: eta_e %.6g mu1 %.6g mu2 %.6g delta %.6g alpha %.6g omega %.6g rad/s (%.4f Hz) "
       "alpha_e(%.2f Hz) %.6g\n",
-      title.c_str(), p[kEtaE], p[kMu1], p[kMu2], p[kDelta], p[kAlpha], p[kOmega],
-      RadPerSecondToHz(p[kOmega]), RadPerSecondToHz(omega_ref),
+      title.c_str(), p[kEtaE], p[kMu1], p[kMu2], p[kDelta], p[kAlpha], p[kNaturalFrequency],
+      RadPerSecondToHz(p[kNaturalFrequency]), RadPerSecondToHz(omega_ref),
       EffectiveNonlinearity(p, omega_ref));
 }
 
@@ -74,7 +74,7 @@ void ExpectWithinFactorTwo(const ParameterVector& guess, const std::string& cont
       EffectiveNonlinearity(guess, kOmegaRef) / EffectiveNonlinearity(kTruth, kOmegaRef);
   EXPECT_GT(alpha_e_ratio, 0.5) << "alpha_e " << context;
   EXPECT_LT(alpha_e_ratio, 2.0) << "alpha_e " << context;
-  EXPECT_NEAR(guess[kOmega] / kTruth[kOmega], 1.0, 0.02) << "omega " << context;
+  EXPECT_NEAR(guess[kNaturalFrequency] / kTruth[kNaturalFrequency], 1.0, 0.02) << "omega " << context;
 }
 
 class InitialGuessThesis : public ::testing::Test {
@@ -92,7 +92,7 @@ TEST_F(InitialGuessThesis, NoiseFreeGuessIsWithinAFactorTwoWithOmegaKnownAndUnkn
   const InitialGuessReport with_omega = AutomaticInitialGuess(fitted_, OmegaKnown());
   Print("thesis noise-free, omega known", with_omega);
   PrintParameters("guess", with_omega.guess, kOmegaRef);
-  EXPECT_EQ(with_omega.guess[kOmega], kTruth[kOmega]);
+  EXPECT_EQ(with_omega.guess[kNaturalFrequency], kTruth[kNaturalFrequency]);
   ExpectWithinFactorTwo(with_omega.guess, "omega known");
 
   const InitialGuessReport without = AutomaticInitialGuess(fitted_, KnownParameters{});
@@ -116,7 +116,7 @@ TEST_F(InitialGuessThesis, GuessDoesNotDependOnTheAmplitudeUnit) {
     const ParameterVector expected = {
         reference.guess[kEtaE] * s,        reference.guess[kMu1],
         reference.guess[kMu2] / s,         reference.guess[kDelta] / (s * s),
-        reference.guess[kAlpha] / (s * s), reference.guess[kOmega]};
+        reference.guess[kAlpha] / (s * s), reference.guess[kNaturalFrequency]};
     for (int i = 0; i < kNumParameters; ++i) {
       EXPECT_NEAR(guess.guess[i], expected[i], 1e-6 * std::abs(expected[i]))
           << ParameterName(i) << " at unit scale " << s;
@@ -130,7 +130,7 @@ TEST_F(InitialGuessThesis, IdentifyFromTheGuessReachesTheTruth) {
         AutomaticInitialGuess(fitted_, omega_known ? OmegaKnown() : KnownParameters{});
     IdentificationOptions options;  // default stages: algebraic, then vertical
     options.initial = report.guess;
-    options.fixed[kOmega] = omega_known;
+    options.fixed[kNaturalFrequency] = omega_known;
     const IdentificationResult result = Identify(fitted_, options);
     PrintParameters(omega_known ? "identified from the guess, omega fixed"
                                 : "identified from the guess, omega free",
@@ -156,7 +156,7 @@ TEST_F(InitialGuessThesis, OneFrequencySweepAloneGivesOmegaEtaAndThePeakDamping)
   Print("F0.01 alone, omega unknown", report);
   PrintParameters("guess", report.guess, kOmegaRef);
   const ParameterVector& guess = report.guess;
-  EXPECT_NEAR(guess[kOmega] / kTruth[kOmega], 1.0, 0.002);
+  EXPECT_NEAR(guess[kNaturalFrequency] / kTruth[kNaturalFrequency], 1.0, 0.002);
   EXPECT_NEAR(guess[kEtaE] / kTruth[kEtaE], 1.0, 0.01);
   EXPECT_NEAR(EffectiveNonlinearity(guess, kOmegaRef) / EffectiveNonlinearity(kTruth, kOmegaRef),
               1.0, 0.1);
@@ -177,7 +177,7 @@ TEST_F(InitialGuessThesis, KnownParametersAreKeptAndUsed) {
   known[kDelta] = 1e4;
   const InitialGuessReport report = AutomaticInitialGuess(fitted_, known);
   Print("eta_e, mu1, delta, omega given", report);
-  for (int i : {kEtaE, kMu1, kDelta, kOmega}) {
+  for (int i : {kEtaE, kMu1, kDelta, kNaturalFrequency}) {
     EXPECT_EQ(report.guess[i], *known[i]) << ParameterName(i);
   }
   // With delta given, the backbone's slope is alpha itself (not alpha_e), and
@@ -238,7 +238,7 @@ TEST(InitialGuess, OnePercentNoiseReplicaStaysWithinAFactorTwo) {
           EffectiveNonlinearity(guess, kOmegaRef) / EffectiveNonlinearity(kTruth, kOmegaRef), 1.0,
           0.4)
           << context;
-      EXPECT_NEAR(guess[kOmega] / kTruth[kOmega], 1.0, 0.02) << context;
+      EXPECT_NEAR(guess[kNaturalFrequency] / kTruth[kNaturalFrequency], 1.0, 0.02) << context;
       EXPECT_NEAR(DampingAt(guess, a_peak) / DampingAt(kTruth, a_peak), 1.0, 0.2) << context;
     }
   }
@@ -257,8 +257,8 @@ TEST(InitialGuess, SofteningModeFromOneFrequencySweep) {
   ASSERT_EQ(sweeps[0].jumps.size(), 1u);
   ASSERT_EQ(sweeps[0].jumps[0].kind, JumpKind::kJumpUp);
   const InitialGuessReport report = AutomaticInitialGuess({&sweeps[0], &sweeps[1]}, {});
-  PrintParameters("softening, F alone", report.guess, plan.truth[kOmega]);
-  EXPECT_NEAR(report.guess[kOmega] / plan.truth[kOmega], 1.0, 0.002);
+  PrintParameters("softening, F alone", report.guess, plan.truth[kNaturalFrequency]);
+  EXPECT_NEAR(report.guess[kNaturalFrequency] / plan.truth[kNaturalFrequency], 1.0, 0.002);
   EXPECT_NEAR(report.guess[kEtaE] / plan.truth[kEtaE], 1.0, 0.02);
   EXPECT_NEAR(report.guess[kAlpha] / plan.truth[kAlpha], 1.0, 0.1);
   const double a_peak = 5.043e-3;
@@ -278,9 +278,9 @@ TEST(InitialGuess, ClampedBeamGuessIsPlausibleAndTheFitConvergesFromIt) {
   const InitialGuessReport report = AutomaticInitialGuess(fitted, known);
   Print("clamped beam, L0.060g and L0.080g up and down, delta = 0", report);
   const ParameterVector& guess = report.guess;
-  PrintParameters("guess", guess, guess[kOmega]);
+  PrintParameters("guess", guess, guess[kNaturalFrequency]);
   // The README: linear natural frequency near 156 Hz; hardening.
-  EXPECT_NEAR(guess[kOmega] / HzToRadPerSecond(156.0), 1.0, 0.03);
+  EXPECT_NEAR(guess[kNaturalFrequency] / HzToRadPerSecond(156.0), 1.0, 0.03);
   for (int i : {kEtaE, kMu1, kMu2, kAlpha}) EXPECT_GT(guess[i], 0.0) << ParameterName(i);
 
   IdentificationOptions options;
@@ -288,7 +288,7 @@ TEST(InitialGuess, ClampedBeamGuessIsPlausibleAndTheFitConvergesFromIt) {
   options.fixed[kDelta] = true;
   const IdentificationResult result = Identify(fitted, options);
   PrintParameters("identified from the guess (omega free, delta fixed at 0)", result.parameters,
-                  guess[kOmega]);
+                  guess[kNaturalFrequency]);
   for (const StageSummary& stage : result.stages) {
     std::printf("  %s stage: cost %.4g -> %.4g, %d iterations\n", ResidualKindName(stage.residual),
                 stage.initial_cost, stage.final_cost, stage.iterations);
@@ -308,7 +308,7 @@ TEST(InitialGuess, ClampedBeamGuessIsPlausibleAndTheFitConvergesFromIt) {
   }
   EXPECT_TRUE(result.converged);
   EXPECT_LT(result.stages.back().final_cost, result.stages.back().initial_cost);
-  for (int i : {kEtaE, kAlpha, kOmega}) {
+  for (int i : {kEtaE, kAlpha, kNaturalFrequency}) {
     EXPECT_GT(result.parameters[i], 0.0) << ParameterName(i);
   }
   // Without the bifurcation-range penalty the damping may move wholly into

@@ -25,7 +25,7 @@ struct PermutedBlocks {
   double x[2];
   double y[4];
   explicit PermutedBlocks(const ParameterVector& p)
-      : x{p[kOmega], p[kEtaE]}, y{p[kAlpha], p[kDelta], p[kMu2], p[kMu1]} {}
+      : x{p[kNaturalFrequency], p[kEtaE]}, y{p[kAlpha], p[kDelta], p[kMu2], p[kMu1]} {}
   ParameterLayout Layout() {
     FitDescription fit;
     fit.blocks = {{x, 2, "x"}, {y, 4, "y"}};
@@ -62,7 +62,7 @@ TEST(MappedCostFunction, GathersTheParametersAndScattersTheJacobian) {
   double residual = 0.0;
   ASSERT_TRUE(mapped.Evaluate(parameters, &residual, jacobians));
   EXPECT_EQ(residual, model_residual);
-  EXPECT_EQ(jx[0], model_jacobian[kOmega]);
+  EXPECT_EQ(jx[0], model_jacobian[kNaturalFrequency]);
   EXPECT_EQ(jx[1], model_jacobian[kEtaE]);
   EXPECT_EQ(jy[0], model_jacobian[kAlpha]);
   EXPECT_EQ(jy[3], model_jacobian[kMu1]);

@@ -47,7 +47,7 @@ TEST_F(ThesisStarts, StartsAreDeterministicAndSpreadWithinTheFactor) {
   EXPECT_EQ(a, b);
   EXPECT_EQ(a[0], config_.identification.initial);
   for (const ParameterVector& start : a) {
-    EXPECT_EQ(start[kOmega], config_.identification.initial[kOmega]);  // fixed
+    EXPECT_EQ(start[kNaturalFrequency], config_.identification.initial[kNaturalFrequency]);  // fixed
     for (int i = 0; i < 5; ++i) {
       const double factor = start[i] / config_.identification.initial[i];
       EXPECT_GE(factor, 1.0 / 3.0);
@@ -75,7 +75,7 @@ TEST_F(ThesisStarts, ResultDoesNotDependOnTheThreadCount) {
 // start plus the automatic one. Reports the single-start rate too.
 TEST_F(ThesisStarts, TwoHundredRandomStartsReachTheTruth) {
   KnownParameters known;
-  known[kOmega] = kTruth[kOmega];  // the config fixes w
+  known[kNaturalFrequency] = kTruth[kNaturalFrequency];  // the config fixes w
   const ParameterVector automatic = AutomaticInitialGuess(fitted_, known).guess;
   MultiStartOptions defaults;
   defaults.starts = 2;  // the given start and the automatic one
@@ -100,10 +100,10 @@ TEST_F(ThesisStarts, NoGuessesAtAllReachTheTruth) {
   const KnownParameters known{};  // every guess automatic, w too
   IdentificationOptions options = config_.identification;
   options.initial = AutomaticInitialGuess(fitted_, known).guess;
-  options.fixed[kOmega] = false;
+  options.fixed[kNaturalFrequency] = false;
   const IdentificationResult result = Identify(fitted_, options);
   EXPECT_TRUE(AtTheTruth(result.parameters));
-  EXPECT_NEAR(result.parameters[kOmega] / kTruth[kOmega], 1.0, 1e-6);
+  EXPECT_NEAR(result.parameters[kNaturalFrequency] / kTruth[kNaturalFrequency], 1.0, 1e-6);
 }
 
 // The bar on measured data: with no guesses, the fit matches or beats

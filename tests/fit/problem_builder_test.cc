@@ -95,7 +95,7 @@ TEST(ScaledSubsetManifold, StepsAreRelativeAndFixedEntriesNeverMove) {
   ASSERT_TRUE(manifold.Plus(kTruth.data(), delta, moved.data()));
   EXPECT_DOUBLE_EQ(moved[kEtaE], 101.0);
   EXPECT_EQ(moved[kDelta], kTruth[kDelta]);
-  EXPECT_EQ(moved[kOmega], kTruth[kOmega]);
+  EXPECT_EQ(moved[kNaturalFrequency], kTruth[kNaturalFrequency]);
 }
 
 // The dwells go onto a problem the caller owns, beside blocks of its own, and

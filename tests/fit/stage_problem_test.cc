@@ -64,10 +64,10 @@ TEST(StageProblem, OneBlockGetsBoundsFixedEntriesAndScaling) {
 
 TEST(StageProblem, SharedEntriesAreBoundedAndEachBlockIsScaled) {
   ParameterVector truth_b = kThesisTruth;
-  truth_b[kOmega] = HzToRadPerSecond(43.0);
+  truth_b[kNaturalFrequency] = HzToRadPerSecond(43.0);
   const std::vector<Sweep> a = SimulateDataset(kThesisTruth, 0.0, 0);
   const std::vector<Sweep> b = SimulateDataset(truth_b, 0.0, 0);
-  SharedModel model(kThesisTruth, truth_b[kOmega]);
+  SharedModel model(kThesisTruth, truth_b[kNaturalFrequency]);
   const FitDescription fit = model.Describe(Pointers(a), Pointers(b));
   StageProblem stage(fit, SetupFor(fit, ResidualKind::kVertical));
   stage.Configure();

@@ -142,7 +142,7 @@ TEST_F(StagedSolve, InvalidDescriptionsNameTheDatasetBlockOrEntry) {
 TEST_F(StagedSolve, MappedBlocksGiveTheSingleBlocksAnswerWhenTheMappingIsTheIdentity) {
   IdentificationOptions options;
   options.initial = ThesisStart(kThesisTruth);
-  options.fixed[kOmega] = true;
+  options.fixed[kNaturalFrequency] = true;
   options.residual.error = ErrorMeasure::kRelative;
   const IdentificationResult single = Identify(Pointers(sweeps_), options);
   ASSERT_EQ(single.status, FitStatus::kConverged) << single.message;
@@ -201,7 +201,7 @@ class TwoDatasets : public ::testing::Test {
  protected:
   void SetUp() override {
     truth_b_ = kThesisTruth;
-    truth_b_[kOmega] = HzToRadPerSecond(43.0);
+    truth_b_[kNaturalFrequency] = HzToRadPerSecond(43.0);
     a_ = SimulateDataset(kThesisTruth, 0.0, 0);
     b_ = SimulateDataset(truth_b_, 0.0, 0);
   }
@@ -210,10 +210,10 @@ class TwoDatasets : public ::testing::Test {
     return SharedModel(
         [&] {
           ParameterVector p = ThesisStart(kThesisTruth);
-          p[kOmega] *= 1.005;
+          p[kNaturalFrequency] *= 1.005;
           return p;
         }(),
-        truth_b_[kOmega] * 0.995);
+        truth_b_[kNaturalFrequency] * 0.995);
   }
   ParameterVector truth_b_;
   std::vector<Sweep> a_, b_;
@@ -232,8 +232,8 @@ TEST_F(TwoDatasets, SharedEtaEAndOneWPerDatasetRecoverTheTruth) {
   for (int i = 0; i < 5; ++i) {
     EXPECT_NEAR(model.shared[i] / kThesisTruth[i], 1.0, 1e-6) << ParameterName(i);
   }
-  EXPECT_NEAR(model.w_a[0] / kThesisTruth[kOmega], 1.0, 1e-9);
-  EXPECT_NEAR(model.w_b[0] / truth_b_[kOmega], 1.0, 1e-9);
+  EXPECT_NEAR(model.w_a[0] / kThesisTruth[kNaturalFrequency], 1.0, 1e-9);
+  EXPECT_NEAR(model.w_b[0] / truth_b_[kNaturalFrequency], 1.0, 1e-9);
 }
 
 // The mapped blocks are evaluated on threads like the one block: bitwise the

@@ -44,7 +44,7 @@ TEST_F(ThesisNumerical, CommittedConfigStartsAtTheFirstStartOfTheIssue) {
   for (int i = 0; i < 5; ++i) {
     EXPECT_DOUBLE_EQ(config_.identification.initial[i], expected.initial[i]) << ParameterName(i);
   }
-  EXPECT_TRUE(config_.identification.fixed[kOmega]);
+  EXPECT_TRUE(config_.identification.fixed[kNaturalFrequency]);
   EXPECT_EQ(fitted_.size(), 4u);
   EXPECT_EQ(validation_.size(), 4u);
 }

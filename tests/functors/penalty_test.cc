@@ -38,7 +38,7 @@ void ExpectGradientCheckerPasses(const ceres::CostFunction& cost, ParameterVecto
 std::unique_ptr<ceres::CostFunction> FrequencyJumpDown(double before_hz, double after_hz,
                                                        int exponent = 10) {
   return std::unique_ptr<ceres::CostFunction>(BifurcationRangePenalty::Create(
-      ControlKind::kDriveFrequency, FoldKind::kUpperBranchEnd, 0.01, HzToRadPerSecond(before_hz),
+      SweepKind::kFrequency, JumpKind::kJumpDown, 0.01, HzToRadPerSecond(before_hz),
       HzToRadPerSecond(after_hz), 4.7e-3, exponent, 1.0));
 }
 
@@ -58,11 +58,11 @@ TEST(BifurcationRangePenalty, IsSmallInsideTheBracketAndGrowsFastOutside) {
 TEST(BifurcationRangePenalty, GradientCheckerPassesForBothSweepKinds) {
   ExpectGradientCheckerPasses(*FrequencyJumpDown(42.2, 42.3), kTruth);
   std::unique_ptr<ceres::CostFunction> jump_up(BifurcationRangePenalty::Create(
-      ControlKind::kDriveFrequency, FoldKind::kLowerBranchEnd, 0.01, HzToRadPerSecond(40.7),
+      SweepKind::kFrequency, JumpKind::kJumpUp, 0.01, HzToRadPerSecond(40.7),
       HzToRadPerSecond(40.6), 1.1e-3, 10, 1.0));
   ExpectGradientCheckerPasses(*jump_up, kTruth);
   std::unique_ptr<ceres::CostFunction> amplitude(
-      BifurcationRangePenalty::Create(ControlKind::kBaseLevel, FoldKind::kLowerBranchEnd,
+      BifurcationRangePenalty::Create(SweepKind::kAmplitude, JumpKind::kJumpUp,
                                       HzToRadPerSecond(41.5), 0.035, 0.036, 2.0e-3, 10, 2.0));
   ExpectGradientCheckerPasses(*amplitude, kTruth);
 }

@@ -14,8 +14,8 @@ const ParameterVector kTruth = {100.0, 0.2, 300.0, 1e4, 9e8, HzToRadPerSecond(40
 
 TEST(SolveAmplitudeFold, JumpLevelsAt41_5HzSolveTheFoldConditions) {
   const double omega = HzToRadPerSecond(41.5);
-  const FoldPoint up = SolveAmplitudeFold(kTruth.data(), omega, FoldKind::kLowerBranchEnd);
-  const FoldPoint down = SolveAmplitudeFold(kTruth.data(), omega, FoldKind::kUpperBranchEnd);
+  const FoldPoint up = SolveAmplitudeFold(kTruth.data(), omega, JumpKind::kJumpUp);
+  const FoldPoint down = SolveAmplitudeFold(kTruth.data(), omega, JumpKind::kJumpDown);
   ASSERT_TRUE(up.exists);
   ASSERT_TRUE(down.exists);
   // The dataset's A41.5 sweep jumps up between a_base 0.035 and 0.036 and
@@ -31,9 +31,9 @@ TEST(SolveAmplitudeFold, JumpLevelsAt41_5HzSolveTheFoldConditions) {
 
 TEST(SolveFrequencyFold, JumpFrequenciesAtABase0_01SolveTheFoldConditions) {
   const double a_base = 0.01;
-  const FoldPoint down = SolveFrequencyFold(kTruth.data(), a_base, FoldKind::kUpperBranchEnd,
+  const FoldPoint down = SolveFrequencyFold(kTruth.data(), a_base, JumpKind::kJumpDown,
                                             HzToRadPerSecond(42.25), HzToRadPerSecond(0.05));
-  const FoldPoint up = SolveFrequencyFold(kTruth.data(), a_base, FoldKind::kLowerBranchEnd,
+  const FoldPoint up = SolveFrequencyFold(kTruth.data(), a_base, JumpKind::kJumpUp,
                                           HzToRadPerSecond(40.65), HzToRadPerSecond(0.05));
   ASSERT_TRUE(down.exists);
   ASSERT_TRUE(up.exists);
@@ -50,10 +50,10 @@ TEST(SolveFrequencyFold, JumpFrequenciesAtABase0_01SolveTheFoldConditions) {
 }
 
 TEST(SolveFrequencyFold, FindsTheFoldFromAGuessFarFromItAndFromBeyondTheCusp) {
-  const FoldPoint reference = SolveFrequencyFold(kTruth.data(), 0.01, FoldKind::kUpperBranchEnd,
+  const FoldPoint reference = SolveFrequencyFold(kTruth.data(), 0.01, JumpKind::kJumpDown,
                                                  HzToRadPerSecond(42.25), 0.1);
   for (double guess_hz : {41.0, 44.0, 39.0}) {  // 39 Hz: no turning points there
-    const FoldPoint fold = SolveFrequencyFold(kTruth.data(), 0.01, FoldKind::kUpperBranchEnd,
+    const FoldPoint fold = SolveFrequencyFold(kTruth.data(), 0.01, JumpKind::kJumpDown,
                                               HzToRadPerSecond(guess_hz), 0.1);
     ASSERT_TRUE(fold.exists) << guess_hz;
     EXPECT_NEAR(fold.control, reference.control, 1e-9 * reference.control) << guess_hz;
@@ -63,16 +63,16 @@ TEST(SolveFrequencyFold, FindsTheFoldFromAGuessFarFromItAndFromBeyondTheCusp) {
 TEST(SolveFrequencyFold, ReportsNoFoldWhenTheDampingIsTooHighForAJump) {
   ParameterVector damped = kTruth;
   damped[kMu1] = 20.0;  // 100 x: no bistability at a_base = 0.01
-  EXPECT_FALSE(SolveFrequencyFold(damped.data(), 0.01, FoldKind::kUpperBranchEnd,
+  EXPECT_FALSE(SolveFrequencyFold(damped.data(), 0.01, JumpKind::kJumpDown,
                                   HzToRadPerSecond(42.25), 0.1)
                    .exists);
   EXPECT_FALSE(
-      SolveAmplitudeFold(damped.data(), HzToRadPerSecond(41.5), FoldKind::kLowerBranchEnd).exists);
+      SolveAmplitudeFold(damped.data(), HzToRadPerSecond(41.5), JumpKind::kJumpUp).exists);
 }
 
 // Functors exposing the lifted folds as residuals, to check their derivatives.
 struct FrequencyFoldOf {
-  FoldKind kind;
+  JumpKind kind;
   template <typename T>
   bool operator()(const T* p, T* out) const {
     ParameterVector value;
@@ -86,7 +86,7 @@ struct FrequencyFoldOf {
 };
 
 struct AmplitudeFoldOf {
-  FoldKind kind;
+  JumpKind kind;
   template <typename T>
   bool operator()(const T* p, T* out) const {
     ParameterVector value;
@@ -111,7 +111,7 @@ void ExpectDerivativesMatch(const ceres::CostFunction& cost) {
 }
 
 TEST(FoldPoint, LiftedFoldDerivativesPassTheGradientChecker) {
-  for (FoldKind kind : {FoldKind::kLowerBranchEnd, FoldKind::kUpperBranchEnd}) {
+  for (JumpKind kind : {JumpKind::kJumpUp, JumpKind::kJumpDown}) {
     ceres::AutoDiffCostFunction<FrequencyFoldOf, 1, kNumParameters> frequency(
         new FrequencyFoldOf{kind});
     ExpectDerivativesMatch(frequency);

@@ -134,8 +134,8 @@ TEST(SolveStableRootNear, AgreesWithTheSafeguardedSolverOnRandomModels) {
     p[kMu2] = (unit(generator) < 0.1 ? -1.0 : 1.0) * log_uniform(1e-2, 1e4);
     p[kDelta] = (unit(generator) - 0.5) * 2e6;
     p[kAlpha] = (unit(generator) < 0.2 ? -1.0 : 1.0) * log_uniform(1e6, 1e12);
-    p[kOmega] = log_uniform(100.0, 2000.0);
-    const double omega = p[kOmega] * (0.8 + 0.5 * unit(generator));
+    p[kNaturalFrequency] = log_uniform(100.0, 2000.0);
+    const double omega = p[kNaturalFrequency] * (0.8 + 0.5 * unit(generator));
     const auto k = ResponseCoefficients<double>::FromParameters(p.data(), omega);
     const double a_base = log_uniform(1e-4, 1.0);
     for (Branch branch : {Branch::kLower, Branch::kUpper}) {

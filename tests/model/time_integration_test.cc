@@ -46,7 +46,7 @@ struct BeamModeEquation {
   void operator()(const State& x, State& dxdt, double t) const {
     const double u = x[0];
     const double v = x[1];
-    const double w = p[kOmega];
+    const double w = p[kNaturalFrequency];
     const double force = 2.0 * p[kEtaE] * a_base * std::cos(omega_drive_rad_s * t);
     const double restoring = w * w * u + p[kDelta] * u * v * v + p[kAlpha] * u * u * u;
     const double damping = 2.0 * p[kMu1] * v + (p[kMu2] / omega_drive_rad_s) * v * std::abs(v);

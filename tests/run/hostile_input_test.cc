@@ -179,7 +179,7 @@ TEST_F(HostileInput, AFailedStartIsNeverTheBest) {
   std::vector<const Sweep*> fitted = {&loaded.sweeps[0]};
   IdentificationOptions options;
   options.initial = {130.0, 0.14, 390.0, 7e3, 1e300, HzToRadPerSecond(40.0)};
-  options.fixed[kOmega] = true;
+  options.fixed[kNaturalFrequency] = true;
   const ParameterVector reachable = {130.0, 0.14, 390.0, 7e3, 1.17e9, HzToRadPerSecond(40.0)};
   MultiStartOptions multi_start;
   multi_start.starts = 2;

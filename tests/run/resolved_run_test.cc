@@ -148,8 +148,8 @@ TEST(ResolveRun, AFixedParameterWithoutAGivenGuessIsAnInputError) {
   // LoadIdentifyConfig rejects such a file at its `fixed` line; a config
   // built in code reaches ResolveRun.
   IdentifyConfig config = LoadIdentifyConfig(kConfig);
-  config.initial_guess[kOmega].reset();
-  ASSERT_TRUE(config.identification.fixed[kOmega]);
+  config.initial_guess[kNaturalFrequency].reset();
+  ASSERT_TRUE(config.identification.fixed[kNaturalFrequency]);
   const InputError error = ErrorOf([&] { ResolveRun(config); });
   EXPECT_EQ(error.file(), config.config_path);
   EXPECT_EQ(error.field(), "fixed");
@@ -168,7 +168,7 @@ TEST(FitRun, AMultiStartFitsFromTheGivenAndTheAutomaticStart) {
   EXPECT_FALSE(run.guessed_from_data);
   EXPECT_EQ(run.options.initial, config.identification.initial);
   KnownParameters omega;  // the config fixes omega
-  omega[kOmega] = config.initial_guess[kOmega];
+  omega[kNaturalFrequency] = config.initial_guess[kNaturalFrequency];
   const InitialGuessReport automatic = AutomaticInitialGuess(run.fitted, omega);
   ASSERT_TRUE(run.automatic_start.has_value());
   EXPECT_EQ(*run.automatic_start, automatic.guess);
