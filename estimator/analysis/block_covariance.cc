@@ -12,19 +12,12 @@
 #include "boost/math/distributions/students_t.hpp"
 #include "ceres/covariance.h"
 #include "ceres/crs_matrix.h"
+#include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/fit/scaled_subset_manifold.h"
 #include "dwellfit/estimator/fit/stage_problem.h"
 
 namespace dwellfit {
 namespace {
-
-// printf-style formatting into a std::string.
-template <typename... Args>
-std::string Format(const char* format, Args... args) {
-  char buffer[512];
-  std::snprintf(buffer, sizeof(buffer), format, args...);
-  return buffer;
-}
 
 // A normalised coordinate's entry of a null direction smaller than this (the
 // direction has unit length) does not implicate its entry.
@@ -143,7 +136,7 @@ bool EstimateNoise(BlockCovariance* c) {
   } else if (c->degrees_of_freedom > 0) {
     c->noise_sigma = std::sqrt(c->reduced_chi_square);
   } else {
-    c->message = Format(
+    c->message = StringPrintf(
         "%d points for %d free parameters leave no degrees of freedom to estimate the noise: add "
         "dwells or fix parameters",
         c->num_points, c->num_free);
@@ -196,7 +189,7 @@ bool CheckCollinearity(const FitDescription& fit, BlockCovariance* c) {
     if (c->null_space.row(j).norm() < kNullDirectionShare) continue;
     names += (involved++ > 0 ? ", " : "") + fit.EntryName(c->free[j]);
   }
-  c->message = Format(
+  c->message = StringPrintf(
       "%s cannot be told apart by these data: %d combination(s) of them are not determined; fix "
       "%d of them, add data that affect them differently, or a prior (collinearity %.3g, limit "
       "%.3g)",
@@ -261,13 +254,13 @@ void SetIntervals(BlockCovariance* c) {
     c->ci95_high[i] = c->values[i] + c->interval_quantile * c->standard_error[i];
   }
   c->available = true;
-  c->message = Format(
+  c->message = StringPrintf(
       "%d points, %d free parameters, %d degrees of freedom; noise sigma %.3g (%s); "
       "collinearity %.3g",
       c->num_points, c->num_free, c->degrees_of_freedom, c->noise_sigma,
       c->all_standardised ? "point sigmas given" : "estimated from the residuals", c->collinearity);
   if (c->caller_residuals > 0) {
-    c->message += Format("; with %d residual(s) of the caller's", c->caller_residuals);
+    c->message += StringPrintf("; with %d residual(s) of the caller's", c->caller_residuals);
   }
 }
 
@@ -320,8 +313,8 @@ BlockCovariance EstimateBlockCovariance(const FitDescription& fit,
     return Unavailable(c, c.message);
   }
   if (!ComputeCovariance(fit, factor, problem.get(), &c)) {
-    return Unavailable(
-        c, Format("the covariance could not be computed (collinearity %.3g)", c.collinearity));
+    return Unavailable(c, StringPrintf("the covariance could not be computed (collinearity %.3g)",
+                                       c.collinearity));
   }
   SetIntervals(&c);
   return c;

@@ -8,20 +8,13 @@
 #include <string>
 #include <vector>
 
+#include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/fit/fit_description.h"
 #include "dwellfit/residuals/model/response_model.h"
 #include "dwellfit/residuals/model/stable_root.h"
 
 namespace dwellfit {
 namespace {
-
-// printf-style formatting into a std::string.
-template <typename... Args>
-std::string Format(const char* format, Args... args) {
-  char buffer[512];
-  std::snprintf(buffer, sizeof(buffer), format, args...);
-  return buffer;
-}
 
 // A tangent coordinate's entry of a null direction smaller than this (the
 // direction has unit length) does not implicate its parameter.
@@ -71,7 +64,7 @@ std::string DescribeNullSpace(const Eigen::MatrixXd& null_space, const Eigen::Ve
   const int rank_loss = static_cast<int>(null_space.cols());
   std::string text = JoinNames(involved) + " cannot be told apart by these sweeps";
   if (rank_loss != 1 || involved.size() != 2) {
-    return text + Format(
+    return text + StringPrintf(
                       ": %d combination(s) of them are not determined; fix %d of them or add "
                       "sweeps at other levels and frequencies",
                       rank_loss, rank_loss);
@@ -81,9 +74,9 @@ std::string DescribeNullSpace(const Eigen::MatrixXd& null_space, const Eigen::Ve
   // unchanged, so their estimates correlate at the sign of that direction.
   const double cosine = std::abs(columns.col(tangent[0]).dot(columns.col(tangent[1])));
   const double sign = null_space(tangent[0], 0) * null_space(tangent[1], 0) > 0.0 ? 1.0 : -1.0;
-  text +=
-      Format(" (a change of one is undone by a change of the other: their correlation is %+.3f)",
-             sign * cosine);
+  text += StringPrintf(
+      " (a change of one is undone by a change of the other: their correlation is %+.3f)",
+      sign * cosine);
   if (IsPair(involved[0], involved[1], kDelta, kAlpha)) {
     // Along the null direction alpha - (2/3) delta Omega^2 stays constant:
     // d alpha = (2/3) Omega^2 d delta, which gives the Omega the data fix.
@@ -92,8 +85,9 @@ std::string DescribeNullSpace(const Eigen::MatrixXd& null_space, const Eigen::Ve
     const double omega_squared =
         1.5 * (null_space(a, 0) * unit_scale[a]) / (null_space(d, 0) * unit_scale[d]);
     if (omega_squared > 0.0 && std::isfinite(omega_squared)) {
-      text += Format(": only alpha - (2/3) delta Omega^2 at Omega = 2 pi %.4g Hz is determined",
-                     RadPerSecondToHz(std::sqrt(omega_squared)));
+      text +=
+          StringPrintf(": only alpha - (2/3) delta Omega^2 at Omega = 2 pi %.4g Hz is determined",
+                       RadPerSecondToHz(std::sqrt(omega_squared)));
     }
   }
   return text + "; " + PairAdvice(involved[0], involved[1]);
@@ -117,9 +111,9 @@ int DwellsPastTheirBranchEnd(const std::vector<const Sweep*>& fitted,
       if (++count > 3) continue;
       if (!examples->empty()) *examples += ", ";
       *examples += sweep->kind == SweepKind::kFrequency
-                       ? Format("%s at %.4g Hz", sweep->Name().c_str(),
-                                RadPerSecondToHz(point.drive_frequency_rad_s))
-                       : Format("%s at a_base %.4g", sweep->Name().c_str(), point.a_base);
+                       ? StringPrintf("%s at %.4g Hz", sweep->Name().c_str(),
+                                      RadPerSecondToHz(point.drive_frequency_rad_s))
+                       : StringPrintf("%s at a_base %.4g", sweep->Name().c_str(), point.a_base);
     }
   }
   return count;
@@ -195,9 +189,9 @@ void AddPairAndBoundWarnings(const std::vector<int>& free, const ParameterVector
       const double rho = u->correlation(a, b);
       if (std::abs(rho) <= kCorrelationWarning) continue;
       std::string warning =
-          Format("%s and %s correlate at %+.3f: ", ParameterName(a), ParameterName(b), rho);
+          StringPrintf("%s and %s correlate at %+.3f: ", ParameterName(a), ParameterName(b), rho);
       if (IsPair(a, b, kDelta, kAlpha)) {
-        warning += Format(
+        warning += StringPrintf(
             "delta and alpha are weakly separated by these sweeps, while alpha - (2/3) delta "
             "Omega_ref^2 = %.4g +/- %.2g is well determined; ",
             u->effective_nonlinearity, u->effective_nonlinearity_standard_error);
@@ -221,7 +215,7 @@ void WarnAboutDwellsPastTheirBranchEnd(const std::vector<const Sweep*>& fitted,
   std::string examples;
   u->dwells_past_branch_end = DwellsPastTheirBranchEnd(fitted, estimate, &examples);
   if (u->dwells_past_branch_end == 0) return;
-  u->warnings.push_back(Format(
+  u->warnings.push_back(StringPrintf(
       "%d fitted dwell(s) lie past the end of their branch at the estimate (%s%s): the model's "
       "fold falls short of where they were measured, the fit is not smooth there and the "
       "intervals may be too narrow; check the branch labels or enable the branch-stability "
@@ -251,7 +245,8 @@ ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted
         c.null_space.cols() == 0
             ? c.message
             : DescribeNullSpace(c.null_space, c.unit_scale, c.free, c.columns) +
-                  Format(" (collinearity %.3g, limit %.3g)", c.collinearity, kMaxCollinearity);
+                  StringPrintf(" (collinearity %.3g, limit %.3g)", c.collinearity,
+                               kMaxCollinearity);
     return Unavailable(u, message);
   }
   CopyIntervals(c, &u);
@@ -260,7 +255,7 @@ ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted
   u.available = true;
   u.message = c.message;
   if (!u.warnings.empty())
-    u.message += Format("; %d warning(s)", static_cast<int>(u.warnings.size()));
+    u.message += StringPrintf("; %d warning(s)", static_cast<int>(u.warnings.size()));
   return u;
 }
 
