@@ -3,14 +3,58 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <system_error>
 #include <utility>
 
 #include "yaml-cpp/depthguard.h"
+#include "yaml-cpp/eventhandler.h"
+#include "yaml-cpp/parser.h"
 
 namespace dwellfit {
 namespace {
+
+// Documents a config file may hold before the reader gives up (see
+// DocumentWalker).
+constexpr int kMaxDocuments = 1000;
+
+// Walks the documents of a YAML text without building them and keeps where a
+// second document with content starts. yaml-cpp 0.7's LoadAll never returns
+// on some malformed text (a stray ',' or '}' at the top level: its parser
+// yields empty documents without advancing), so the caller bounds the walk.
+class DocumentWalker : public YAML::EventHandler {
+ public:
+  void OnDocumentStart(const YAML::Mark&) override { ++documents_; }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { Content(mark); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                const std::string&) override {
+    Content(mark);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    Content(mark);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {
+    Content(mark);
+  }
+  void OnMapEnd() override {}
+
+  int documents() const { return documents_; }
+  const std::optional<YAML::Mark>& second_document() const { return second_document_; }
+
+ private:
+  void Content(const YAML::Mark& mark) {
+    if (documents_ >= 2 && !second_document_) second_document_ = mark;
+  }
+
+  int documents_ = 0;
+  std::optional<YAML::Mark> second_document_;
+};
 
 // True when `path` is `prefix` or lies inside it ("solver" holds
 // "solver.max_iterations"; "fit" holds "fit[2]").
@@ -200,9 +244,26 @@ ConfigSource ConfigSource::Load(const std::string& path, const std::string& kind
 }
 
 ConfigSource ConfigSource::Parse(const std::string& file, const std::string& yaml_text) {
-  std::vector<YAML::Node> documents;
+  YAML::Node root;
   try {
-    documents = YAML::LoadAll(yaml_text);
+    std::stringstream stream(yaml_text);
+    YAML::Parser parser(stream);
+    DocumentWalker walker;
+    while (parser.HandleNextDocument(walker)) {
+      // Later documents are not read: one with content is an error, not ignored.
+      if (walker.second_document()) {
+        throw InputError(file, OneBasedLine(*walker.second_document()), "",
+                         "a second YAML document starts here (after a '---' line), and only the "
+                         "first would be read; the file holds one document: move these keys into "
+                         "the first one, or remove the '---' line");
+      }
+      if (walker.documents() > kMaxDocuments) {
+        throw InputError(file, 0, "",
+                         "YAML syntax error: the reader does not get past a stray ',', '}' or "
+                         "']' outside brackets; check the punctuation of the file");
+      }
+    }
+    root = YAML::Load(yaml_text);
   } catch (const YAML::DeepRecursion& e) {
     throw InputError(file, OneBasedLine(e.mark), "",
                      "the YAML is nested too deeply (the reader stops at " +
@@ -212,15 +273,7 @@ ConfigSource ConfigSource::Parse(const std::string& file, const std::string& yam
   } catch (const YAML::ParserException& e) {
     throw InputError(file, OneBasedLine(e.mark), "", "YAML syntax error: " + e.msg);
   }
-  // Later documents are not read: one with content is an error, not ignored.
-  for (std::size_t i = 1; i < documents.size(); ++i) {
-    if (documents[i].IsNull()) continue;
-    throw InputError(file, OneBasedLine(documents[i].Mark()), "",
-                     "a second YAML document starts here (after a '---' line), and only the "
-                     "first would be read; the file holds one document: move these keys into "
-                     "the first one, or remove the '---' line");
-  }
-  return ConfigSource(file, documents.empty() ? YAML::Node() : documents.front());
+  return ConfigSource(file, root);
 }
 
 ConfigSource::ConfigSource(std::string file, YAML::Node root)

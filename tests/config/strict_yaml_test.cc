@@ -58,5 +58,30 @@ TEST(ReadNonEmptyString, ANulCharacterIsAnError) {
   }
 }
 
+// yaml-cpp 0.7's LoadAll never returns on a stray ',' or '}' at the top
+// level (its parser yields empty documents without advancing): found by the
+// dwell-plan fuzzer as a timeout. Parse bounds the walk and says what is wrong.
+TEST(ConfigSourceParse, AStrayCommaOrBraceAtTheTopLevelIsASyntaxErrorNotAHang) {
+  for (const char* text : {", a}\n", "#c\n, delta: 1}\nsweeps:\n  - {id: A40\n"}) {
+    try {
+      ConfigSource::Parse("stray.yaml", text);
+      FAIL() << "accepted: " << text;
+    } catch (const InputError& error) {
+      EXPECT_THAT(error.what(), HasSubstr("stray.yaml: YAML syntax error: the reader does not get "
+                                          "past a stray ','"));
+    }
+  }
+}
+
+TEST(ConfigSourceParse, ASecondDocumentWithContentIsNamedAtItsLine) {
+  try {
+    ConfigSource::Parse("two.yaml", "a: 1\n---\nb: 2\n");
+    FAIL() << "a second document was accepted";
+  } catch (const InputError& error) {
+    EXPECT_THAT(error.what(), HasSubstr("two.yaml:3: a second YAML document starts here"));
+  }
+  EXPECT_TRUE(ConfigSource::Parse("one.yaml", "a: 1\n---\n").root().IsMap());
+}
+
 }  // namespace
 }  // namespace dwellfit
