@@ -22,6 +22,9 @@ DEFINE_string(residual_error, "", "Overrides residual.error: absolute or relativ
 DEFINE_int32(max_iterations, 0, "Overrides solver.max_iterations when positive");
 DEFINE_string(fit, "", "Overrides the fitted sweeps: comma list of ids or id/direction");
 DEFINE_string(validate, "", "Overrides the validation sweeps: comma list");
+DEFINE_bool(accept_no_convergence, false,
+            "Exit 0 also when the fit stopped at its iteration limit (status no_convergence), "
+            "for scripted studies that read result.yaml's status themselves");
 DEFINE_string(set, "",
               "Overrides any config value: key.path=value[,key.path=value...], each key once, "
               "e.g. initial_guess.mu1=0.3,solver.function_tolerance=1e-12");
@@ -75,15 +78,21 @@ int main(int argc, char** argv) {
     std::cerr << "identify: give the config file with --config FILE"
               << (argc > 1 ? std::string(" (unexpected argument '") + argv[1] + "')" : "")
               << "; see --help\n";
-    return 2;
+    return dwellfit::kExitUsage;
   }
   try {
     const dwellfit::IdentifyConfig config =
         dwellfit::LoadIdentifyConfig(FLAGS_config, OverridesFromFlags());
-    dwellfit::RunIdentify(config, std::cout);
+    const auto outcome = dwellfit::RunIdentify(config, std::cout);
+    const dwellfit::IdentificationResult& result = outcome->report.result;
+    const int exit_status = dwellfit::ExitStatusFor(result.status, FLAGS_accept_no_convergence);
+    if (result.status != dwellfit::FitStatus::kConverged) {
+      std::cerr << "identify: status " << dwellfit::FitStatusName(result.status) << " (exit "
+                << exit_status << "): " << result.message << "\n";
+    }
+    return exit_status;
   } catch (const dwellfit::InputError& error) {
     std::cerr << "identify: " << error.what() << "\n";
-    return 1;
+    return dwellfit::kExitInputError;
   }
-  return 0;
 }

@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "dwellfit/estimator/common/string_printf.h"
+#include "dwellfit/estimator/common/version.h"
 #include "dwellfit/estimator/data/sweep_csv_writer.h"
 #include "yaml-cpp/yaml.h"
 
@@ -123,6 +124,7 @@ void EmitStarts(const IdentificationReport& report, YAML::Emitter* out) {
 void EmitStage(const StageSummary& stage, YAML::Emitter* out) {
   *out << YAML::BeginMap;
   *out << YAML::Key << "residual" << YAML::Value << ResidualKindName(stage.residual);
+  if (stage.fold_stage) *out << YAML::Key << "fold_conditions" << YAML::Value << true;
   *out << YAML::Key << "dwells" << YAML::Value << stage.residual_blocks;
   *out << YAML::Key << "initial_cost" << YAML::Value << stage.initial_cost;
   *out << YAML::Key << "final_cost" << YAML::Value << stage.final_cost;
@@ -137,6 +139,13 @@ void EmitStage(const StageSummary& stage, YAML::Emitter* out) {
   for (int index : stage.held_at_bound) *out << ParameterName(index);
   *out << YAML::EndSeq;
   *out << YAML::Key << "converged" << YAML::Value << stage.converged;
+  if (stage.penalty_unit > 0.0) {
+    *out << YAML::Key << "final_penalty_cost" << YAML::Value << stage.final_penalty_cost;
+    *out << YAML::Key << "missing_folds" << YAML::Value << YAML::BeginSeq;
+    for (const std::string& fold : stage.missing_folds) *out << fold;
+    *out << YAML::EndSeq;
+  }
+  if (!stage.note.empty()) *out << YAML::Key << "note" << YAML::Value << stage.note;
   *out << YAML::Key << "solver" << YAML::Value << stage.brief_report;
   *out << YAML::EndMap;
 }
@@ -189,6 +198,9 @@ std::string ReportToYaml(const IdentificationReport& report) {
   YAML::Emitter out;
   out.SetDoublePrecision(17);
   out << YAML::BeginMap;
+  out << YAML::Key << "status" << YAML::Value << FitStatusName(result.status);
+  out << YAML::Key << "status_message" << YAML::Value << result.message;
+  out << YAML::Key << "dwellfit_version" << YAML::Value << DwellfitVersion();
   out << YAML::Key << "config" << YAML::Value << report.config_path;
   EmitParameters(report, &out);
   EmitUncertainty(report, &out);
@@ -203,6 +215,9 @@ std::string ReportToYaml(const IdentificationReport& report) {
   out << YAML::Key << "sweeps" << YAML::Value << YAML::BeginSeq;
   for (const SweepPrediction& prediction : report.predictions) EmitSweep(prediction, &out);
   out << YAML::EndSeq;
+  if (!report.config_in_effect.empty()) {
+    out << YAML::Key << "config_in_effect" << YAML::Value << YAML::Load(report.config_in_effect);
+  }
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }
@@ -231,7 +246,7 @@ namespace {
 
 void PrintStages(const IdentificationResult& result, std::ostream& out) {
   for (const StageSummary& stage : result.stages) {
-    out << ResidualKindName(stage.residual);
+    out << ResidualKindName(stage.residual) << (stage.fold_stage ? " + fold conditions" : "");
     if (stage.penalty_unit > 0.0) out << " + penalties (exponent " << stage.penalty_exponent << ")";
     out << " stage: cost " << StringPrintf("%.7g -> %.7g", stage.initial_cost, stage.final_cost)
         << ", " << stage.iterations << " iterations";
@@ -239,7 +254,9 @@ void PrintStages(const IdentificationResult& result, std::ostream& out) {
     for (size_t i = 0; i < stage.held_at_bound.size(); ++i) {
       out << (i == 0 ? ", held at bound: " : ", ") << ParameterName(stage.held_at_bound[i]);
     }
-    out << "\n  last solve: " << stage.brief_report << "\n";
+    out << "\n";
+    if (!stage.note.empty()) out << "  " << stage.note << "\n";
+    out << "  last solve: " << stage.brief_report << "\n";
   }
 }
 
@@ -266,8 +283,8 @@ void PrintParameters(const IdentificationReport& report, std::ostream& out) {
                         u.effective_nonlinearity_standard_error, u.effective_nonlinearity_ci95_low,
                         u.effective_nonlinearity_ci95_high);
   }
-  out << StringPrintf("final cost %.6g after %d iterations, %s\n", result.final_cost,
-                      result.iterations, result.converged ? "converged" : "NOT converged");
+  out << StringPrintf("final cost %.6g after %d iterations\n", result.final_cost,
+                      result.iterations);
   out << StringPrintf("starts: %zu, %d reached the best (start %d)\n",
                       report.multi_start.starts.size(), report.multi_start.reached_best,
                       report.multi_start.best_start);
@@ -317,6 +334,8 @@ void PrintReport(const IdentificationReport& report, std::ostream& out) {
   PrintSweeps(report, out);
   out << "\n";
   PrintJumps(report, out);
+  out << "\nstatus: " << FitStatusName(report.result.status) << ": " << report.result.message
+      << "\n";
 }
 
 }  // namespace dwellfit

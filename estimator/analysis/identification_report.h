@@ -18,6 +18,10 @@ namespace dwellfit {
 
 struct IdentificationReport {
   std::string config_path;
+  // The configuration in effect (overrides applied) as YAML, recorded in
+  // result.yaml when set (identify leaves out output_dir and the thread
+  // counts, which cannot change the result).
+  std::string config_in_effect;
   IdentificationOptions options;  // the start and the fixed parameters
   IdentificationResult result;
   double omega_ref_rad_s = 0.0;              // reference of the effective nonlinearity
@@ -38,9 +42,10 @@ IdentificationReport MakeIdentificationReport(const std::string& config_path,
                                               const std::vector<const Sweep*>& fitted,
                                               const std::vector<const Sweep*>& validation);
 
-// result.yaml: parameters (omega in rad/s), effective nonlinearity and its
-// Omega_ref, final_cost, iterations, converged, stages, per-sweep errors and
-// measured jump brackets.
+// result.yaml: the run's status and its reason, the dwellfit version, the
+// parameters (omega in rad/s), effective nonlinearity and its Omega_ref,
+// final_cost, iterations, stages, per-sweep errors, measured jump brackets
+// and the configuration in effect.
 std::string ReportToYaml(const IdentificationReport& report);
 
 // predictions.csv: one row per measured dwell with the model's amplitude.

@@ -1,5 +1,6 @@
 #include "dwellfit/estimator/fit/fit_description.h"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <sstream>
@@ -185,6 +186,15 @@ std::vector<double> FitDescription::Values() const {
   for (const FitBlock& block : blocks)
     values.insert(values.end(), block.values, block.values + block.size);
   return values;
+}
+
+void FitDescription::SetValues(const std::vector<double>& values) const {
+  CHECK_EQ(static_cast<int>(values.size()), NumEntries());
+  auto next = values.begin();
+  for (const FitBlock& block : blocks) {
+    std::copy(next, next + block.size, block.values);
+    next += block.size;
+  }
 }
 
 std::vector<bool> FitDescription::FixedEntries() const {

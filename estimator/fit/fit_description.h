@@ -98,6 +98,8 @@ struct FitDescription {
   std::string EntryName(int ambient) const;
   // Every entry's value, blocks in order.
   std::vector<double> Values() const;
+  // Writes `values` (Values() order, NumEntries() of them) into the blocks.
+  void SetValues(const std::vector<double>& values) const;
   // Per ambient entry: fixed (FitBlock::fixed).
   std::vector<bool> FixedEntries() const;
   // Per ambient entry: whether some dataset maps parameter `parameter` there.

@@ -8,6 +8,7 @@
 #include "dwellfit/residuals/functors/algebraic_residual.h"
 #include "dwellfit/residuals/functors/bifurcation_range_penalty.h"
 #include "dwellfit/residuals/functors/branch_stability_penalty.h"
+#include "dwellfit/residuals/functors/fold_condition_residual.h"
 #include "dwellfit/residuals/functors/vertical_error_residual.h"
 
 namespace dwellfit {
@@ -80,6 +81,25 @@ ceres::CostFunction* MakeBifurcationRangePenalty(const Sweep& sweep, const JumpB
                                          jump.amplitude_before, options.exponent, options.weight);
 }
 
+bool FoldExists(const Sweep& sweep, const JumpBracket& jump, const ParameterVector& p) {
+  const DwellPoint& before = sweep.points[jump.index_before];
+  const bool frequency = sweep.kind == SweepKind::kFrequency;
+  const BifurcationRangePenalty penalty(
+      sweep.kind, jump.kind, frequency ? before.a_base : before.drive_frequency_rad_s,
+      jump.control_before, jump.control_after, jump.amplitude_before, 2, 1.0);
+  return penalty.SolveFold(p).exists;
+}
+
+ceres::CostFunction* MakeFoldCondition(const Sweep& sweep, const JumpBracket& jump) {
+  const DwellPoint& before = sweep.points[jump.index_before];
+  const bool frequency = sweep.kind == SweepKind::kFrequency;
+  // One jump weighs as much as its sweep's dwells together.
+  const double weight = std::sqrt(static_cast<double>(sweep.points.size()));
+  return FoldConditionResidual::Create(frequency ? jump.centre() : before.drive_frequency_rad_s,
+                                       frequency ? before.a_base : jump.centre(),
+                                       jump.amplitude_before, weight);
+}
+
 int ProblemBuilder::AddPenalties(const Sweep& sweep, double* parameters, ceres::Problem* problem,
                                  ParallelResidualEvaluator* evaluator) const {
   return AddPenalties(sweep, SingleBlockLayout(parameters), problem, evaluator);
@@ -89,6 +109,7 @@ int ProblemBuilder::AddPenalties(const Sweep& sweep, const ParameterLayout& layo
                                  ceres::Problem* problem,
                                  ParallelResidualEvaluator* evaluator) const {
   int blocks = 0;
+  const bool algebraic = options_.residual == ResidualKind::kAlgebraic;
   const BifurcationRangeOptions& range = options_.penalties.bifurcation_range;
   if (range.enabled) {
     for (const JumpBracket& jump : sweep.jumps) {
@@ -96,12 +117,13 @@ int ProblemBuilder::AddPenalties(const Sweep& sweep, const ParameterLayout& layo
       if (std::find(range.enforce.begin(), range.enforce.end(), target) == range.enforce.end()) {
         continue;
       }
-      Add(MakeBifurcationRangePenalty(sweep, jump, range), layout, problem, evaluator);
+      Add(algebraic ? MakeFoldCondition(sweep, jump) : MakeBifurcationRangePenalty(sweep, jump, range),
+          layout, problem, evaluator);
       ++blocks;
     }
   }
   const BranchStabilityOptions& stability = options_.penalties.branch_stability;
-  if (stability.enabled && !sweep.points.empty()) {
+  if (stability.enabled && !algebraic && !sweep.points.empty()) {
     double largest = 0.0;
     for (const DwellPoint& point : sweep.points) largest = std::max(largest, point.amplitude);
     const double lambda = stability.lambda / largest;  // [1/amplitude]

@@ -61,7 +61,10 @@ class ProblemBuilder {
 
   // Adds the enabled penalties for `sweep`: one BifurcationRangePenalty per
   // measured jump whose target is enforced, one BranchStabilityPenalty per
-  // dwell labelled lower or upper. Returns the number of blocks added.
+  // dwell labelled lower or upper. On the algebraic residual the enforced
+  // jumps get their FoldConditionResidual instead (the algebraic form of
+  // eq. 3.17; the weights of `penalties` are not used) and there is no
+  // branch-stability term. Returns the number of blocks added.
   int AddPenalties(const Sweep& sweep, const ParameterLayout& layout, ceres::Problem* problem,
                    ParallelResidualEvaluator* evaluator = nullptr) const;
   int AddPenalties(const Sweep& sweep, double* parameters, ceres::Problem* problem,
@@ -88,6 +91,15 @@ JumpTarget TargetOf(const Sweep& sweep, const JumpBracket& jump);
 // caller; Ceres takes it.
 ceres::CostFunction* MakeBifurcationRangePenalty(const Sweep& sweep, const JumpBracket& jump,
                                                  const BifurcationRangeOptions& options);
+
+// Whether the model at `p` has the fold of `jump` (the fold the
+// bifurcation-range penalty measures, within a factor 2 of the bracket).
+bool FoldExists(const Sweep& sweep, const JumpBracket& jump, const ParameterVector& p);
+
+// The algebraic fold condition of one measured jump (FoldConditionResidual),
+// weighted by the square root of its sweep's dwell count; owned by the
+// caller.
+ceres::CostFunction* MakeFoldCondition(const Sweep& sweep, const JumpBracket& jump);
 
 }  // namespace dwellfit
 

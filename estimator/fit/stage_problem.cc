@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <sstream>
 #include <utility>
 
 #include "ceres/loss_function.h"
+#include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/fit/scaled_subset_manifold.h"
 #include "glog/logging.h"
 
@@ -52,11 +54,41 @@ void StageProblem::AddPenalties(const PenaltyOptions& penalties) {
   ProblemBuilderOptions options = builder_.options();
   options.penalties = penalties;
   const ProblemBuilder penalty_builder(options);
+  const int before = problem_.NumResidualBlocks();
   for (size_t d = 0; d < fit_.datasets.size(); ++d) {
     for (const Sweep* sweep : fit_.datasets[d].sweeps) {
       penalty_builder.AddPenalties(*sweep, layouts_[d], &problem_, Evaluator());
     }
   }
+  std::vector<ceres::ResidualBlockId> all;
+  problem_.GetResidualBlocks(&all);
+  penalty_blocks_.insert(penalty_blocks_.end(), all.begin() + before, all.end());
+}
+
+std::vector<std::string> StageProblem::MissingFolds(const BifurcationRangeOptions& range) const {
+  std::vector<std::string> missing;
+  if (!range.enabled) return missing;
+  for (size_t d = 0; d < fit_.datasets.size(); ++d) {
+    const ParameterLayout& layout = layouts_[d];
+    ParameterVector p;
+    for (int i = 0; i < kNumParameters; ++i) p[i] = layout.blocks[layout.block[i]][layout.index[i]];
+    for (const Sweep* sweep : fit_.datasets[d].sweeps) {
+      for (const JumpBracket& jump : sweep->jumps) {
+        const JumpTarget target = TargetOf(*sweep, jump);
+        if (std::find(range.enforce.begin(), range.enforce.end(), target) == range.enforce.end() ||
+            FoldExists(*sweep, jump, p)) {
+          continue;
+        }
+        const bool frequency = sweep->kind == SweepKind::kFrequency;
+        const double scale = frequency ? 1.0 / kTwoPi : 1.0;
+        missing.push_back(StringPrintf("%s: no %s fold near its measured bracket %.6g..%.6g %s",
+                                       sweep->Name().c_str(), JumpKindName(jump.kind),
+                                       jump.control_before * scale, jump.control_after * scale,
+                                       frequency ? "Hz" : "(a_base)"));
+      }
+    }
+  }
+  return missing;
 }
 
 void StageProblem::AddCallerResiduals() {
@@ -97,13 +129,24 @@ void StageProblem::Configure() {
   }
 }
 
-double StageProblem::DataCost() {
+namespace {
+
+double CostOf(const std::vector<ceres::ResidualBlockId>& blocks, ceres::Problem* problem) {
+  if (blocks.empty()) return 0.0;
   ceres::Problem::EvaluateOptions evaluate;
-  evaluate.residual_blocks = dwell_blocks_;
+  evaluate.residual_blocks = blocks;
   double cost = 0.0;
-  problem_.Evaluate(evaluate, &cost, nullptr, nullptr, nullptr);
+  if (!problem->Evaluate(evaluate, &cost, nullptr, nullptr, nullptr) || !std::isfinite(cost)) {
+    return std::numeric_limits<double>::infinity();
+  }
   return cost;
 }
+
+}  // namespace
+
+double StageProblem::DataCost() { return CostOf(dwell_blocks_, &problem_); }
+
+double StageProblem::PenaltyCost() { return CostOf(penalty_blocks_, &problem_); }
 
 bool StageProblem::CostGradient(std::vector<double>* gradient) {
   std::vector<ceres::ResidualBlockId> direct = caller_blocks_;

@@ -57,8 +57,17 @@ class StageProblem {
   // Bounds, fixed and held entries, scaling. Call once, after the residuals.
   void Configure();
 
-  // The cost of the dwells alone at the blocks' current values.
+  // The cost of the dwells alone at the blocks' current values (infinity
+  // where some dwell cannot be evaluated).
   double DataCost();
+  // The cost of the penalties added by AddPenalties (0 without them).
+  double PenaltyCost();
+  // The enforced jumps of `range` (an enabled bifurcation-range penalty)
+  // where the model at the blocks' current values has no fold of the
+  // jump's kind, each named: "L0.060g/up: no jump_down fold near its
+  // measured bracket 180.924..180.953 Hz". Empty when every enforced fold
+  // exists (or the penalty is off).
+  std::vector<std::string> MissingFolds(const BifurcationRangeOptions& range) const;
   // The gradient of the whole cost (every residual block, the caller's
   // included) in the described entries, ambient order, at their current
   // values: no manifold, no bounds, no held entries. False if a residual
@@ -104,6 +113,7 @@ class StageProblem {
   ceres::Problem problem_;
   std::vector<ceres::ResidualBlockId> dwell_blocks_;
   std::vector<ceres::ResidualBlockId> caller_blocks_;
+  std::vector<ceres::ResidualBlockId> penalty_blocks_;
   int dwells_ = 0;
 };
 

@@ -24,6 +24,8 @@ const char* FitStatusName(FitStatus status) {
       return "failure";
     case FitStatus::kInvalidInput:
       return "invalid_input";
+    case FitStatus::kUnidentifiable:
+      return "unidentifiable";
   }
   return "invalid_input";
 }
@@ -169,8 +171,8 @@ std::vector<double*> EntriesHolding(const FitDescription& fit, bool damping) {
   return entries;
 }
 
-void RecordSolve(const ceres::Solver::Summary& summary, int round, StageProblem* problem,
-                 StageSummary* stage) {
+void RecordSolve(const ceres::Solver::Summary& summary, int round, const PenaltyOptions& penalties,
+                 StageProblem* problem, StageSummary* stage) {
   if (round == 0) stage->initial_cost = summary.initial_cost;
   stage->final_cost = summary.final_cost;
   stage->iterations += std::max(static_cast<int>(summary.iterations.size()) - 1, 0);
@@ -178,6 +180,8 @@ void RecordSolve(const ceres::Solver::Summary& summary, int round, StageProblem*
   stage->converged = summary.termination_type == ceres::CONVERGENCE;
   stage->brief_report = summary.BriefReport();
   stage->final_data_cost = problem->DataCost();
+  stage->final_penalty_cost = problem->PenaltyCost();
+  stage->missing_folds = problem->MissingFolds(penalties.bifurcation_range);
 }
 
 // "eta_e 100, mu1 0.2, ..., omega 251.3 rad/s": every entry of `fit` at
@@ -192,6 +196,16 @@ std::string DescribeValues(const FitDescription& fit, const std::vector<double>&
   return text.str();
 }
 
+StageSetup MakeSetup(const SolveContext& context, ResidualKind kind) {
+  StageSetup setup;
+  setup.residuals.residual = kind;
+  setup.residuals.residual_options = context.options.residual;
+  setup.scale = context.scale;
+  setup.bound_damping = kind != ResidualKind::kAlgebraic;
+  setup.num_threads = context.threads;
+  return setup;
+}
+
 // One stage: the residual `kind` (with `penalties` on a vertical stage) from
 // the blocks' values, which it updates. False when a solve failed
 // (`*failure` says why).
@@ -203,12 +217,11 @@ std::string DescribeValues(const FitDescription& fit, const std::vector<double>&
 // convergence test with nothing to release ends the stage.
 bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptions& penalties,
               StageSummary* stage, std::string* failure) {
-  StageSetup setup;
-  setup.residuals.residual = kind;
-  setup.residuals.residual_options = context.options.residual;
-  setup.scale = context.scale;
-  setup.bound_damping = kind != ResidualKind::kAlgebraic;
-  setup.num_threads = context.threads;
+  StageSetup setup = MakeSetup(context, kind);
+  // The algebraic stage takes the enforced jumps' fold conditions
+  // (ProblemBuilder::AddPenalties), unweighted by the data's cost.
+  const bool fold_conditions =
+      kind == ResidualKind::kAlgebraic && penalties.bifurcation_range.enabled;
   const bool with_penalties = kind == ResidualKind::kVertical && PenaltiesEnabled(penalties);
   const int entries = context.fit.NumEntries();
   setup.held.assign(entries, false);
@@ -218,7 +231,7 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
   for (int round = 0;; ++round) {
     StageProblem problem(context.fit, setup);
     if (round == 0 && with_penalties) weighted = WeighPenalties(penalties, &problem, stage);
-    if (with_penalties) problem.AddPenalties(weighted);
+    if (with_penalties || fold_conditions) problem.AddPenalties(weighted);
     problem.AddCallerResiduals();
     stage->residual_blocks = problem.dwells();
     std::optional<int> resting;
@@ -227,7 +240,7 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
         SolveOnce(kind, context.options.solver, &problem, &resting);
     VLOG(2) << ResidualKindName(kind) << " stage, solve " << round + 1 << ": "
             << summary.BriefReport();
-    RecordSolve(summary, round, &problem, stage);
+    RecordSolve(summary, round, with_penalties ? penalties : PenaltyOptions{}, &problem, stage);
     if (!summary.IsSolutionUsable() || !std::isfinite(summary.final_cost)) {
       stage->converged = false;
       *failure = std::string("the ") + ResidualKindName(kind) +
@@ -272,8 +285,89 @@ std::vector<double> StartScale(const FitDescription& fit) {
   return scale;
 }
 
-// Status and message from how the last stage ended.
-void Conclude(FitSummary* summary) {
+std::string JoinLines(const std::vector<std::string>& lines) {
+  std::string joined;
+  for (const std::string& line : lines) joined += (joined.empty() ? "" : "; ") + line;
+  return joined;
+}
+
+// How good a point is as the start of a vertical stage: fewer enforced folds
+// missing first, then a lower cost of the dwells.
+struct StartRating {
+  std::vector<std::string> missing_folds;
+  double data_cost = 0.0;
+
+  bool BetterThan(const StartRating& other) const {
+    if (missing_folds.size() != other.missing_folds.size()) {
+      return missing_folds.size() < other.missing_folds.size();
+    }
+    return data_cost < other.data_cost;
+  }
+};
+
+// Rates `values` (written into the blocks) as a vertical stage's start.
+StartRating RateStart(const SolveContext& context, const std::vector<double>& values,
+                      const PenaltyOptions& penalties) {
+  context.fit.SetValues(values);
+  StageProblem problem(context.fit, MakeSetup(context, ResidualKind::kVertical));
+  return {problem.MissingFolds(penalties.bifurcation_range), problem.DataCost()};
+}
+
+std::string DescribeRating(const StartRating& rating) {
+  if (!rating.missing_folds.empty()) return "it lacks " + JoinLines(rating.missing_folds);
+  std::ostringstream text;
+  text << "its dwells' cost is " << rating.data_cost;
+  return text.str();
+}
+
+// Where a vertical stage starts. Of the points the previous stage started
+// and ended at, the better (StartRating): a stage may end where the next
+// one does worse (the algebraic residual does not know branches, and an
+// enforced fold may vanish on its way). When that point still lacks an
+// enforced fold, a fold stage (the algebraic residual with the enforced
+// jumps' fold conditions, FoldConditionResidual) runs from it first, once
+// per solve, and the better of its start and end is taken. Leaves the
+// blocks at the chosen start; false when the fold stage failed.
+bool ChooseVerticalStart(const SolveContext& context, const std::vector<double>* previous_start,
+                         bool* fold_stage_ran, const PenaltyOptions& penalties,
+                         FitSummary* summary, std::string* note, std::string* failure) {
+  std::vector<double> best = context.fit.Values();
+  StartRating rating = RateStart(context, best, penalties);
+  if (previous_start != nullptr) {
+    const StartRating earlier = RateStart(context, *previous_start, penalties);
+    if (earlier.BetterThan(rating)) {
+      *note = "started where the previous stage started, since at its end " +
+              DescribeRating(rating) + " (at its start: " + DescribeRating(earlier) + ")";
+      best = *previous_start;
+      rating = earlier;
+    }
+  }
+  if (!rating.missing_folds.empty() && !*fold_stage_ran) {
+    context.fit.SetValues(best);
+    summary->stages.emplace_back();
+    StageSummary& fold_stage = summary->stages.back();
+    fold_stage.fold_stage = true;
+    fold_stage.note = "fold stage: the vertical stage's start lacks " +
+                      JoinLines(rating.missing_folds);
+    if (!RunStage(context, ResidualKind::kAlgebraic, penalties, &fold_stage, failure)) {
+      return false;
+    }
+    *fold_stage_ran = true;
+    const std::vector<double> after = context.fit.Values();
+    const StartRating folded = RateStart(context, after, penalties);
+    if (folded.BetterThan(rating)) {
+      *note = "started where the fold stage ended";
+      best = after;
+    }
+  }
+  context.fit.SetValues(best);
+  return true;
+}
+
+// Status and message from how the last stage ended: a failure when an
+// enforced fold is missing, the penalties dominate the cost, or a value is
+// not finite; else converged or not.
+void Conclude(const FitDescription& fit, FitSummary* summary) {
   const StageSummary& last = summary->stages.back();
   for (const StageSummary& stage : summary->stages) summary->iterations += stage.iterations;
   summary->residual_blocks = last.residual_blocks;
@@ -286,6 +380,30 @@ void Conclude(FitSummary* summary) {
           << ResidualKindName(last.residual) << ") "
           << (last.converged ? "converged" : "stopped without meeting a convergence test") << ": "
           << last.brief_report;
+  const std::vector<double> values = fit.Values();
+  std::string failure;
+  if (!std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); }) ||
+      !std::isfinite(summary->final_cost)) {
+    failure = "the fit ended at values that are not finite";
+  } else if (!last.missing_folds.empty()) {
+    failure = "the fit ended without the enforced fold(s) " + JoinLines(last.missing_folds) +
+              ": the bifurcation-range penalty could not bring them in (start closer, "
+              "enforce fewer jumps, or free more parameters)";
+  } else if (last.final_penalty_cost > std::max(last.final_data_cost, last.penalty_unit)) {
+    std::ostringstream text;
+    text << "the penalties dominate the final cost (" << last.final_penalty_cost
+         << " against the dwells' " << last.final_data_cost << " and the penalty unit "
+         << last.penalty_unit
+         << "): the enforced jumps and the dwells disagree (check the jump brackets, or relax "
+            "the penalties)";
+    failure = text.str();
+  }
+  if (!failure.empty()) {
+    summary->status = FitStatus::kFailure;
+    summary->converged = false;
+    summary->message = failure + "; " + message.str();
+    return;
+  }
   summary->message = message.str();
 }
 
@@ -301,8 +419,24 @@ FitSummary SolveStaged(const FitDescription& fit, const StagedSolveOptions& opti
   }
   const SolveContext context{fit, options, StartScale(fit),
                              ResolveThreadCount(options.solver.num_threads)};
+  std::vector<double> previous_start;
+  bool fold_stage_ran = false;
   for (ResidualKind kind : options.stages) {
-    std::vector<PenaltyOptions> runs = {options.penalties};
+    std::string note;
+    if (kind == ResidualKind::kVertical &&
+        !ChooseVerticalStart(context, summary.stages.empty() ? nullptr : &previous_start,
+                             &fold_stage_ran, options.penalties, &summary, &note, &error)) {
+      summary.status = FitStatus::kFailure;
+      summary.evaluation_failed = true;
+      summary.message = error;
+      summary.final_cost = summary.stages.back().final_cost;
+      return summary;
+    }
+    previous_start = fit.Values();
+    // The algebraic stage fits the dwells alone: a fold stage adds the fold
+    // conditions when a vertical stage needs them (ChooseVerticalStart).
+    std::vector<PenaltyOptions> runs = {kind == ResidualKind::kAlgebraic ? PenaltyOptions{}
+                                                                         : options.penalties};
     const BifurcationRangeOptions& range = options.penalties.bifurcation_range;
     if (kind == ResidualKind::kVertical && range.enabled && range.exponent > 2) {
       // Continuation: u^n with n = 10 is flat near the bracket and so stiff
@@ -314,15 +448,18 @@ FitSummary SolveStaged(const FitDescription& fit, const StagedSolveOptions& opti
     }
     for (const PenaltyOptions& penalties : runs) {
       summary.stages.emplace_back();
+      summary.stages.back().note = note;
+      note.clear();
       if (!RunStage(context, kind, penalties, &summary.stages.back(), &error)) {
         summary.status = FitStatus::kFailure;
+        summary.evaluation_failed = true;
         summary.message = error;
         summary.final_cost = summary.stages.back().final_cost;
         return summary;
       }
     }
   }
-  Conclude(&summary);
+  Conclude(fit, &summary);
   return summary;
 }
 

@@ -47,9 +47,13 @@ namespace dwellfit {
 enum class FitStatus {
   kConverged,      // the last stage met a convergence test
   kNoConvergence,  // the last stage stopped at its iteration limit: usable, not a proven minimum
-  kFailure,        // a stage's solve failed (the model could not be evaluated): not
-                   // usable; the blocks hold where that solve stopped
+  kFailure,        // not usable: a stage's solve failed (the model could not be
+                   // evaluated; the blocks hold where that solve stopped), or the fit
+                   // ended without an enforced fold, with a cost dominated by the
+                   // penalties, or with values that are not finite
   kInvalidInput,   // invalid options or description: nothing solved, blocks untouched
+  kUnidentifiable,  // set by the analysis (not SolveStaged): the solve ended, but the
+                    // data cannot tell the free parameters apart (no covariance)
 };
 const char* FitStatusName(FitStatus status);  // "converged", "no_convergence", ...
 
@@ -70,6 +74,18 @@ struct StageSummary {
   // Bounded entries the stage ended holding on their bound (an active set),
   // as ambient indices of the description (for Identify: ParameterIndex).
   std::vector<int> held_at_bound;
+  // Penalties' cost at the end (0 without penalties) and the enforced jumps
+  // whose fold the model lacks there (StageProblem::MissingFolds).
+  double final_penalty_cost = 0.0;
+  std::vector<std::string> missing_folds;
+  // An algebraic stage with the enforced jumps' fold conditions
+  // (FoldConditionResidual), run before a vertical stage whose start lacks
+  // an enforced fold.
+  bool fold_stage = false;
+  // Why the stage ran or where it started, when that is not the plain
+  // sequence: a fold stage, or a vertical stage that started where the
+  // previous stage started (ChooseVerticalStart in the .cc).
+  std::string note;
   std::string brief_report;    // ceres::Solver::Summary::BriefReport() of its last solve
   std::vector<double> values;  // every entry where the stage ended, ambient order
 };
@@ -82,10 +98,15 @@ struct FitSummary {
   double final_cost = 0.0;  // of the last stage
   int iterations = 0;       // over all stages
   bool converged = false;   // status == kConverged
+  // kFailure because a stage's solve could not evaluate its cost (the later
+  // stages did not run): the values are where that solve stopped, no fit.
+  bool evaluation_failed = false;
 
-  // The blocks hold a solution (converged, or stopped at the iteration limit).
+  // The blocks hold a solution (converged, or stopped at the iteration limit;
+  // not a unique one when unidentifiable).
   bool IsSolutionUsable() const {
-    return status == FitStatus::kConverged || status == FitStatus::kNoConvergence;
+    return status == FitStatus::kConverged || status == FitStatus::kNoConvergence ||
+           status == FitStatus::kUnidentifiable;
   }
 };
 

@@ -1,5 +1,6 @@
 #include "dwellfit/estimator/run/identify_run.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -8,16 +9,17 @@
 #include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "glog/logging.h"
+#include "yaml-cpp/yaml.h"
 
 namespace dwellfit {
 
 namespace {
 
-// Throws when the best start is no usable estimate: a stage could not
+// Throws when the best start is no estimate at all: a stage could not
 // evaluate its cost (every start failed), or the estimate is not finite.
 void CheckUsable(const IdentifyConfig& config, const MultiStartResult& multi_start) {
   const IdentificationResult& result = multi_start.best;
-  if (!result.IsSolutionUsable()) {
+  if (result.status == FitStatus::kInvalidInput || result.evaluation_failed) {
     throw InputError(
         config.config_path, 0, "initial_guess",
         "the fit cannot proceed: " + result.message +
@@ -39,7 +41,50 @@ void CheckUsable(const IdentifyConfig& config, const MultiStartResult& multi_sta
   }
 }
 
+// A converged fit whose free parameters the data cannot tell apart (no
+// covariance) is unidentifiable: the estimate is one of many. (A fit that
+// did not converge keeps that status: its covariance says little.)
+void MarkUnidentifiable(IdentificationReport* report) {
+  IdentificationResult& result = report->result;
+  const bool any_free = std::count(report->options.fixed.begin(), report->options.fixed.end(),
+                                   false) > 0;
+  if (!any_free || report->uncertainty.available || result.status != FitStatus::kConverged) return;
+  result.status = FitStatus::kUnidentifiable;
+  result.converged = false;
+  result.message = "the data cannot tell the free parameters apart: " +
+                   report->uncertainty.message + "; " + result.message;
+}
+
+// The configuration in effect as YAML, without the keys that cannot change
+// the result (where the files go, how many threads), so that one input gives
+// one result file.
+std::string ConfigAffectingTheResult(const IdentifyConfig& config) {
+  YAML::Node node = YAML::Load(ConfigToYaml(config));
+  node.remove("output_dir");
+  if (node["solver"]) node["solver"].remove("num_threads");
+  if (node["multi_start"]) node["multi_start"].remove("threads");
+  YAML::Emitter out;
+  out << node;
+  return out.c_str();
+}
+
 }  // namespace
+
+int ExitStatusFor(FitStatus status, bool accept_no_convergence) {
+  switch (status) {
+    case FitStatus::kConverged:
+      return kExitConverged;
+    case FitStatus::kNoConvergence:
+      return accept_no_convergence ? kExitConverged : kExitNoConvergence;
+    case FitStatus::kFailure:
+      return kExitFailure;
+    case FitStatus::kUnidentifiable:
+      return kExitUnidentifiable;
+    case FitStatus::kInvalidInput:
+      return kExitInputError;
+  }
+  return kExitFailure;
+}
 
 std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::ostream& out) {
   out << "# config in effect\n" << ConfigToYaml(config) << "\n";
@@ -74,6 +119,8 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
   outcome->report.multi_start = multi_start;
   outcome->report.uncertainty =
       EstimateUncertainty(run.fitted, options, result.parameters, outcome->report.omega_ref_rad_s);
+  outcome->report.config_in_effect = ConfigAffectingTheResult(config);
+  MarkUnidentifiable(&outcome->report);
   const IdentificationReport& report = outcome->report;
   PrintReport(report, out);
   WriteFilesAtomically(config.output_dir, {{"result.yaml", ReportToYaml(report)},

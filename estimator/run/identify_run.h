@@ -21,9 +21,25 @@ struct IdentifyOutcome {
 };
 
 // Runs the identification and writes its files; prints the config in effect
-// and the summary to `out`. Throws InputError on bad input or when the solver
-// returns no usable solution (nothing is written then).
+// and the summary to `out`. The report's result carries the run's status
+// (FitStatus): converged, no_convergence, failure (an enforced fold missing
+// at the end, a cost dominated by the penalties), or unidentifiable (the
+// data cannot tell the free parameters apart: no covariance), each with its
+// reason, and result.yaml records it. Throws InputError on bad input or when
+// no fit could be made at all (the model cannot be evaluated from the start,
+// or the estimate is not finite); nothing is written then.
 std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::ostream& out);
+
+// identify's exit status (README, "Exit status"):
+inline constexpr int kExitConverged = 0;       // a converged, identifiable fit
+inline constexpr int kExitInputError = 1;      // bad input, or no fit could be made
+inline constexpr int kExitUsage = 2;           // bad command line
+inline constexpr int kExitNoConvergence = 3;   // the fit stopped at its iteration limit
+inline constexpr int kExitFailure = 4;         // the fit failed (status_message says why)
+inline constexpr int kExitUnidentifiable = 5;  // the parameters cannot be told apart
+// The exit status of a run that ended in `status`; with
+// `accept_no_convergence` a fit stopped at its iteration limit exits 0.
+int ExitStatusFor(FitStatus status, bool accept_no_convergence);
 
 }  // namespace dwellfit
 

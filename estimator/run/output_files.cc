@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/version.h"
 
 namespace dwellfit {
 namespace {
@@ -74,7 +75,7 @@ void WriteDurably(const fs::path& path, const std::string& content) {
 std::string Manifest(const std::vector<std::pair<std::string, std::string>>& files) {
   std::ostringstream out;
   out << "# The files of one complete dwellfit run; written after all of them.\n"
-      << "dwellfit_version: " << DWELLFIT_VERSION << "\nfiles:\n";
+      << "dwellfit_version: " << DwellfitVersion() << "\nfiles:\n";
   for (const auto& [name, content] : files) {
     out << "  - {name: " << name << ", bytes: " << content.size() << "}\n";
   }

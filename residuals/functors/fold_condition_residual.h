@@ -1,0 +1,67 @@
+// FoldConditionResidual: the bifurcation-range constraint (eq. 3.17) in the
+// algebraic form of eq. (3.11), for the algebraic stage.
+//
+// A measured jump ends a branch at (Omega_c, a_base, a_j): Omega_c the
+// bracket's centre [rad/s] and a_base the held level (frequency sweep), or
+// the held Omega and the bracket's centre level (amplitude sweep); a_j the
+// measured amplitude on the branch that ends. The model has its fold there
+// when G has a turning point at a_j on the level a_base (docs/model.md,
+// "Stability and folds"):
+//
+//   r_0 = s (G(a_j; Omega_c) - a_base^2) / a_base^2
+//   r_1 = s a_j dG/da(a_j; Omega_c) / a_base^2
+//
+// Both are polynomials in the parameters: smooth and defined everywhere,
+// also where the model has no fold at all, which is where the
+// bifurcation-range penalty (bifurcation_range_penalty.h) has nothing to
+// measure. The algebraic stage adds one per enforced jump so that it lands
+// where every enforced fold exists near its bracket; the vertical stage then
+// places the folds exactly with the penalty. s weighs the jump against the
+// dwells' algebraic residuals (AlgebraicResidual).
+//
+// Parameter block p as in model_parameters.h.
+#ifndef DWELLFIT_RESIDUALS_FUNCTORS_FOLD_CONDITION_RESIDUAL_H_
+#define DWELLFIT_RESIDUALS_FUNCTORS_FOLD_CONDITION_RESIDUAL_H_
+
+#include <cmath>
+
+#include "ceres/autodiff_cost_function.h"
+#include "dwellfit/residuals/model/model_parameters.h"
+#include "dwellfit/residuals/model/response_model.h"
+#include "dwellfit/residuals/model/stable_root.h"
+
+namespace dwellfit {
+
+class FoldConditionResidual {
+ public:
+  FoldConditionResidual(double drive_frequency_rad_s, double a_base, double a_jump, double weight)
+      : drive_frequency_rad_s_(drive_frequency_rad_s),
+        a_base_squared_(a_base * a_base),
+        a_jump_(a_jump),
+        weight_(weight) {}
+
+  template <typename T>
+  bool operator()(const T* const p, T* residual) const {
+    const auto k = ResponseCoefficients<T>::FromParameters(p, drive_frequency_rad_s_);
+    const T a(a_jump_);
+    residual[0] = weight_ * (k.G(a) - a_base_squared_) / a_base_squared_;
+    residual[1] = weight_ * a * k.dG(a) / a_base_squared_;
+    return std::isfinite(ScalarPart(residual[0])) && std::isfinite(ScalarPart(residual[1]));
+  }
+
+  static ceres::CostFunction* Create(double drive_frequency_rad_s, double a_base, double a_jump,
+                                     double weight) {
+    return new ceres::AutoDiffCostFunction<FoldConditionResidual, 2, kNumParameters>(
+        new FoldConditionResidual(drive_frequency_rad_s, a_base, a_jump, weight));
+  }
+
+ private:
+  const double drive_frequency_rad_s_;
+  const double a_base_squared_;
+  const double a_jump_;
+  const double weight_;
+};
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_RESIDUALS_FUNCTORS_FOLD_CONDITION_RESIDUAL_H_
