@@ -271,15 +271,55 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
   return true;
 }
 
+// A step unit for a parameter that starts at 0, from the dataset's other
+// parameters and its largest measured amplitude a_max, so that the fit does
+// not depend on the units of a or of time (docs/model.md, "Units"): delta
+// like |alpha| / w^2 (the two nonlinear terms alike), alpha like w^2 / a_max^2
+// over ten (a tenth of the linear stiffness at the largest amplitude), mu2
+// like mu1 / a_max, mu1 like w / 1000 (a damping ratio of 1e-3).
+double NaturalScale(int parameter, const ParameterVector& p, double a_max) {
+  const double w = std::abs(p[kNaturalFrequency]);
+  const double mu1 = p[kMu1] != 0.0 ? std::abs(p[kMu1]) : 1e-3 * w;
+  switch (parameter) {
+    case kDelta:
+      return p[kAlpha] != 0.0 ? std::abs(p[kAlpha]) / (w * w) : 0.1 / (a_max * a_max);
+    case kAlpha:
+      return 0.1 * w * w / (a_max * a_max);
+    case kMu2:
+      return mu1 / a_max;
+    case kMu1:
+      return mu1;
+    default:
+      return 1.0;
+  }
+}
+
 // The step unit of every entry: its scale when given, else the magnitude of
-// its value at the start (1 for 0), so that a stage that drove an entry to
-// its bound still steps sensibly.
+// its value at the start, or for a value 0 its NaturalScale in the first
+// dataset that maps it (1 when none does or it is not finite and positive).
 std::vector<double> StartScale(const FitDescription& fit) {
-  std::vector<double> scale;
+  std::vector<double> scale = fit.Values();
+  for (double& value : scale) value = std::abs(value);
+  for (const FitDataset& dataset : fit.datasets) {
+    const ParameterLayout layout = LayoutOf(fit, dataset.parameters);
+    ParameterVector p;
+    for (int i = 0; i < kNumParameters; ++i) p[i] = layout.blocks[layout.block[i]][layout.index[i]];
+    double a_max = 0.0;
+    for (const Sweep* sweep : dataset.sweeps) {
+      for (const DwellPoint& point : sweep->points) a_max = std::max(a_max, point.amplitude);
+    }
+    for (int i = 0; i < kNumParameters; ++i) {
+      const int entry = fit.AmbientIndex(dataset.parameters[i]);
+      if (entry < 0 || scale[entry] != 0.0) continue;
+      const double natural = a_max > 0.0 ? NaturalScale(i, p, a_max) : 1.0;
+      scale[entry] = std::isfinite(natural) && natural > 0.0 ? natural : 1.0;
+    }
+  }
+  int entry = 0;
   for (const FitBlock& block : fit.blocks) {
-    for (int i = 0; i < block.size; ++i) {
-      const double magnitude = std::abs(block.values[i]);
-      scale.push_back(!block.scale.empty() ? block.scale[i] : magnitude > 0.0 ? magnitude : 1.0);
+    for (int i = 0; i < block.size; ++i, ++entry) {
+      if (!block.scale.empty()) scale[entry] = block.scale[i];
+      if (scale[entry] == 0.0) scale[entry] = 1.0;
     }
   }
   return scale;

@@ -19,6 +19,20 @@
 // determine. With an exponent n > 2 each vertical stage runs first with
 // n = 2 (continuation), then with n.
 //
+// A vertical stage starts from the better of where the previous stage
+// started and ended (fewer enforced folds missing, then a lower cost of the
+// dwells): the algebraic residual knows no branches, and its minimum may
+// lack a fold the vertical stage must place. When that start still lacks an
+// enforced fold, a fold stage runs first: the algebraic residual with each
+// enforced jump's fold conditions (FoldConditionResidual, smooth where the
+// bifurcation-range penalty has no fold to measure), and the better of its
+// start and end is taken. The summary's stages say which (note, fold_stage).
+//
+// The last stage decides the status: converged or not; a failure when it
+// ends without an enforced fold, with the penalties' cost above both the
+// dwells' cost and the penalty unit (the enforced jumps and the dwells
+// disagree), or at values that are not finite.
+//
 // Within a stage the bounds (eta_e, mu1, mu2 >= 0) are an active set: an
 // entry resting on its bound is held there (BoundRestWatcher) and the stage
 // solves again without it; a held entry whose cost gradient points into the

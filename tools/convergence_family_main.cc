@@ -1,0 +1,50 @@
+// convergence_family: fits every member of the convergence family
+// (estimator/studies/convergence_family.h) from the automatic start and
+// writes the Markdown report. Exits 1 unless at least 98 % of the members
+// reach the truth and none reports convergence away from it.
+#include <algorithm>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "dwellfit/config/identify_config.h"
+#include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/run/output_files.h"
+#include "dwellfit/estimator/studies/convergence_family.h"
+#include "gflags/gflags.h"
+#include "glog/logging.h"
+
+DEFINE_string(base, "datasets/thesis-numerical/beam.yaml",
+              "Config whose solver, stage, residual and penalty settings every member uses");
+DEFINE_string(output, "docs/convergence-family.md", "Markdown file to write");
+
+int main(int argc, char** argv) {
+  FLAGS_logtostderr = true;
+  google::InitGoogleLogging(argv[0]);
+  gflags::SetUsageMessage(
+      "fits the convergence family from the automatic start and writes its report.\n"
+      "  convergence_family [--base CFG --output FILE]");
+  gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
+  try {
+    const dwellfit::IdentifyConfig base = dwellfit::LoadIdentifyConfig(FLAGS_base);
+    std::vector<dwellfit::FamilyOutcome> outcomes;
+    for (const dwellfit::FamilyMember& member : dwellfit::ConvergenceFamily()) {
+      outcomes.push_back(dwellfit::RunFamilyMember(base, member));
+    }
+    const std::string::size_type slash = FLAGS_output.rfind('/');
+    dwellfit::WriteFilesAtomically(
+        slash == std::string::npos ? "." : FLAGS_output.substr(0, slash),
+        {{slash == std::string::npos ? FLAGS_output : FLAGS_output.substr(slash + 1),
+          dwellfit::ConvergenceFamilyMarkdown(outcomes)}});
+    const auto reached = std::count_if(outcomes.begin(), outcomes.end(),
+                                       [](const auto& o) { return o.ReachedTruth(); });
+    const auto silent = std::count_if(outcomes.begin(), outcomes.end(),
+                                      [](const auto& o) { return o.SilentlyWrong(); });
+    std::cout << "wrote " << FLAGS_output << ": " << reached << " of " << outcomes.size()
+              << " members reach the truth, " << silent << " silently wrong\n";
+    return 100 * reached >= 98 * static_cast<long>(outcomes.size()) && silent == 0 ? 0 : 1;
+  } catch (const dwellfit::InputError& error) {
+    std::cerr << "convergence_family: " << error.what() << "\n";
+    return 1;
+  }
+}
