@@ -33,10 +33,7 @@ int main(int argc, char** argv) {
         dwellfit::ChapterTablesMarkdown(dwellfit::LoadIdentifyConfig(FLAGS_numerical),
                                         dwellfit::ReadDwellPlan(FLAGS_truth_plan).truth,
                                         dwellfit::LoadIdentifyConfig(FLAGS_measured));
-    const std::string::size_type slash = FLAGS_output.rfind('/');
-    dwellfit::WriteFilesAtomically(
-        slash == std::string::npos ? "." : FLAGS_output.substr(0, slash),
-        {{slash == std::string::npos ? FLAGS_output : FLAGS_output.substr(slash + 1), markdown}});
+    dwellfit::WriteReportAtomically(FLAGS_output, markdown);
     std::cout << "wrote " << FLAGS_output << "\n";
   } catch (const dwellfit::InputError& error) {
     std::cerr << "chapter_tables: " << error.what() << "\n";

@@ -31,11 +31,7 @@ int main(int argc, char** argv) {
     for (const dwellfit::FamilyMember& member : dwellfit::ConvergenceFamily()) {
       outcomes.push_back(dwellfit::RunFamilyMember(base, member));
     }
-    const std::string::size_type slash = FLAGS_output.rfind('/');
-    dwellfit::WriteFilesAtomically(
-        slash == std::string::npos ? "." : FLAGS_output.substr(0, slash),
-        {{slash == std::string::npos ? FLAGS_output : FLAGS_output.substr(slash + 1),
-          dwellfit::ConvergenceFamilyMarkdown(outcomes)}});
+    dwellfit::WriteReportAtomically(FLAGS_output, dwellfit::ConvergenceFamilyMarkdown(outcomes));
     const auto reached = std::count_if(outcomes.begin(), outcomes.end(),
                                        [](const auto& o) { return o.ReachedTruth(); });
     const auto silent = std::count_if(outcomes.begin(), outcomes.end(),

@@ -169,4 +169,10 @@ void WriteFilesAtomically(const std::string& directory,
   fs::remove_all(staging, error);
 }
 
+void WriteReportAtomically(const std::string& path, const std::string& text) {
+  const std::string::size_type slash = path.rfind('/');
+  WriteFilesAtomically(slash == std::string::npos ? "." : path.substr(0, slash),
+                       {{slash == std::string::npos ? path : path.substr(slash + 1), text}});
+}
+
 }  // namespace dwellfit

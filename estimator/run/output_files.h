@@ -40,6 +40,10 @@ void CheckOutputDirectory(const std::string& directory, const std::string& field
 void WriteFilesAtomically(const std::string& directory,
                           const std::vector<std::pair<std::string, std::string>>& files);
 
+// One report file at `path` (its directory: the part before the last '/',
+// or "."), written as WriteFilesAtomically writes a run's files.
+void WriteReportAtomically(const std::string& path, const std::string& text);
+
 }  // namespace dwellfit
 
 #endif  // DWELLFIT_ESTIMATOR_RUN_OUTPUT_FILES_H_
