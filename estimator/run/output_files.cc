@@ -170,9 +170,15 @@ void WriteFilesAtomically(const std::string& directory,
 }
 
 void WriteReportAtomically(const std::string& path, const std::string& text) {
-  const std::string::size_type slash = path.rfind('/');
-  WriteFilesAtomically(slash == std::string::npos ? "." : path.substr(0, slash),
-                       {{slash == std::string::npos ? path : path.substr(slash + 1), text}});
+  const fs::path target(path);
+  const fs::path staged = target.string() + kLegacyPartialMarker + std::to_string(::getpid());
+  WriteDurably(staged, text);
+  std::error_code error;
+  fs::rename(staged, target, error);
+  if (error) {
+    fs::remove(staged, error);
+    ThrowOutputError(target, "cannot move the report into place");
+  }
 }
 
 }  // namespace dwellfit

@@ -40,8 +40,9 @@ void CheckOutputDirectory(const std::string& directory, const std::string& field
 void WriteFilesAtomically(const std::string& directory,
                           const std::vector<std::pair<std::string, std::string>>& files);
 
-// One report file at `path` (its directory: the part before the last '/',
-// or "."), written as WriteFilesAtomically writes a run's files.
+// One report file (docs/chapter-tables.md, say): written beside `path` under
+// a name of this process, flushed, then renamed onto it, so `path` holds the
+// old text or the whole new one. No manifest: a report is one file.
 void WriteReportAtomically(const std::string& path, const std::string& text);
 
 }  // namespace dwellfit
