@@ -99,7 +99,7 @@ ceres::Solver::Summary SolveOnce(ResidualKind kind, const SolverSettings& settin
   problem->Configure();
   BoundRestWatcher watcher(problem->WatchedBounds(), kStepsAtBoundBeforeHolding);
   ceres::Solver::Options options = MakeSolverOptions(settings);
-  if (kind == ResidualKind::kVertical) {
+  if (kind == ResidualKind::kVertical || kind == ResidualKind::kAllRoots) {
     // No projected line search. With bounds set (eta_e, mu1, mu2 >= 0)
     // Ceres runs an Armijo search along every trust-region step; on the
     // vertical error, whose gradient spans some twenty decades (root
@@ -209,7 +209,10 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
   setup.scale = context.scale;
   setup.bound_damping = kind != ResidualKind::kAlgebraic;
   setup.num_threads = context.threads;
-  const bool with_penalties = kind == ResidualKind::kVertical && PenaltiesEnabled(penalties);
+  // The all-roots stage takes the penalties too, its range through the roots.
+  const bool with_penalties =
+      (kind == ResidualKind::kVertical || kind == ResidualKind::kAllRoots) &&
+      PenaltiesEnabled(penalties);
   const int entries = context.fit.NumEntries();
   setup.held.assign(entries, false);
   std::vector<bool> released(entries, false);
