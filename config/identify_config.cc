@@ -267,8 +267,9 @@ std::array<bool, kNumParameters> ReadFixed(const ConfigValue& value, const Confi
 }
 
 std::vector<ResidualKind> ReadStages(const ConfigValue& value, const ConfigSource& source) {
-  const std::vector<std::string> allowed = {ResidualKindName(ResidualKind::kAlgebraic),
-                                            ResidualKindName(ResidualKind::kVertical)};
+  const std::vector<std::string> allowed = {
+      ResidualKindName(ResidualKind::kAlgebraic), ResidualKindName(ResidualKind::kVertical),
+      ResidualKindName(ResidualKind::kPhaseLag), ResidualKindName(ResidualKind::kAllRoots)};
   std::vector<ResidualKind> stages;
   for (const ConfigValue& entry : ReadList(value, source)) {
     const std::string name = ReadNonEmptyString(entry, source);

@@ -17,7 +17,8 @@ DEFINE_string(fix, "",
               "Adds parameters to the config's fixed list: comma list, e.g. delta,omega (each "
               "needs an initial_guess)");
 DEFINE_string(free, "", "Removes parameters from the config's fixed list: comma list, e.g. omega");
-DEFINE_string(stages, "", "Overrides the fit stages: comma list of algebraic, vertical");
+DEFINE_string(stages, "",
+              "Overrides the fit stages: comma list of algebraic, vertical, phase_lag, all_roots");
 DEFINE_string(residual_error, "", "Overrides residual.error: absolute or relative");
 DEFINE_int32(max_iterations, 0, "Overrides solver.max_iterations when positive");
 DEFINE_string(fit, "", "Overrides the fitted sweeps: comma list of ids or id/direction");

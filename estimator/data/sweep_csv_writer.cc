@@ -31,6 +31,7 @@ std::string FormatFrequencyHz(double omega_rad_s) {
 
 void WriteSweepsCsv(const std::vector<Sweep>& sweeps, std::ostream* out) {
   int with_sigma = 0;
+  int with_phase = 0;
   int points = 0;
   for (const Sweep& sweep : sweeps) {
     if (sweep.id.empty() || sweep.id.find_first_of(",\"\r\n") != std::string::npos) {
@@ -41,6 +42,7 @@ void WriteSweepsCsv(const std::vector<Sweep>& sweeps, std::ostream* out) {
     for (const DwellPoint& point : sweep.points) {
       ++points;
       if (point.sigma.has_value()) ++with_sigma;
+      if (point.phase_rad.has_value()) ++with_phase;
     }
   }
   if (with_sigma != 0 && with_sigma != points) {
@@ -48,12 +50,16 @@ void WriteSweepsCsv(const std::vector<Sweep>& sweeps, std::ostream* out) {
                      " dwells carry a sigma; give every dwell a sigma or none");
   }
   const bool sigma_column = with_sigma > 0;
-  *out << "sweep,direction,freq_hz,a_base,a" << (sigma_column ? ",sigma" : "") << "\n";
+  // The phase is written only where every dwell has one (it is optional data).
+  const bool phase_column = points > 0 && with_phase == points;
+  *out << "sweep,direction,freq_hz,a_base,a" << (phase_column ? ",phase_rad" : "")
+       << (sigma_column ? ",sigma" : "") << "\n";
   for (const Sweep& sweep : sweeps) {
     const char* direction = SweepDirectionName(sweep.direction);
     for (const DwellPoint& point : sweep.points) {
       *out << sweep.id << ',' << direction << ',' << FormatFrequencyHz(point.drive_frequency_rad_s)
            << ',' << FormatRoundTrip(point.a_base) << ',' << FormatRoundTrip(point.amplitude);
+      if (phase_column) *out << ',' << FormatRoundTrip(*point.phase_rad);
       if (sigma_column) *out << ',' << FormatRoundTrip(*point.sigma);
       *out << '\n';
     }

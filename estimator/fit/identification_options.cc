@@ -7,11 +7,22 @@
 namespace dwellfit {
 
 const char* ResidualKindName(ResidualKind kind) {
-  return kind == ResidualKind::kAlgebraic ? "algebraic" : "vertical";
+  switch (kind) {
+    case ResidualKind::kAlgebraic:
+      return "algebraic";
+    case ResidualKind::kVertical:
+      return "vertical";
+    case ResidualKind::kPhaseLag:
+      return "phase_lag";
+    case ResidualKind::kAllRoots:
+      return "all_roots";
+  }
+  return "vertical";
 }
 
 bool ResidualKindFromName(const std::string& name, ResidualKind* kind) {
-  for (ResidualKind k : {ResidualKind::kAlgebraic, ResidualKind::kVertical}) {
+  for (ResidualKind k : {ResidualKind::kAlgebraic, ResidualKind::kVertical, ResidualKind::kPhaseLag,
+                         ResidualKind::kAllRoots}) {
     if (name == ResidualKindName(k)) {
       *kind = k;
       return true;

@@ -17,6 +17,9 @@ namespace dwellfit {
 enum class ResidualKind {
   kAlgebraic,  // (G(a_i) - a_base_i^2) / a_base_i^2, eq. (3.11): smooth, branch-free
   kVertical,   // a_i - a_model(Omega_i, a_base_i) on the point's stable branch
+  // The chapter's earlier methods (docs/method-comparison.md):
+  kPhaseLag,  // eqs. (3.9)-(3.10) from the measured phase: two residuals per dwell
+  kAllRoots,  // a_i - the nearest stable root of all six of (3.11); jumps through the roots
 };
 const char* ResidualKindName(ResidualKind kind);
 bool ResidualKindFromName(const std::string& name, ResidualKind* kind);

@@ -4,11 +4,15 @@
 #include <cmath>
 #include <sstream>
 
+#include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/fit/mapped_cost_function.h"
 #include "dwellfit/residuals/functors/algebraic_residual.h"
+#include "dwellfit/residuals/functors/all_roots_residual.h"
 #include "dwellfit/residuals/functors/bifurcation_range_penalty.h"
 #include "dwellfit/residuals/functors/branch_stability_penalty.h"
 #include "dwellfit/residuals/functors/fold_condition_residual.h"
+#include "dwellfit/residuals/functors/phase_lag_residual.h"
+#include "dwellfit/residuals/functors/root_transition_penalty.h"
 #include "dwellfit/residuals/functors/vertical_error_residual.h"
 
 namespace dwellfit {
@@ -30,6 +34,11 @@ ceres::CostFunction* ProblemBuilder::MakeResidual(const DwellPoint& point) const
     return AlgebraicResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
                                      options_.dwell_weight);
   }
+  if (options_.residual == ResidualKind::kPhaseLag) {
+    // AddSweep has checked that every dwell carries its phase.
+    return PhaseLagResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
+                                    point.phase_rad.value_or(0.0), options_.dwell_weight);
+  }
   double weight = options_.dwell_weight;
   if (options_.residual_options.use_point_sigma && point.sigma) {
     // sigma is the standard deviation of a; in relative error it becomes
@@ -37,6 +46,11 @@ ceres::CostFunction* ProblemBuilder::MakeResidual(const DwellPoint& point) const
     weight *= options_.residual_options.error == ErrorMeasure::kAbsolute
                   ? 1.0 / *point.sigma
                   : (point.amplitude + options_.residual_options.amplitude_floor) / *point.sigma;
+  }
+  if (options_.residual == ResidualKind::kAllRoots) {
+    return AllRootsResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
+                                    options_.residual_options.error, weight,
+                                    options_.residual_options.amplitude_floor);
   }
   return VerticalErrorResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
                                        point.branch, options_.residual_options.error, weight,
@@ -53,6 +67,17 @@ void ProblemBuilder::Add(ceres::CostFunction* cost, const ParameterLayout& layou
 
 int ProblemBuilder::AddSweep(const Sweep& sweep, const ParameterLayout& layout,
                              ceres::Problem* problem, ParallelResidualEvaluator* evaluator) const {
+  if (options_.residual == ResidualKind::kPhaseLag) {
+    for (const DwellPoint& point : sweep.points) {
+      if (point.phase_rad && std::isfinite(*point.phase_rad)) continue;
+      throw InputError(sweep.source_file, point.source_line, "phase_deg",
+                       "the phase_lag stage needs the measured phase of every fitted dwell, and "
+                       "sweep '" +
+                           sweep.Name() +
+                           "' has none here; add a phase_deg or phase_rad "
+                           "column, or choose other stages");
+    }
+  }
   for (const DwellPoint& point : sweep.points) Add(MakeResidual(point), layout, problem, evaluator);
   return static_cast<int>(sweep.points.size());
 }
@@ -71,9 +96,16 @@ JumpTarget TargetOf(const Sweep& sweep, const JumpBracket& jump) {
 }
 
 ceres::CostFunction* MakeBifurcationRangePenalty(const Sweep& sweep, const JumpBracket& jump,
-                                                 const BifurcationRangeOptions& options) {
+                                                 const BifurcationRangeOptions& options,
+                                                 ResidualKind residual) {
   const DwellPoint& before = sweep.points[jump.index_before];
   const bool frequency = sweep.kind == SweepKind::kFrequency;
+  if (residual == ResidualKind::kAllRoots) {
+    // The all-roots method enforces the range through the roots (section 3.2.3).
+    return new RootTransitionPenalty(
+        sweep.kind, jump.kind, frequency ? before.a_base : before.drive_frequency_rad_s,
+        jump.control_before, jump.control_after, jump.amplitude_before, options.weight);
+  }
   // The dwell before the jump sits on the branch that ends.
   return BifurcationRangePenalty::Create(sweep.kind, jump.kind,
                                          frequency ? before.a_base : before.drive_frequency_rad_s,
@@ -117,7 +149,8 @@ int ProblemBuilder::AddPenalties(const Sweep& sweep, const ParameterLayout& layo
       if (std::find(range.enforce.begin(), range.enforce.end(), target) == range.enforce.end()) {
         continue;
       }
-      Add(algebraic ? MakeFoldCondition(sweep, jump) : MakeBifurcationRangePenalty(sweep, jump, range),
+      Add(algebraic ? MakeFoldCondition(sweep, jump)
+                    : MakeBifurcationRangePenalty(sweep, jump, range, options_.residual),
           layout, problem, evaluator);
       ++blocks;
     }

@@ -48,7 +48,9 @@ class ProblemBuilder {
   // `options` should be valid (IsValid); the staged solve checks them.
   explicit ProblemBuilder(const ProblemBuilderOptions& options);
 
-  // Adds one residual block per dwell of `sweep`, each reading the six
+  // Adds one residual block per dwell of `sweep` (two residuals each for
+  // kPhaseLag, which throws InputError naming the dwell when one has no
+  // measured phase), each reading the six
   // parameters where `layout` puts them (the blocks are owned by the caller
   // and must outlive `problem`). Returns the number of residual blocks
   // added. With an `evaluator` (the problem's evaluation callback, watching
@@ -87,10 +89,12 @@ class ProblemBuilder {
 // Which enforceable target a measured jump of `sweep` is.
 JumpTarget TargetOf(const Sweep& sweep, const JumpBracket& jump);
 
-// The bifurcation-range penalty of one measured jump (eq. 3.17), owned by the
-// caller; Ceres takes it.
+// The bifurcation-range penalty of one measured jump (eq. 3.17; for the
+// all-roots residual, RootTransitionPenalty: the range enforced through the
+// roots), owned by the caller; Ceres takes it.
 ceres::CostFunction* MakeBifurcationRangePenalty(const Sweep& sweep, const JumpBracket& jump,
-                                                 const BifurcationRangeOptions& options);
+                                                 const BifurcationRangeOptions& options,
+                                                 ResidualKind residual = ResidualKind::kVertical);
 
 // Whether the model at `p` has the fold of `jump` (the fold the
 // bifurcation-range penalty measures, within a factor 2 of the bracket).

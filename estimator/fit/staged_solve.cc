@@ -101,7 +101,7 @@ ceres::Solver::Summary SolveOnce(ResidualKind kind, const SolverSettings& settin
   problem->Configure();
   BoundRestWatcher watcher(problem->WatchedBounds(), kStepsAtBoundBeforeHolding);
   ceres::Solver::Options options = MakeSolverOptions(settings);
-  if (kind == ResidualKind::kVertical) {
+  if (kind == ResidualKind::kVertical || kind == ResidualKind::kAllRoots) {
     // No projected line search. With bounds set (eta_e, mu1, mu2 >= 0)
     // Ceres runs an Armijo search along every trust-region step; on the
     // vertical error, whose gradient spans some twenty decades (root
@@ -219,10 +219,13 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
               StageSummary* stage, std::string* failure) {
   StageSetup setup = MakeSetup(context, kind);
   // The algebraic stage takes the enforced jumps' fold conditions
-  // (ProblemBuilder::AddPenalties), unweighted by the data's cost.
+  // (ProblemBuilder::AddPenalties), unweighted by the data's cost; the
+  // all-roots stage takes the penalties too, its range through the roots.
   const bool fold_conditions =
       kind == ResidualKind::kAlgebraic && penalties.bifurcation_range.enabled;
-  const bool with_penalties = kind == ResidualKind::kVertical && PenaltiesEnabled(penalties);
+  const bool with_penalties =
+      (kind == ResidualKind::kVertical || kind == ResidualKind::kAllRoots) &&
+      PenaltiesEnabled(penalties);
   const int entries = context.fit.NumEntries();
   setup.held.assign(entries, false);
   std::vector<bool> released(entries, false);

@@ -220,6 +220,11 @@ SettledDwell SettleDwell(const ParameterVector& truth, double omega_drive_rad_s,
   return dwell;
 }
 
+double ResponseLag(const ParameterVector& truth, double omega_drive_rad_s, double amplitude) {
+  const auto k = ResponseCoefficients<double>::FromParameters(truth.data(), omega_drive_rad_s);
+  return std::atan2(k.P(amplitude), k.Q(amplitude));
+}
+
 std::vector<Sweep> SimulateDwells(const DwellPlan& plan) {
   std::string error;
   if (!plan.IsValid(&error)) throw InputError("dwell plan: " + error);
@@ -249,6 +254,7 @@ std::vector<Sweep> SimulateDwells(const DwellPlan& plan) {
         a = dwell.amplitude;
         point.amplitude = dwell.amplitude;
         point.branch = dwell.branch;
+        point.phase_rad = ResponseLag(plan.truth, point.drive_frequency_rad_s, dwell.amplitude);
         sweep.points.push_back(point);
       }
       sweeps.push_back(std::move(sweep));
@@ -287,7 +293,8 @@ void DescribeSimulation(const DwellPlan& plan, const std::vector<Sweep>& sweeps,
   const ParameterVector& p = plan.truth;
   *out << "truth: eta_e " << G12(p[kEtaE]) << ", mu1 " << G12(p[kMu1]) << " 1/s, mu2 "
        << G12(p[kMu2]) << ", delta " << G12(p[kDelta]) << ", alpha " << G12(p[kAlpha]) << ", w "
-       << G12(p[kNaturalFrequency]) << " rad/s (" << G12(RadPerSecondToHz(p[kNaturalFrequency])) << " Hz)\n";
+       << G12(p[kNaturalFrequency]) << " rad/s (" << G12(RadPerSecondToHz(p[kNaturalFrequency]))
+       << " Hz)\n";
   if (plan.noise.relative_sigma > 0.0) {
     *out << "noise: relative_sigma " << G12(plan.noise.relative_sigma) << ", seed "
          << plan.noise.seed << "\n";

@@ -100,9 +100,15 @@ struct SettledDwell {
 SettledDwell SettleDwell(const ParameterVector& truth, double omega_drive_rad_s, double a_base,
                          Branch side_before, double a_before);
 
+// The lag gamma [rad] of the response behind the base excitation at a fixed
+// point of amplitude `amplitude` (docs/model.md, "Phase convention"):
+// gamma = atan2(P(a), Q(a)) of eqs. (3.1)-(3.2), in (0, pi) for positive damping.
+double ResponseLag(const ParameterVector& truth, double omega_drive_rad_s, double amplitude);
+
 // Simulates every sweep of `plan`: one Sweep per (sweep, direction), in plan
 // order, with kind, direction, id, points (drive_frequency_rad_s, a_base,
-// amplitude with noise, true branch; source_line 0) and the true jumps
+// amplitude with noise, the noise-free phase lag ResponseLag, true branch;
+// source_line 0) and the true jumps
 // (controls in rad/s or a_base, amplitudes as output). Deterministic. Throws
 // InputError when the plan is not valid.
 std::vector<Sweep> SimulateDwells(const DwellPlan& plan);

@@ -85,7 +85,7 @@ class HostileInput : public ::testing::Test {
 TEST_F(HostileInput, AHugeAmplitudeStopsTheRunNamingRowAndColumn) {
   // Before: a = 1e308 gave final_cost -1 and the start reported as the estimate.
   std::vector<std::string> lines = lines_;
-  lines[6] = "F0.01,up,38.5,0.01,1e308";
+  lines[6] = "F0.01,up,38.5,0.01,1e308,0.02";
   const std::string data = WriteSweeps(lines);
   const InputError error = RunError(Config(data));
   EXPECT_EQ(error.file(), data);
@@ -97,7 +97,7 @@ TEST_F(HostileInput, AHugeAmplitudeStopsTheRunNamingRowAndColumn) {
 TEST_F(HostileInput, ASubnormalFrequencyStopsTheRun) {
   // Before: a garbage fit marked converged.
   std::vector<std::string> lines = lines_;
-  lines[6] = "F0.01,up,1e-320,0.01,0.0004";
+  lines[6] = "F0.01,up,1e-320,0.01,0.0004,0.02";
   const InputError error = RunError(Config(WriteSweeps(lines)));
   EXPECT_EQ(error.line(), 7);
   EXPECT_EQ(error.field(), "freq_hz");
@@ -136,7 +136,7 @@ TEST_F(HostileInput, EveryRowTwiceIsAnError) {
 TEST_F(HostileInput, AOnePointSweepCannotBeFittedAlone) {
   // Before: six parameters fitted to one dwell, "converged", result written.
   std::vector<std::string> lines = lines_;
-  lines.push_back("ONE,up,40,0.01,0.001");
+  lines.push_back("ONE,up,40,0.01,0.001,1.5");
   const InputError error = RunError(Config(WriteSweeps(lines), {{"fit", "[ONE]", "--fit"}}));
   EXPECT_EQ(error.file(), kThesis + "/beam.yaml");
   EXPECT_EQ(error.field(), "fit");

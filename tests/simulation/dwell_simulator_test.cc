@@ -352,7 +352,7 @@ TEST(SweepCsvWriter, NoisyDataWithSigmaRoundTripsThroughTheLoader) {
   }
   const std::string path = ::testing::TempDir() + "dwellfit_dwell_simulator_round_trip.csv";
   WriteSweepsCsvFile(sweeps, path);
-  EXPECT_EQ(ReadFile(path).substr(0, 37), "sweep,direction,freq_hz,a_base,a,sigm");
+  EXPECT_EQ(ReadFile(path).substr(0, 47), "sweep,direction,freq_hz,a_base,a,phase_rad,sigm");
 
   const LoadedSweeps loaded = LoadSweepsCsv(path);
   EXPECT_EQ(loaded.dropped_nonpositive, 0);
@@ -371,6 +371,8 @@ TEST(SweepCsvWriter, NoisyDataWithSigmaRoundTripsThroughTheLoader) {
       EXPECT_EQ(r.amplitude, w.amplitude);
       ASSERT_TRUE(r.sigma.has_value());
       EXPECT_EQ(*r.sigma, *w.sigma);
+      ASSERT_TRUE(r.phase_rad.has_value());
+      EXPECT_EQ(*r.phase_rad, *w.phase_rad);
     }
   }
 }

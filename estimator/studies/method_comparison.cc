@@ -1,0 +1,462 @@
+#include "dwellfit/estimator/studies/method_comparison.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+#include <sstream>
+#include <vector>
+
+#include "dwellfit/estimator/analysis/sweep_prediction.h"
+#include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/string_printf.h"
+#include "dwellfit/estimator/fit/identification.h"
+#include "dwellfit/estimator/run/resolved_run.h"
+
+namespace dwellfit {
+namespace {
+
+// One method of the chapter: the stages it fits with and what it enforces.
+struct Method {
+  std::string name;
+  std::vector<ResidualKind> stages;
+  bool range_penalty = false;  // the bifurcation range (through the roots for all_roots)
+  bool phase_bias = false;     // the measured phase is off by the study's bias
+  bool needs_phase = false;
+  // Multiplies the config's bifurcation_range.weight: the chapter enforces
+  // the ranges through the roots by "a large penalty" (section 3.2.3).
+  double range_weight = 1.0;
+};
+
+// The weight of the root-transition penalty in the all-roots method, in
+// units of the data's cost where the stage starts (docs/model.md): large, as
+// the chapter's; with weight 1 the measured beam's fit loses its jump-downs.
+constexpr double kAllRootsRangeWeight = 1e4;
+
+std::vector<Method> Methods(bool with_phase) {
+  using R = ResidualKind;
+  std::vector<Method> methods;
+  if (with_phase) {
+    methods.push_back({"phase lag", {R::kPhaseLag}, false, false, true});
+    methods.push_back({"phase lag, biased phase", {R::kPhaseLag}, false, true, true});
+  }
+  methods.push_back({"least squares (3.11)", {R::kAlgebraic}, false, false, false});
+  methods.push_back({"all roots + ranges",
+                     {R::kAlgebraic, R::kAllRoots},
+                     true,
+                     false,
+                     false,
+                     kAllRootsRangeWeight});
+  methods.push_back({"Newton, no penalty", {R::kAlgebraic, R::kVertical}, false, false, false});
+  methods.push_back({"Newton + ranges", {R::kAlgebraic, R::kVertical}, true, false, false});
+  return methods;
+}
+
+struct MethodFit {
+  IdentificationResult result;
+  double seconds = 0.0;
+  // |model fold - reference| / reference [%] of every measured jump-down;
+  // a missing fold counts 100 %.
+  std::vector<double> fitted_jump_down_errors;
+  std::vector<double> held_out_jump_down_errors;
+};
+
+// The jump-down errors of `sweeps` at `parameters`, against the folds of
+// `truth` when given, else against the measured brackets' centres.
+std::vector<double> JumpDownErrors(const std::vector<const Sweep*>& sweeps,
+                                   const ParameterVector& parameters,
+                                   const std::optional<ParameterVector>& truth) {
+  std::vector<double> errors;
+  for (const Sweep* sweep : sweeps) {
+    const std::vector<PredictedJump> model = PredictJumps(parameters, *sweep);
+    std::vector<PredictedJump> reference;
+    if (truth) reference = PredictJumps(*truth, *sweep);
+    for (size_t j = 0; j < model.size(); ++j) {
+      if (!model[j].measured || model[j].kind != JumpKind::kJumpDown) continue;
+      const double target = truth && j < reference.size() && reference[j].exists
+                                ? reference[j].control
+                                : model[j].bracket.centre();
+      errors.push_back(model[j].exists ? 100.0 * std::abs(model[j].control - target) / target
+                                       : 100.0);
+    }
+  }
+  return errors;
+}
+
+MethodFit FitMethod(const IdentifyConfig& config, const std::optional<std::vector<Sweep>>& sweeps,
+                    const Method& method, double phase_bias_rad,
+                    const std::optional<ParameterVector>& truth) {
+  ResolvedRun run = sweeps ? ResolveRun(config, *sweeps) : ResolveRun(config);
+  if (method.phase_bias) {
+    for (Sweep& sweep : run.sweeps) {
+      for (DwellPoint& point : sweep.points) {
+        if (point.phase_rad) *point.phase_rad += phase_bias_rad;
+      }
+    }
+  }
+  run.options.stages = method.stages;
+  run.options.penalties.branch_stability.enabled = false;
+  run.options.penalties.bifurcation_range.enabled = method.range_penalty;
+  run.options.penalties.bifurcation_range.weight *= method.range_weight;
+  MethodFit fit;
+  const auto start = std::chrono::steady_clock::now();
+  fit.result = FitRun(run).best;
+  fit.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  fit.fitted_jump_down_errors = JumpDownErrors(run.fitted, fit.result.parameters, truth);
+  fit.held_out_jump_down_errors = JumpDownErrors(run.validation, fit.result.parameters, truth);
+  return fit;
+}
+
+double Largest(const std::vector<double>& values) {
+  return values.empty() ? 0.0 : *std::max_element(values.begin(), values.end());
+}
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+double PercentError(double estimate, double reference) {
+  if (reference == 0.0) return estimate == 0.0 ? 0.0 : 100.0;
+  return 100.0 * std::abs(estimate - reference) / std::abs(reference);
+}
+
+// The rows: the free parameters and the effective nonlinearity.
+struct Quantity {
+  std::string name;
+  int index;  // ParameterIndex, or kNumParameters for alpha_e
+};
+
+std::vector<Quantity> Quantities(const IdentifyConfig& config, double omega_ref_rad_s) {
+  std::vector<Quantity> rows;
+  for (int i = 0; i < kNumParameters; ++i) {
+    if (!config.identification.fixed[i]) {
+      rows.push_back({i == kNaturalFrequency ? "w [Hz]" : ParameterName(i), i});
+    }
+  }
+  rows.push_back(
+      {StringPrintf("alpha_e at %.4g Hz", RadPerSecondToHz(omega_ref_rad_s)), kNumParameters});
+  return rows;
+}
+
+double ValueOf(const ParameterVector& p, int index, double omega_ref_rad_s) {
+  if (index == kNumParameters) return EffectiveNonlinearity(p, omega_ref_rad_s);
+  return index == kNaturalFrequency ? RadPerSecondToHz(p[index]) : p[index];
+}
+
+std::string Header(const std::vector<Method>& methods, const std::string& first) {
+  std::string text = first;
+  std::string rule = "|---|---|";
+  for (const Method& m : methods) {
+    text += " | " + m.name;
+    rule += "---|";
+  }
+  return text + " |\n" + rule + "\n";
+}
+
+}  // namespace
+
+namespace {
+
+// Fits of every method on one dataset (several replicas for the noise study).
+struct Comparison {
+  std::vector<Method> methods;
+  std::vector<std::vector<MethodFit>> fits;  // [method][replica]
+  std::vector<Quantity> quantities;
+  double omega_ref_rad_s = 0.0;
+};
+
+Comparison Compare(const IdentifyConfig& config, const std::vector<Method>& methods,
+                   const std::vector<std::optional<std::vector<Sweep>>>& replicas,
+                   double phase_bias_rad, const std::optional<ParameterVector>& truth) {
+  Comparison c;
+  c.methods = methods;
+  for (const Method& method : methods) {
+    c.fits.emplace_back();
+    for (const auto& sweeps : replicas) {
+      c.fits.back().push_back(FitMethod(config, sweeps, method, phase_bias_rad, truth));
+    }
+  }
+  // The reference frequency of alpha_e: the config's, else the truth's or the
+  // last method's w.
+  c.omega_ref_rad_s = config.omega_ref_rad_s.value_or(
+      truth ? (*truth)[kNaturalFrequency]
+            : c.fits.back().front().result.parameters[kNaturalFrequency]);
+  c.quantities = Quantities(config, c.omega_ref_rad_s);
+  return c;
+}
+
+// One table row: `cell(method's fits)` per method.
+template <typename Cell>
+void Row(const Comparison& c, const std::string& name, const std::string& second, const Cell& cell,
+         std::ostream& out) {
+  out << "| " << name << " | " << second;
+  for (const std::vector<MethodFit>& fits : c.fits) out << " | " << cell(fits);
+  out << " |\n";
+}
+
+template <typename Value>
+double Mean(const std::vector<MethodFit>& fits, const Value& value) {
+  double sum = 0.0;
+  for (const MethodFit& fit : fits) sum += value(fit);
+  return sum / static_cast<double>(fits.size());
+}
+
+void SolverRows(const Comparison& c, bool wall_time, std::ostream& out) {
+  Row(
+      c, "converged", "",
+      [](const std::vector<MethodFit>& fits) {
+        int n = 0;
+        for (const MethodFit& fit : fits) n += fit.result.converged;
+        return StringPrintf("%d of %zu", n, fits.size());
+      },
+      out);
+  Row(
+      c, "iterations", "",
+      [](const std::vector<MethodFit>& fits) {
+        return StringPrintf("%.4g",
+                            Mean(fits, [](const MethodFit& f) { return f.result.iterations; }));
+      },
+      out);
+  Row(
+      c, "fitted jump-downs: largest error %", "",
+      [](const std::vector<MethodFit>& fits) {
+        return StringPrintf("%.3g", Mean(fits, [](const MethodFit& f) {
+                              return Largest(f.fitted_jump_down_errors);
+                            }));
+      },
+      out);
+  Row(
+      c, "held-out jump-downs: median error %", "",
+      [](const std::vector<MethodFit>& fits) {
+        return StringPrintf("%.3g", Mean(fits, [](const MethodFit& f) {
+                              return Median(f.held_out_jump_down_errors);
+                            }));
+      },
+      out);
+  if (wall_time) {
+    Row(
+        c, "wall time [s]", "",
+        [](const std::vector<MethodFit>& fits) {
+          return StringPrintf("%.3g", Mean(fits, [](const MethodFit& f) { return f.seconds; }));
+        },
+        out);
+  }
+}
+
+}  // namespace
+
+namespace {
+
+// Table 3.1: estimate (and percent error) of every quantity by every method.
+void TruthTable(const Comparison& c, const ParameterVector& truth, bool wall_time,
+                std::ostream& out) {
+  out << Header(c.methods, "| quantity | known value");
+  for (const Quantity& q : c.quantities) {
+    const double known = ValueOf(truth, q.index, c.omega_ref_rad_s);
+    Row(
+        c, q.name, StringPrintf("%.6g", known),
+        [&](const std::vector<MethodFit>& fits) {
+          if (fits.size() == 1) {
+            const double estimate = ValueOf(fits[0].result.parameters, q.index, c.omega_ref_rad_s);
+            return StringPrintf("%.8g (%.2g %%)", estimate, PercentError(estimate, known));
+          }
+          return StringPrintf("%.3g %%", Mean(fits, [&](const MethodFit& f) {
+                                return PercentError(
+                                    ValueOf(f.result.parameters, q.index, c.omega_ref_rad_s),
+                                    known);
+                              }));
+        },
+        out);
+  }
+  SolverRows(c, wall_time, out);
+  out << "\n";
+}
+
+// Table 3.2: estimates side by side, each compared with the last method's.
+void SideBySideTable(const Comparison& c, bool wall_time, std::ostream& out) {
+  out << Header(c.methods, "| quantity | unit");
+  const ParameterVector& reference = c.fits.back().front().result.parameters;
+  for (const Quantity& q : c.quantities) {
+    const double ref = ValueOf(reference, q.index, c.omega_ref_rad_s);
+    Row(
+        c, q.name, q.index == kNaturalFrequency ? "Hz" : "",
+        [&](const std::vector<MethodFit>& f) {
+          const double estimate = ValueOf(f[0].result.parameters, q.index, c.omega_ref_rad_s);
+          if (ref == 0.0) return StringPrintf("%.6g (-)", estimate);
+          return StringPrintf("%.6g (%.3g %%)", estimate, PercentError(estimate, ref));
+        },
+        out);
+  }
+  SolverRows(c, wall_time, out);
+  out << "\n";
+}
+
+const MethodFit& FitOf(const Comparison& c, const std::string& name, int replica = 0) {
+  for (size_t m = 0; m < c.methods.size(); ++m) {
+    if (c.methods[m].name == name) return c.fits[m][replica];
+  }
+  throw InputError("method comparison: no method '" + name + "'");
+}
+
+// The largest relative difference [%] between two fits over the quantities.
+double LargestDifference(const Comparison& c, const MethodFit& a, const MethodFit& b) {
+  double largest = 0.0;
+  for (const Quantity& q : c.quantities) {
+    largest =
+        std::max(largest, PercentError(ValueOf(a.result.parameters, q.index, c.omega_ref_rad_s),
+                                       ValueOf(b.result.parameters, q.index, c.omega_ref_rad_s)));
+  }
+  return largest;
+}
+
+double LargestError(const Comparison& c, const MethodFit& fit, const ParameterVector& truth) {
+  double largest = 0.0;
+  for (const Quantity& q : c.quantities) {
+    largest =
+        std::max(largest, PercentError(ValueOf(fit.result.parameters, q.index, c.omega_ref_rad_s),
+                                       ValueOf(truth, q.index, c.omega_ref_rad_s)));
+  }
+  return largest;
+}
+
+}  // namespace
+
+bool MethodComparisonOptions::IsValid(std::string* error) const {
+  if (noise_seeds < 1) {
+    *error = StringPrintf("noise_seeds must be at least 1, got %d", noise_seeds);
+    return false;
+  }
+  if (!(relative_noise > 0.0 && relative_noise < 1.0)) {
+    *error = StringPrintf("relative_noise must lie in (0, 1), got %g", relative_noise);
+    return false;
+  }
+  if (!(std::abs(phase_bias_deg) < 90.0)) {
+    *error = StringPrintf("phase_bias_deg must lie in (-90, 90), got %g", phase_bias_deg);
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+void Introduction(const MethodComparisonOptions& options, std::ostream& out) {
+  out << "# The chapter's methods compared\n\n"
+      << "Generated by `build/tools/method_comparison` (from the repository root; see "
+         "docs/README.md); do not edit by hand. Each method is a list of `stages:` "
+         "(config/README.md) run from the config's start:\n\n"
+      << "- **phase lag**: `[phase_lag]`, eqs. (3.9)-(3.10) on the measured phase (section "
+         "3.1); **biased phase**: the same with every measured phase "
+      << StringPrintf("%+g", options.phase_bias_deg) << " degrees off;\n"
+      << "- **least squares (3.11)**: `[algebraic]`, the frequency-response equation alone "
+         "(3.2.1);\n"
+      << "- **all roots + ranges**: `[algebraic, all_roots]` with `penalties.bifurcation_range` "
+         "on: the nearest stable of all six roots, each enforced jump's saddle and node roots "
+         "turning complex inside its bracket (3.2.2-3.2.3), the range weight 1e4 times the "
+         "config's (the chapter's \"large penalty\");\n"
+      << "- **Newton, no penalty** and **Newton + ranges**: `[algebraic, vertical]`, the "
+         "vertical error by Newton refinement (3.2.4), without and with the eq. (3.17) "
+         "penalty.\n\n"
+      << "Jump-down errors compare each fold of the fitted model with the true model's fold "
+         "(numerical case) or with the centre of the measured bracket (measured data); a "
+         "missing fold counts 100 %. Wall-clock times differ between runs and machines, so "
+         "this file leaves them out (`method_comparison --wall_time` adds them); the "
+         "residuals' cost is timed by `build/benchmarks/method_residual_benchmark`.\n\n";
+}
+
+std::vector<std::optional<std::vector<Sweep>>> NoisyReplicas(
+    const DwellPlan& plan, const MethodComparisonOptions& options) {
+  std::vector<std::optional<std::vector<Sweep>>> replicas;
+  for (int r = 0; r < options.noise_seeds; ++r) {
+    DwellPlan noisy = plan;
+    noisy.noise.relative_sigma = options.relative_noise;
+    noisy.noise.seed = options.first_seed + static_cast<std::uint64_t>(r);
+    replicas.emplace_back(SimulateDwells(noisy));
+  }
+  return replicas;
+}
+
+void Findings(const Comparison& exact, const Comparison& noisy, const Comparison& measured,
+              const DwellPlan& plan, const MethodComparisonOptions& options, std::ostream& out) {
+  const MethodFit& phase = FitOf(exact, "phase lag");
+  const MethodFit& biased = FitOf(exact, "phase lag, biased phase");
+  out << "## Findings\n\n"
+      << StringPrintf(
+             "- **Phase errors.** On exact data the phase-lag fit is exact (largest "
+             "error %.2g %%); with the phase %+g degrees off its largest error is "
+             "%.3g %%.\n",
+             LargestError(exact, phase, plan.truth), options.phase_bias_deg,
+             LargestError(exact, biased, plan.truth));
+  auto mean_largest = [](const Comparison& c, const std::string& name) {
+    for (size_t m = 0; m < c.methods.size(); ++m) {
+      if (c.methods[m].name != name) continue;
+      return Mean(c.fits[m], [](const MethodFit& f) { return Largest(f.fitted_jump_down_errors); });
+    }
+    return 0.0;
+  };
+  out << StringPrintf(
+      "- **Least squares alone and the jump-downs.** Largest fitted jump-down error: with %g %% "
+      "noise %.3g %% (least squares) against %.3g %% (Newton + ranges); on the measured beam "
+      "%.3g %% against %.3g %%, held-out median %.3g %% against %.3g %%.\n",
+      100.0 * options.relative_noise, mean_largest(noisy, "least squares (3.11)"),
+      mean_largest(noisy, "Newton + ranges"), mean_largest(measured, "least squares (3.11)"),
+      mean_largest(measured, "Newton + ranges"),
+      Median(FitOf(measured, "least squares (3.11)").held_out_jump_down_errors),
+      Median(FitOf(measured, "Newton + ranges").held_out_jump_down_errors));
+  double noisy_difference = 0.0;
+  for (int r = 0; r < options.noise_seeds; ++r) {
+    noisy_difference =
+        std::max(noisy_difference, LargestDifference(noisy, FitOf(noisy, "all roots + ranges", r),
+                                                     FitOf(noisy, "Newton + ranges", r)));
+  }
+  out << StringPrintf(
+      "- **All roots against Newton refinement.** Largest difference between their estimates: "
+      "%.2g %% on exact data, %.3g %% over the noisy replicas, %.3g %% on the measured beam. "
+      "Per residual evaluation the all-roots residual is the slower; "
+      "`build/benchmarks/method_residual_benchmark` measures the ratio.\n\n",
+      LargestDifference(exact, FitOf(exact, "all roots + ranges"), FitOf(exact, "Newton + ranges")),
+      noisy_difference,
+      LargestDifference(measured, FitOf(measured, "all roots + ranges"),
+                        FitOf(measured, "Newton + ranges")));
+}
+
+std::string DatasetName(const IdentifyConfig& config) {
+  const std::string::size_type at = config.config_path.rfind("datasets/");
+  return config.config_path.substr(at == std::string::npos ? 0 : at);
+}
+
+}  // namespace
+
+std::string MethodComparisonMarkdown(const IdentifyConfig& numerical, const DwellPlan& plan,
+                                     const IdentifyConfig& measured,
+                                     const MethodComparisonOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw InputError("method comparison: " + error);
+  const double bias_rad = options.phase_bias_deg * kPi / 180.0;
+  std::ostringstream out;
+  Introduction(options, out);
+  const Comparison exact = Compare(numerical, Methods(true), {std::nullopt}, bias_rad, plan.truth);
+  out << "## Numerical case, exact data (as Table 3.1): `" << DatasetName(numerical) << "`\n\n"
+      << "Each cell: the estimate and its percent error.\n\n";
+  TruthTable(exact, plan.truth, options.wall_time, out);
+  const Comparison noisy =
+      Compare(numerical, Methods(true), NoisyReplicas(plan, options), bias_rad, plan.truth);
+  out << StringPrintf("## Numerical case, %g %% amplitude noise, %d seeds (%llu-%llu)\n\n",
+                      100.0 * options.relative_noise, options.noise_seeds,
+                      static_cast<unsigned long long>(options.first_seed),
+                      static_cast<unsigned long long>(options.first_seed + options.noise_seeds - 1))
+      << "Each cell: the mean over the seeds of the percent error; rows below it, means too. "
+         "The phase is the exact fixed point's (noise on the amplitude only).\n\n";
+  TruthTable(noisy, plan.truth, options.wall_time, out);
+  const Comparison beam = Compare(measured, Methods(false), {std::nullopt}, bias_rad, {});
+  out << "## Measured beam (as Table 3.2): `" << DatasetName(measured) << "`\n\n"
+      << "No phase was measured, so the phase-lag fit does not apply. Each cell: the estimate "
+         "and its percent difference from the last column's.\n\n";
+  SideBySideTable(beam, options.wall_time, out);
+  Findings(exact, noisy, beam, plan, options, out);
+  return out.str();
+}
+
+}  // namespace dwellfit
