@@ -31,6 +31,7 @@ std::string FormatFrequencyHz(double omega_rad_s) {
 
 void WriteSweepsCsv(const std::vector<Sweep>& sweeps, std::ostream* out) {
   int with_sigma = 0;
+  int with_phase = 0;
   int points = 0;
   for (const Sweep& sweep : sweeps) {
     if (sweep.id.empty() || sweep.id.find_first_of(",\"\r\n") != std::string::npos) {
@@ -41,19 +42,27 @@ void WriteSweepsCsv(const std::vector<Sweep>& sweeps, std::ostream* out) {
     for (const DwellPoint& point : sweep.points) {
       ++points;
       if (point.sigma.has_value()) ++with_sigma;
+      if (point.phase_rad.has_value()) ++with_phase;
     }
   }
   if (with_sigma != 0 && with_sigma != points) {
     throw InputError(std::to_string(with_sigma) + " of " + std::to_string(points) +
                      " dwells carry a sigma; give every dwell a sigma or none");
   }
+  if (with_phase != 0 && with_phase != points) {
+    throw InputError(std::to_string(with_phase) + " of " + std::to_string(points) +
+                     " dwells carry a phase; give every dwell a phase or none");
+  }
   const bool sigma_column = with_sigma > 0;
-  *out << "sweep,direction,freq_hz,a_base,a" << (sigma_column ? ",sigma" : "") << "\n";
+  const bool phase_column = with_phase > 0;
+  *out << "sweep,direction,freq_hz,a_base,a" << (phase_column ? ",phase_rad" : "")
+       << (sigma_column ? ",sigma" : "") << "\n";
   for (const Sweep& sweep : sweeps) {
     const char* direction = SweepDirectionName(sweep.direction);
     for (const DwellPoint& point : sweep.points) {
       *out << sweep.id << ',' << direction << ',' << FormatFrequencyHz(point.drive_frequency_rad_s)
            << ',' << FormatRoundTrip(point.a_base) << ',' << FormatRoundTrip(point.amplitude);
+      if (phase_column) *out << ',' << FormatRoundTrip(*point.phase_rad);
       if (sigma_column) *out << ',' << FormatRoundTrip(*point.sigma);
       *out << '\n';
     }

@@ -1,8 +1,8 @@
 // Writing sine-dwell sweeps in the project's CSV format (read by
 // LoadSweepsCsv, estimator/data/sweep_csv.h).
 //
-// Header `sweep,direction,freq_hz,a_base,a`, plus `sigma` when the points carry
-// one; then one row per dwell, sweeps in the given order and each sweep's
+// Header `sweep,direction,freq_hz,a_base,a`, plus `phase_rad` and `sigma` when
+// the points carry them (each all or nothing); then one row per dwell, sweeps in the given order and each sweep's
 // points in measurement order. Every number is printed so that reading it
 // back gives the same double:
 //   freq_hz  the shortest decimal f with HzToRadPerSecond(f) equal to the
