@@ -148,7 +148,8 @@ DwellResult AnalyzeDwell(const DwellTrace& dwell, const TraceProcessingOptions& 
   CheckTraces(dwell, options.harmonics);
   const double fs = dwell.sample_rate_hz;
   const double per_period = fs / RadPerSecondToHz(dwell.drive_frequency_rad_s);
-  const int periods = static_cast<int>(std::floor(dwell.base.size() / per_period + 1e-9));
+  // Whole periods to within half a sample: a record of round(P fs / f) samples holds P.
+  const int periods = static_cast<int>(std::floor((dwell.base.size() + 0.5) / per_period));
   const std::vector<double> base = LastPeriods(dwell.base, per_period, periods);
   const std::vector<double> volts = LastPeriods(dwell.response, per_period, periods);
   const RigChannels none;
