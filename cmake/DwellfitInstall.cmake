@@ -3,7 +3,8 @@
 #   <prefix>/include/dwellfit/{residuals,estimator,config}/<stage>/*.h
 #   <prefix>/lib/libdwellfit_<stage>.a (one archive per stage of the data path)
 #   <prefix>/lib/cmake/dwellfit/dwellfit{Config,ConfigVersion,Targets}.cmake
-#   <prefix>/bin/dwellfit-identify, dwellfit-simulate-dwell
+#   <prefix>/bin/dwellfit-identify, dwellfit-simulate-dwell, dwellfit-simulate-rig,
+#   dwellfit-process-traces
 #
 # Outside code: find_package(dwellfit) and link dwellfit::dwellfit (all of
 # the library) or one stage (dwellfit::residuals, the header-only functors;
@@ -49,7 +50,7 @@ install(FILES
 
 # The command-line tools keep their build names (build/tools/identify) but are
 # installed with a dwellfit- prefix: ImageMagick already installs `identify`.
-foreach(tool identify simulate_dwell)
+foreach(tool identify simulate_dwell simulate_rig process_traces)
   if(TARGET ${tool})
     string(REPLACE "_" "-" installed_name "dwellfit-${tool}")
     install(PROGRAMS $<TARGET_FILE:${tool}>

@@ -49,9 +49,12 @@ void WriteSweepsCsv(const std::vector<Sweep>& sweeps, std::ostream* out) {
     throw InputError(std::to_string(with_sigma) + " of " + std::to_string(points) +
                      " dwells carry a sigma; give every dwell a sigma or none");
   }
+  if (with_phase != 0 && with_phase != points) {
+    throw InputError(std::to_string(with_phase) + " of " + std::to_string(points) +
+                     " dwells carry a phase; give every dwell a phase or none");
+  }
   const bool sigma_column = with_sigma > 0;
-  // The phase is written only where every dwell has one (it is optional data).
-  const bool phase_column = points > 0 && with_phase == points;
+  const bool phase_column = with_phase > 0;
   *out << "sweep,direction,freq_hz,a_base,a" << (phase_column ? ",phase_rad" : "")
        << (sigma_column ? ",sigma" : "") << "\n";
   for (const Sweep& sweep : sweeps) {

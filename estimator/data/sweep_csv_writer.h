@@ -1,10 +1,10 @@
 // Writing sine-dwell sweeps in the project's CSV format (read by
 // LoadSweepsCsv, estimator/data/sweep_csv.h).
 //
-// Header `sweep,direction,freq_hz,a_base,a`, plus `phase_rad` when every
-// point carries a phase and `sigma` when the points carry one; then one row per dwell, sweeps in the given order and each sweep's
-// points in measurement order. Every number is printed so that reading it
-// back gives the same double:
+// Header `sweep,direction,freq_hz,a_base,a`, plus `phase_rad` and `sigma` when
+// the points carry them (each all or nothing); then one row per dwell, sweeps
+// in the given order and each sweep's points in measurement order. Every
+// number is printed so that reading it back gives the same double:
 //   freq_hz  the shortest decimal f with HzToRadPerSecond(f) equal to the
 //            point's drive_frequency_rad_s (so 41.5, not 41.500000000000007);
 //   others   the shortest round-trip representation (std::to_chars).

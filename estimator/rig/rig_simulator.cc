@@ -1,0 +1,328 @@
+#include "dwellfit/estimator/rig/rig_simulator.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <complex>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "boost/numeric/odeint.hpp"
+#include "boost/random/normal_distribution.hpp"
+#include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/string_printf.h"
+#include "dwellfit/estimator/data/sweep_csv_writer.h"
+
+namespace dwellfit {
+namespace {
+
+namespace odeint = boost::numeric::odeint;
+using Complex = std::complex<double>;
+// Scaled state: u/U, u'/(Omega U), base filter y_b/a_base, response filter
+// y_r/(V_U), and the running integrals of u cos(theta), u sin(theta) in U/Omega;
+// U the dwell's amplitude scale, V_U its small-signal voltage.
+using State = std::array<double, 6>;
+
+// The rig during one dwell: eq. (3.12) with the two channel filters and the
+// first-harmonic integrals, on the scaled state.
+struct RigEquation {
+  ParameterVector p;
+  double omega;  // drive [rad/s]
+  double a_base;
+  double phase0;      // the drive's phase at t = 0
+  double scale;       // U [m]
+  double volt_scale;  // V_U [V]
+  double base_pole;   // 2 pi f_c [rad/s], 0: no filter
+  double response_pole;
+  const StrainGauge* gauge;
+
+  void operator()(const State& x, State& dxdt, double t) const {
+    const double theta = omega * t + phase0;
+    const double u = scale * x[0];
+    const double v = omega * scale * x[1];
+    const double w = p[kNaturalFrequency];
+    const double drive = a_base * std::cos(theta);
+    const double restoring = w * w * u + p[kDelta] * u * v * v + p[kAlpha] * u * u * u;
+    const double damping = 2.0 * p[kMu1] * v + (p[kMu2] / omega) * v * std::abs(v);
+    const double acc = (2.0 * p[kEtaE] * drive - restoring - damping) / (1.0 + p[kDelta] * u * u);
+    dxdt[0] = omega * x[1];
+    dxdt[1] = acc / (omega * scale);
+    dxdt[2] = base_pole > 0.0 ? base_pole * (drive / a_base - x[2]) : 0.0;
+    dxdt[3] = response_pole > 0.0
+                  ? response_pole * (gauge->VoltageFromDisplacement(u) / volt_scale - x[3])
+                  : 0.0;
+    dxdt[4] = x[0] * std::cos(theta) * omega;
+    dxdt[5] = x[0] * std::sin(theta) * omega;
+  }
+};
+
+struct PhysicalState {
+  double u = 0.0, v = 0.0, y_base = 0.0, y_response = 0.0;
+  double phase = 0.0;      // the drive's phase now
+  double amplitude = 0.0;  // last first-harmonic amplitude
+};
+
+using Stepper = odeint::controlled_runge_kutta<odeint::runge_kutta_dopri5<State>>;
+
+// One dwell: settle, then record. Updates `state`.
+class DwellRun {
+ public:
+  DwellRun(const ParameterVector& p, const RigOptions& options, const StrainGauge& gauge,
+           double omega, double a_base, PhysicalState* state)
+      : options_(options), state_(state), period_(kTwoPi / omega) {
+    const double w = p[kNaturalFrequency];
+    const double linear =
+        2.0 * p[kEtaE] * a_base / std::hypot(w * w - omega * omega, 2.0 * p[kMu1] * omega);
+    const double scale = std::max(state->amplitude, 0.1 * linear);
+    const double volt_scale = std::abs(gauge.SmallSignalVoltsPerMetre()) * scale;
+    const auto pole = [](double cutoff_hz) { return cutoff_hz > 0.0 ? kTwoPi * cutoff_hz : 0.0; };
+    equation_ = {p,
+                 omega,
+                 a_base,
+                 state->phase,
+                 scale,
+                 volt_scale,
+                 pole(options.channels.base_filter_cutoff_hz),
+                 pole(options.channels.response_filter_cutoff_hz),
+                 &gauge};
+    x_ = {state->u / scale,
+          state->v / (omega * scale),
+          state->y_base / a_base,
+          state->y_response / volt_scale,
+          0.0,
+          0.0};
+    stepper_ = odeint::make_controlled(options.integration_tolerance, options.integration_tolerance,
+                                       odeint::runge_kutta_dopri5<State>());
+  }
+
+  RigDwellTruth Settle();
+  void Record(DwellTrace* trace);
+  void Finish(const RigDwellTruth& truth);
+
+ private:
+  // Integrates one period from t_; returns the first harmonic H of u over it.
+  Complex OnePeriod() {
+    x_[4] = x_[5] = 0.0;
+    odeint::integrate_adaptive(stepper_, equation_, x_, t_, t_ + period_, period_ / 32);
+    t_ += period_;
+    return 2.0 / period_ * equation_.scale / equation_.omega * Complex(x_[4], -x_[5]);
+  }
+
+  const RigOptions& options_;
+  PhysicalState* state_;
+  double period_;
+  double t_ = 0.0;
+  RigEquation equation_;
+  State x_;
+  Stepper stepper_;
+  Complex last_harmonic_;
+};
+
+RigDwellTruth DwellRun::Settle() {
+  const int window = options_.settle_window_periods;
+  std::vector<Complex> history;
+  int good_checks = 0;
+  RigDwellTruth truth;
+  while (static_cast<int>(history.size()) < options_.max_settle_periods) {
+    history.push_back(OnePeriod());
+    const int k = static_cast<int>(history.size());
+    if (k % window != 0 || k < 2 * window) continue;
+    const Complex now = history.back();
+    const bool steady =
+        std::abs(now - history[k - 1 - window]) <= options_.settle_tolerance * std::abs(now);
+    good_checks = steady ? good_checks + 1 : 0;
+    if (good_checks >= 2) {
+      truth.settled = true;
+      break;
+    }
+  }
+  last_harmonic_ = history.back();
+  truth.settle_periods = static_cast<int>(history.size());
+  truth.amplitude = std::abs(last_harmonic_);
+  truth.lag_rad = -std::arg(last_harmonic_);
+  return truth;
+}
+
+void DwellRun::Record(DwellTrace* trace) {
+  const double fs = options_.sample_rate_hz;
+  const double tau = options_.channels.skew_samples / fs;
+  const int n = static_cast<int>(std::lround(options_.record_periods * period_ * fs));
+  const double start = t_ + std::max(0.0, -tau);
+  // Sample times of both channels, in time order: (time, channel 0 base / 1 response).
+  std::vector<std::pair<double, int>> events;
+  for (int j = 0; j < n; ++j) {
+    events.emplace_back(start + j / fs, 0);
+    events.emplace_back(start + j / fs + tau, 1);
+  }
+  std::stable_sort(events.begin(), events.end());
+  std::vector<double> times;
+  for (const auto& event : events) {
+    if (times.empty() || event.first > times.back()) times.push_back(event.first);
+  }
+  trace->base.reserve(n);
+  trace->response.reserve(n);
+  std::size_t next = 0;
+  auto observe = [&](const State& x, double t) {
+    for (; next < events.size() && events[next].first <= t; ++next) {
+      const RigEquation& e = equation_;
+      if (events[next].second == 0) {
+        const double y =
+            e.base_pole > 0.0 ? e.a_base * x[2] : e.a_base * std::cos(e.omega * t + e.phase0);
+        trace->base.push_back(static_cast<float>(y));
+      } else {
+        const double y = e.response_pole > 0.0 ? e.volt_scale * x[3]
+                                               : e.gauge->VoltageFromDisplacement(e.scale * x[0]);
+        trace->response.push_back(static_cast<float>(y));
+      }
+    }
+  };
+  odeint::integrate_times(stepper_, equation_, x_, times.begin(), times.end(), period_ / 32,
+                          observe);
+  t_ = times.back();
+}
+
+void DwellRun::Finish(const RigDwellTruth& truth) {
+  const RigEquation& e = equation_;
+  state_->u = e.scale * x_[0];
+  state_->v = e.omega * e.scale * x_[1];
+  state_->y_base = e.a_base * x_[2];
+  state_->y_response = e.volt_scale * x_[3];
+  state_->phase = std::fmod(e.phase0 + e.omega * t_, kTwoPi);
+  state_->amplitude = truth.amplitude;
+}
+
+// |H(f)| of a one-pole filter (1 without one).
+double FilterGain(double cutoff_hz, double f_hz) {
+  return cutoff_hz > 0.0 ? 1.0 / std::hypot(1.0, f_hz / cutoff_hz) : 1.0;
+}
+
+// Per-sample noise of standard deviation relative_sigma A sqrt(N/2), A the
+// channel's amplitude: the first harmonic of N samples then carries a
+// relative error of relative_sigma (header).
+void AddNoise(const RigOptions& options, const StrainGauge& gauge, double a_base,
+              const RigDwellTruth& truth, double f_hz, std::mt19937_64* random, DwellTrace* trace) {
+  if (options.noise_relative_sigma == 0.0) return;
+  boost::random::normal_distribution<double> normal(
+      0.0, options.noise_relative_sigma * std::sqrt(0.5 * trace->base.size()));
+  const double base_amplitude = a_base * FilterGain(options.channels.base_filter_cutoff_hz, f_hz);
+  const double volt_amplitude = std::abs(gauge.VoltageFromDisplacement(truth.amplitude)) *
+                                FilterGain(options.channels.response_filter_cutoff_hz, f_hz);
+  for (float& y : trace->base) y += static_cast<float>(base_amplitude * normal(*random));
+  for (float& y : trace->response) y += static_cast<float>(volt_amplitude * normal(*random));
+}
+
+void CheckPlan(const DwellPlan& plan, const RigOptions& options) {
+  std::string error;
+  if (!plan.IsValid(&error)) throw InputError("plan: " + error);
+  if (!options.IsValid(&error)) throw InputError("rig: " + error);
+  if (plan.noise.relative_sigma != 0.0) {
+    throw InputError(
+        "plan: the plan's noise applies to dwell amplitudes; set it to 0 (or leave "
+        "it out) and give the rig's noise instead");
+  }
+  for (const SweepPlan& sweep : plan.sweeps) {
+    if (sweep.start_branch == Branch::kUpper) {
+      throw InputError("plan: sweep '" + sweep.id +
+                       "' asks to start on the upper branch; the "
+                       "rig starts every sweep from rest (leave `start` out)");
+    }
+  }
+}
+
+}  // namespace
+
+bool RigOptions::IsValid(std::string* error) const {
+  if (!channels.IsValid(error) || !gauge.IsValid(error)) return false;
+  if (!(sample_rate_hz > 0.0 && std::isfinite(sample_rate_hz)) || record_periods < 1) {
+    *error = "sample_rate_hz must be positive and record_periods at least 1";
+    return false;
+  }
+  if (!(settle_tolerance > 0.0) || settle_window_periods < 1 ||
+      max_settle_periods < 2 * settle_window_periods) {
+    *error =
+        "settle_tolerance must be positive, window_periods >= 1 and max_periods at least "
+        "twice window_periods";
+    return false;
+  }
+  if (!(noise_relative_sigma >= 0.0 && noise_relative_sigma < 1.0)) {
+    *error = StringPrintf("noise relative_sigma must lie in [0, 1), got %g", noise_relative_sigma);
+    return false;
+  }
+  if (!(integration_tolerance > 0.0 && integration_tolerance < 1e-3)) {
+    *error = "integration_tolerance must lie in (0, 1e-3)";
+    return false;
+  }
+  return true;
+}
+
+RigRun SimulateRig(const DwellPlan& plan, const RigOptions& options, const RigProgress& progress) {
+  CheckPlan(plan, options);
+  const StrainGauge gauge(options.gauge);
+  std::mt19937_64 random(options.noise_seed);
+  int total = 0;
+  for (const SweepPlan& sweep : plan.sweeps) {
+    for (SweepDirection direction : sweep.directions) {
+      total += static_cast<int>(ControlGrid(sweep, direction).size());
+    }
+  }
+  RigRun run;
+  for (const SweepPlan& sweep : plan.sweeps) {
+    PhysicalState state;  // every sweep starts from rest
+    for (SweepDirection direction : sweep.directions) {
+      Sweep truth;
+      truth.id = sweep.id;
+      truth.direction = direction;
+      truth.kind = sweep.kind;
+      for (double control : ControlGrid(sweep, direction)) {
+        const bool frequency = sweep.kind == SweepKind::kFrequency;
+        const double f_hz = frequency ? control : sweep.held_frequency_hz;
+        const double a_base = frequency ? sweep.held_a_base : control;
+        DwellRun dwell(plan.truth, options, gauge, HzToRadPerSecond(f_hz), a_base, &state);
+        const RigDwellTruth dwell_truth = dwell.Settle();
+        DwellTrace trace{sweep.id, direction, sweep.kind, HzToRadPerSecond(f_hz),
+                         options.sample_rate_hz};
+        dwell.Record(&trace);
+        dwell.Finish(dwell_truth);
+        AddNoise(options, gauge, a_base, dwell_truth, f_hz, &random, &trace);
+        DwellPoint point;
+        point.drive_frequency_rad_s = HzToRadPerSecond(f_hz);
+        point.a_base = a_base;
+        point.amplitude = dwell_truth.amplitude;
+        point.phase_rad = dwell_truth.lag_rad;
+        truth.points.push_back(point);
+        run.traces.push_back(std::move(trace));
+        run.dwell_truth.push_back(dwell_truth);
+        if (progress) progress(static_cast<int>(run.traces.size()), total);
+      }
+      run.truth.push_back(std::move(truth));
+    }
+  }
+  return run;
+}
+
+void WriteRigTruthCsv(const RigRun& run, const std::string& path) {
+  std::ostringstream text;
+  text << "sweep,direction,freq_hz,a_base,a,phase_deg,settled,settle_periods\n";
+  std::size_t i = 0;
+  for (const Sweep& sweep : run.truth) {
+    for (const DwellPoint& point : sweep.points) {
+      const RigDwellTruth& truth = run.dwell_truth[i++];
+      text << sweep.id << ',' << SweepDirectionName(sweep.direction) << ','
+           << FormatFrequencyHz(point.drive_frequency_rad_s) << ',' << FormatRoundTrip(point.a_base)
+           << ',' << FormatRoundTrip(point.amplitude) << ','
+           << StringPrintf("%.6f", *point.phase_rad * 360.0 / kTwoPi) << ','
+           << (truth.settled ? "true" : "false") << ',' << truth.settle_periods << '\n';
+    }
+  }
+  const std::string staged = path + ".partial";
+  std::ofstream file(staged, std::ios::binary | std::ios::trunc);
+  file << text.str();
+  file.close();
+  if (!file || std::rename(staged.c_str(), path.c_str()) != 0) {
+    throw InputError(path, 0, "", "cannot write the truth file; check that its folder is writable");
+  }
+}
+
+}  // namespace dwellfit

@@ -1,0 +1,108 @@
+// Turns the time traces of a sine-dwell test into the sweeps CSV identify
+// reads (with the phase), and optionally identifies the parameters by
+// harmonic balance (estimator/traces/harmonic_balance.h).
+//
+//   process_traces --rig datasets/virtual-beam/rig.yaml \
+//                  --traces datasets/virtual-beam/traces \
+//                  --out datasets/virtual-beam/sweeps.csv \
+//                  [--harmonic_balance=hb.yaml [--reference_hz=41.5]]
+//
+// Warnings (unsettled dwells, strong harmonics, base levels off the sweep's
+// mean) are printed. With an unsettled dwell nothing is written and the exit
+// code is 3, unless --allow_unsettled; bad input exits 1.
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "dwellfit/config/rig_config_reader.h"
+#include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/data/sweep_csv_writer.h"
+#include "dwellfit/estimator/traces/harmonic_balance.h"
+#include "dwellfit/estimator/traces/trace_processing.h"
+#include "gflags/gflags.h"
+#include "glog/logging.h"
+
+DEFINE_string(rig, "", "YAML rig: channels, beam and gauge, processing (required).");
+DEFINE_string(traces, "", "Folder holding traces.csv and traces.f32 (required).");
+DEFINE_string(out, "", "Sweeps CSV to write (sweep,direction,freq_hz,a_base,a,phase_rad).");
+DEFINE_string(harmonic_balance, "", "If set, also identify by harmonic balance into this YAML.");
+DEFINE_double(reference_hz, 0.0, "Omega_ref [Hz] of the effective nonlinearity (0: identified w).");
+DEFINE_bool(allow_unsettled, false, "Write the results even when a dwell looks unsettled.");
+
+namespace {
+
+// Stages `text` as `path`.partial, listed in `staged` (removed again when the
+// run fails); Commit renames it into place.
+std::string Stage(const std::string& text, const std::string& path,
+                  std::vector<std::string>* staged) {
+  const std::string name = path + ".partial";
+  staged->push_back(name);
+  std::ofstream file(name, std::ios::binary | std::ios::trunc);
+  file << text;
+  file.close();
+  if (!file) throw dwellfit::InputError(path, 0, "", "cannot write the file; check its folder");
+  return name;
+}
+
+void Commit(const std::string& staged, const std::string& path) {
+  if (std::rename(staged.c_str(), path.c_str()) != 0) {
+    throw dwellfit::InputError(path, 0, "", "cannot rename the written file into place");
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  google::InitGoogleLogging(argv[0]);
+  gflags::SetUsageMessage(
+      "Dwell points (and optionally harmonic-balance estimates) from sine-dwell time traces.\n"
+      "Usage: process_traces --rig rig.yaml --traces folder --out sweeps.csv");
+  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  if (FLAGS_rig.empty() || FLAGS_traces.empty() || FLAGS_out.empty()) {
+    std::cerr << "process_traces: give --rig, --traces and --out\n"
+              << gflags::ProgramUsage() << "\n";
+    return 2;
+  }
+  std::vector<std::string> staged;
+  try {
+    const dwellfit::RigConfig rig = dwellfit::ReadRigConfig(FLAGS_rig);
+    const auto dwells = dwellfit::ReadTraceSet(FLAGS_traces);
+    const dwellfit::ProcessedTraces processed = dwellfit::ProcessTraces(dwells, rig.processing);
+    for (const std::string& warning : processed.warnings) {
+      std::cerr << "warning: " << warning << "\n";
+    }
+    if (processed.unsettled_dwells > 0 && !FLAGS_allow_unsettled) {
+      std::cerr << "process_traces: " << processed.unsettled_dwells
+                << " dwell(s) look unsettled; nothing written (record them again after a longer "
+                   "wait, or pass --allow_unsettled)\n";
+      return 3;
+    }
+    std::string hb_text;
+    if (!FLAGS_harmonic_balance.empty()) {
+      const dwellfit::HarmonicBalanceResult result =
+          dwellfit::IdentifyHarmonicBalance(processed.harmonics, rig.processing.harmonics,
+                                            dwellfit::HzToRadPerSecond(FLAGS_reference_hz));
+      std::ostringstream yaml;
+      dwellfit::WriteHarmonicBalanceYaml(result, &yaml);
+      hb_text = yaml.str();
+    }
+    // Both files are written in full before either is renamed into place.
+    std::ostringstream csv;
+    dwellfit::WriteSweepsCsv(processed.sweeps, &csv);
+    const std::string staged_csv = Stage(csv.str(), FLAGS_out, &staged);
+    const std::string staged_hb =
+        hb_text.empty() ? std::string() : Stage(hb_text, FLAGS_harmonic_balance, &staged);
+    Commit(staged_csv, FLAGS_out);
+    if (!staged_hb.empty()) Commit(staged_hb, FLAGS_harmonic_balance);
+    std::cout << "processed " << dwells.size() << " dwells; wrote " << FLAGS_out << "\n";
+    if (!hb_text.empty()) std::cout << hb_text << "wrote " << FLAGS_harmonic_balance << "\n";
+  } catch (const dwellfit::InputError& e) {
+    for (const std::string& name : staged) std::remove(name.c_str());
+    std::cerr << "process_traces: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
