@@ -1,9 +1,9 @@
 #include "dwellfit/config/model_selection_config.h"
 
 #include <cmath>
-#include <cstdio>
 
 #include "dwellfit/config/strict_yaml.h"
+#include "dwellfit/estimator/common/string_printf.h"
 
 namespace dwellfit {
 
@@ -98,9 +98,7 @@ std::vector<ParameterChoice> ReadChoices(const ConfigValue& value, const ConfigS
       }
       choice.value = *initial_guess[index];
       const double shown = omega ? RadPerSecondToHz(*choice.value) : *choice.value;
-      char buffer[32];
-      std::snprintf(buffer, sizeof(buffer), "%.6g", shown);
-      choice.text = buffer;
+      choice.text = StringPrintf("%.6g", shown);
     } else {
       const double number = ReadFiniteDouble(entry, source);
       choice.value = omega ? HzToRadPerSecond(number) : number;
