@@ -173,5 +173,27 @@ TEST_F(ModelSelectionTest, PoolSweepNotInTheDataIsAnInputError) {
   }
 }
 
+// The committed beam-selected.yaml: with the validate sweeps as the only
+// held-out data (no cross-validation, to keep the test short), the study
+// recommends delta = 0, whose median jump-down error over the ten validate
+// levels is within the 2 % bar, and better than delta free's.
+TEST(ModelSelectionBeam, CommittedSelectedConfigRecommendsDeltaZeroWithinTwoPercent) {
+  const IdentifyConfig config = LoadIdentifyConfig(
+      std::string(DWELLFIT_SOURCE_DIR) + "/datasets/clamped-beam-27C/beam-selected.yaml",
+      ParseSetFlag("model_selection.cross_validation=none", "--test"));
+  const ModelSelectionReport report = RunModelSelection(config, 2);
+  ASSERT_EQ(report.variants.size(), 2u);
+  ASSERT_EQ(report.recommended, 1);
+  const VariantResult& chosen = report.variants[1];
+  EXPECT_EQ(chosen.variant.Name(), "delta 0, mu2 0, w free");
+  ASSERT_EQ(chosen.validation.jump_down_percent.size(), 10u);
+  const double median = MedianOf(chosen.validation.jump_down_percent);
+  std::cout << "delta 0: validate median jump-down error " << median << " %\n";
+  EXPECT_LE(median, 2.0);
+  EXPECT_LT(median, MedianOf(report.variants[0].validation.jump_down_percent));
+  // Lower cost is not better prediction: delta free fits far better.
+  EXPECT_LT(report.variants[0].fits[0].final_cost, 0.2 * chosen.fits[0].final_cost);
+}
+
 }  // namespace
 }  // namespace dwellfit
