@@ -565,7 +565,7 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
   const StrictMap top(DocumentValue(source), source,
                       {"data", "fit", "validate", "initial_guess", "fixed", "stages", "residual",
                        "solver", "penalties", "multi_start", "jump_detection", "jumps",
-                       "effective_nonlinearity_reference_hz", "output_dir"});
+                       "effective_nonlinearity_reference_hz", "model_selection", "output_dir"});
   IdentifyConfig config;
   config.data_files =
       ReadDataFiles(top.Required("data", "give the CSV file with the sweeps (or a list of files)"),
@@ -605,6 +605,9 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
   }
   if (!identification.IsValid(&message)) ThrowInvalidBlock(initial_guess, source, message);
 
+  if (const auto value = top.Optional("model_selection")) {
+    config.model_selection = ReadModelSelectionConfig(*value, source, config.initial_guess);
+  }
   if (const auto value = top.Optional("multi_start")) {
     config.multi_start = ReadMultiStart(*value, source);
   }

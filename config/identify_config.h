@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "dwellfit/config/config_override.h"
+#include "dwellfit/config/model_selection_config.h"
 #include "dwellfit/config/sweep_selection.h"
 #include "dwellfit/estimator/fit/identification_options.h"
 #include "dwellfit/estimator/fit/initial_guess.h"
@@ -49,6 +50,9 @@ struct IdentifyConfig {
   std::optional<double> omega_ref_rad_s;
   // Where results go, absolute (resolved like data_files); may not exist yet.
   std::string output_dir;
+  // The model variants to compare and how (`model_selection:`); unset when
+  // the config has no such block. `identify` ignores it; `select_model` runs it.
+  std::optional<ModelSelectionConfig> model_selection;
   // The overrides applied on top of the file, in order.
   std::vector<ConfigOverride> overrides;
 };

@@ -150,6 +150,32 @@ void EmitMultiStartAndJumpDetection(YAML::Emitter& out, const IdentifyConfig& co
   out << YAML::EndMap;
 }
 
+void EmitChoices(YAML::Emitter& out, const char* key, const std::vector<ParameterChoice>& choices,
+                 bool omega) {
+  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (const ParameterChoice& choice : choices) {
+    if (!choice.value) {
+      out << "free";
+    } else {
+      out << (omega ? ConvertedNumber(RadPerSecondToHz(*choice.value)) : ExactNumber(*choice.value));
+    }
+  }
+  out << YAML::EndSeq;
+}
+
+void EmitModelSelection(YAML::Emitter& out, const ModelSelectionConfig& selection) {
+  out << YAML::Key << "model_selection" << YAML::Value << YAML::BeginMap;
+  EmitChoices(out, "delta", selection.delta, false);
+  EmitChoices(out, "mu2", selection.mu2, false);
+  EmitChoices(out, "omega_hz", selection.omega, true);
+  out << YAML::Key << "cross_validation" << YAML::Value
+      << CrossValidationSchemeName(selection.scheme);
+  out << YAML::Key << "training" << YAML::Value << CrossValidationTrainingName(selection.training);
+  EmitSelections(out, "pool", selection.pool);
+  out << YAML::Key << "threads" << YAML::Value << selection.threads;
+  out << YAML::EndMap;
+}
+
 }  // namespace
 
 std::string ConfigToYaml(const IdentifyConfig& config) {
@@ -175,6 +201,7 @@ std::string ConfigToYaml(const IdentifyConfig& config) {
         << ConvertedNumber(RadPerSecondToHz(*config.omega_ref_rad_s))
         << YAML::Comment(ExactNumber(*config.omega_ref_rad_s) + " rad/s");
   }  // unset: the identified omega (the key's default)
+  if (config.model_selection.has_value()) EmitModelSelection(out, *config.model_selection);
   out << YAML::Key << "output_dir" << YAML::Value << config.output_dir;
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";

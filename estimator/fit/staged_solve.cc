@@ -154,6 +154,22 @@ PenaltyOptions WeighPenalties(const PenaltyOptions& penalties, StageProblem* pro
   return weighted;
 }
 
+// The entries whose `holding` flag (ambient order) is set.
+std::vector<double*> EntriesMarked(const FitDescription& fit, const std::vector<bool>& holding) {
+  std::vector<double*> entries;
+  for (size_t b = 0; b < fit.blocks.size(); ++b) {
+    for (int i = 0; i < fit.blocks[b].size; ++i) {
+      if (holding[fit.Offset(static_cast<int>(b)) + i]) entries.push_back(fit.blocks[b].values + i);
+    }
+  }
+  return entries;
+}
+
+// The entries of `fit` that hold `parameter` in some dataset, each once.
+std::vector<double*> EntriesOf(const FitDescription& fit, int parameter) {
+  return EntriesMarked(fit, fit.EntriesHolding(parameter));
+}
+
 // The entries of `fit` holding eta_e of some dataset, or with `damping` its
 // mu1 or mu2, each once.
 std::vector<double*> EntriesHolding(const FitDescription& fit, bool damping) {
@@ -162,13 +178,7 @@ std::vector<double*> EntriesHolding(const FitDescription& fit, bool damping) {
     const std::vector<bool> mu2 = fit.EntriesHolding(kMu2);
     for (size_t i = 0; i < holding.size(); ++i) holding[i] = holding[i] || mu2[i];
   }
-  std::vector<double*> entries;
-  for (size_t b = 0; b < fit.blocks.size(); ++b) {
-    for (int i = 0; i < fit.blocks[b].size; ++i) {
-      if (holding[fit.Offset(static_cast<int>(b)) + i]) entries.push_back(fit.blocks[b].values + i);
-    }
-  }
-  return entries;
+  return EntriesMarked(fit, holding);
 }
 
 void RecordSolve(const ceres::Solver::Summary& summary, int round, const PenaltyOptions& penalties,
@@ -423,11 +433,18 @@ void Conclude(const FitDescription& fit, FitSummary* summary) {
           << ResidualKindName(last.residual) << ") "
           << (last.converged ? "converged" : "stopped without meeting a convergence test") << ": "
           << last.brief_report;
+  // G depends on w only through w^2: a negative w is the same model.
+  for (double* w : EntriesOf(fit, kNaturalFrequency)) *w = std::abs(*w);
+  std::vector<double> eta_e_values;
+  for (const double* eta_e : EntriesOf(fit, kEtaE)) eta_e_values.push_back(*eta_e);
   const std::vector<double> values = fit.Values();
   std::string failure;
   if (!std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); }) ||
       !std::isfinite(summary->final_cost)) {
     failure = "the fit ended at values that are not finite";
+  } else if (std::any_of(eta_e_values.begin(), eta_e_values.end(),
+                         [](double eta_e) { return !(eta_e > 0.0); })) {
+    failure = "the fit ended at eta_e = 0, where the model has no forcing";
   } else if (!last.missing_folds.empty()) {
     failure = "the fit ended without the enforced fold(s) " + JoinLines(last.missing_folds) +
               ": the bifurcation-range penalty could not bring them in (start closer, "

@@ -1,0 +1,174 @@
+#include "dwellfit/config/model_selection_config.h"
+
+#include <cmath>
+
+#include "dwellfit/config/strict_yaml.h"
+#include "dwellfit/estimator/common/string_printf.h"
+
+namespace dwellfit {
+
+const char* CrossValidationSchemeName(CrossValidationScheme scheme) {
+  switch (scheme) {
+    case CrossValidationScheme::kNone:
+      return "none";
+    case CrossValidationScheme::kLeaveOneLevelOut:
+      return "leave_one_level_out";
+  }
+  return "?";
+}
+
+const char* CrossValidationTrainingName(CrossValidationTraining training) {
+  switch (training) {
+    case CrossValidationTraining::kConfig:
+      return "config";
+    case CrossValidationTraining::kAll:
+      return "all";
+  }
+  return "?";
+}
+
+ModelSelectionConfig ModelSelectionConfig::Defaults() {
+  ModelSelectionConfig config;
+  config.delta = {{std::nullopt, "free"}, {0.0, "0"}};
+  config.mu2 = {{std::nullopt, "free"}, {0.0, "0"}};
+  config.omega = {{std::nullopt, "free"}};
+  return config;
+}
+
+bool ModelSelectionConfig::IsValid(std::string* error) const {
+  const struct {
+    const char* name;
+    const std::vector<ParameterChoice>* choices;
+  } lists[] = {{"delta", &delta}, {"mu2", &mu2}, {"omega_hz", &omega}};
+  for (const auto& list : lists) {
+    if (list.choices->empty()) {
+      *error = std::string(list.name) + " lists no choice; give free and/or values";
+      return false;
+    }
+    for (std::size_t i = 0; i < list.choices->size(); ++i) {
+      for (std::size_t j = 0; j < i; ++j) {
+        if ((*list.choices)[i].value == (*list.choices)[j].value) {
+          *error = std::string(list.name) + " lists '" + (*list.choices)[i].text + "' twice";
+          return false;
+        }
+      }
+    }
+  }
+  for (const ParameterChoice& choice : omega) {
+    if (choice.value && !(*choice.value > 0.0)) {
+      *error = "omega_hz: a fixed natural frequency must be positive, got " + choice.text;
+      return false;
+    }
+  }
+  for (const ParameterChoice& choice : mu2) {
+    if (choice.value && *choice.value < 0.0) {
+      *error = "mu2: a fixed value must be >= 0 (the parameter is bounded below by 0), got " +
+               choice.text;
+      return false;
+    }
+  }
+  if (threads < 1) {
+    *error = "threads must be >= 1, got " + std::to_string(threads);
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+// One list of choices: entries `free`, `initial` (the config's initial
+// guess, which must be given) or a number (omega in Hz).
+std::vector<ParameterChoice> ReadChoices(const ConfigValue& value, const ConfigSource& source,
+                                         ParameterIndex index,
+                                         const KnownParameters& initial_guess) {
+  const bool omega = index == kNaturalFrequency;
+  std::vector<ParameterChoice> choices;
+  for (const ConfigValue& entry : ReadList(value, source)) {
+    const std::string text = entry.node.IsScalar() ? entry.node.Scalar() : "";
+    ParameterChoice choice;
+    if (text == "free") {
+      choice.text = "free";
+    } else if (text == "initial") {
+      if (!initial_guess[index]) {
+        const std::string key = omega ? "omega_hz" : ParameterName(index);
+        throw source.Error(entry.path, entry.mark,
+                           "'initial' holds " + std::string(ParameterName(index)) +
+                               " at the config's initial guess, but initial_guess." + key +
+                               " is auto; give it, or write the value here");
+      }
+      choice.value = *initial_guess[index];
+      const double shown = omega ? RadPerSecondToHz(*choice.value) : *choice.value;
+      choice.text = StringPrintf("%.6g", shown);
+    } else {
+      const double number = ReadFiniteDouble(entry, source);
+      choice.value = omega ? HzToRadPerSecond(number) : number;
+      if (!std::isfinite(*choice.value)) {
+        throw source.Error(entry.path, entry.mark, "the frequency is too large");
+      }
+      choice.text = text;
+    }
+    choices.push_back(choice);
+  }
+  return choices;
+}
+
+std::vector<SweepSelection> ReadPool(const ConfigValue& value, const ConfigSource& source) {
+  std::vector<SweepSelection> pool;
+  for (const ConfigValue& entry : ReadList(value, source)) {
+    SweepSelection selection;
+    std::string error;
+    if (!ParseSweepSelection(ReadNonEmptyString(entry, source), &selection, &error)) {
+      throw source.Error(entry.path, entry.mark, error);
+    }
+    for (const SweepSelection& earlier : pool) {
+      if (earlier.Overlaps(selection)) {
+        throw source.Error(entry.path, entry.mark,
+                           "sweep '" + selection.Name() + "' overlaps '" + earlier.Name() +
+                               "' listed before; list each sweep once");
+      }
+    }
+    pool.push_back(selection);
+  }
+  return pool;
+}
+
+}  // namespace
+
+ModelSelectionConfig ReadModelSelectionConfig(const ConfigValue& value, const ConfigSource& source,
+                                              const KnownParameters& initial_guess) {
+  const StrictMap block(
+      value, source,
+      {"delta", "mu2", "omega_hz", "cross_validation", "training", "pool", "threads"});
+  ModelSelectionConfig config = ModelSelectionConfig::Defaults();
+  if (const auto v = block.Optional("delta")) {
+    config.delta = ReadChoices(*v, source, kDelta, initial_guess);
+  }
+  if (const auto v = block.Optional("mu2"))
+    config.mu2 = ReadChoices(*v, source, kMu2, initial_guess);
+  if (const auto v = block.Optional("omega_hz")) {
+    config.omega = ReadChoices(*v, source, kNaturalFrequency, initial_guess);
+  }
+  if (const auto v = block.Optional("cross_validation")) {
+    const std::string name =
+        ReadOneOf(*v, source, "cross-validation scheme",
+                  {CrossValidationSchemeName(CrossValidationScheme::kNone),
+                   CrossValidationSchemeName(CrossValidationScheme::kLeaveOneLevelOut)});
+    config.scheme =
+        name == "none" ? CrossValidationScheme::kNone : CrossValidationScheme::kLeaveOneLevelOut;
+  }
+  if (const auto v = block.Optional("training")) {
+    const std::string name =
+        ReadOneOf(*v, source, "training set",
+                  {CrossValidationTrainingName(CrossValidationTraining::kConfig),
+                   CrossValidationTrainingName(CrossValidationTraining::kAll)});
+    config.training =
+        name == "all" ? CrossValidationTraining::kAll : CrossValidationTraining::kConfig;
+  }
+  if (const auto v = block.Optional("pool")) config.pool = ReadPool(*v, source);
+  if (const auto v = block.Optional("threads")) config.threads = ReadInt(*v, source);
+  std::string message;
+  if (!config.IsValid(&message)) throw source.Error(value.path, value.mark, message);
+  return config;
+}
+
+}  // namespace dwellfit
