@@ -7,6 +7,7 @@
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/run/output_files.h"
+#include "dwellfit/estimator/run/run_figures.h"
 #include "glog/logging.h"
 
 namespace dwellfit {
@@ -76,9 +77,12 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
       EstimateUncertainty(run.fitted, options, result.parameters, outcome->report.omega_ref_rad_s);
   const IdentificationReport& report = outcome->report;
   PrintReport(report, out);
-  WriteFilesAtomically(config.output_dir, {{"result.yaml", ReportToYaml(report)},
-                                           {"predictions.csv", ReportToPredictionsCsv(report)}});
-  out << "\nwrote " << config.output_dir << "/result.yaml and predictions.csv (listed in "
+  std::vector<NamedFile> files = {{"result.yaml", ReportToYaml(report)},
+                                  {"predictions.csv", ReportToPredictionsCsv(report)}};
+  AppendCurvesAndFigures(report, &files, out);
+  WriteFilesAtomically(config.output_dir, files);
+  out << "\nwrote " << config.output_dir << "/result.yaml, predictions.csv, curves.csv, "
+      << kFigureScriptName << " and " << files.size() - 4 << " figure file(s) (listed in "
       << kManifestFileName << ")\n";
   return outcome;
 }
