@@ -11,6 +11,7 @@
 // --kind with --a_base or --freq_hz and --from/--to (Hz or a_base), else the
 // plan's sweeps.
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iostream>
 
@@ -121,8 +122,12 @@ int main(int argc, char** argv) {
     if (FLAGS_output.empty()) {
       std::cout << csv;
     } else {
-      std::ofstream out(FLAGS_output, std::ios::binary);
-      if (!(out << csv) || !out.flush()) {
+      // Written beside and renamed into place: never a half-written file.
+      const std::string partial = FLAGS_output + ".partial";
+      std::ofstream out(partial, std::ios::binary);
+      if (!(out << csv) || !out.flush() ||
+          (out.close(), std::rename(partial.c_str(), FLAGS_output.c_str()) != 0)) {
+        std::remove(partial.c_str());
         throw dwellfit::InputError(FLAGS_output, 0, "--output", "cannot write the file");
       }
     }

@@ -323,22 +323,29 @@ std::string StudyFigureScript(const SensitivityStudy& study) {
   gp << "# Figures of a dwellfit sensitivity study, from fits.csv. PNG: gnuplot figures.gp;\n"
         "# SVG: gnuplot -e \"fmt='svg'\" figures.gp\n"
         "if (!exists(\"fmt\")) fmt = \"png\"\n"
-        "if (fmt eq \"svg\") {\n  set terminal svg size 1100,700 dynamic background \"white\"\n"
-        "} else {\n  set terminal pngcairo size 1100,700 font \"sans,9\"\n}\n"
+        "if (fmt eq \"svg\") {\n  set terminal svg size 1100,700 dynamic noenhanced background "
+        "\"white\"\n"
+        "} else {\n  set terminal pngcairo size 1100,700 noenhanced font \"sans,9\"\n}\n"
         "set datafile separator \",\"\nset style fill solid 0.6 border -1\nset grid\n"
         "ok(x) = (strcol('status') eq \"converged\" || strcol('status') eq \"no_convergence\")\n";
   gp << "set output \"histograms.\".fmt\nset multiplot layout 2,3 title \"estimates over "
-     << study.rows.size() << " fits\"\n";
+     << study.rows.size() << " fits" << (study.truth ? " (red: the truth)" : "") << "\"\n";
   for (int i = 0; i < kNumParameters; ++i) {
     const std::string name = ParameterColumn(i);
     gp << "stats 'fits.csv' using (ok(0) ? column('" << name << "') : NaN) name \"S\" nooutput\n"
        << "w = (S_max > S_min) ? (S_max - S_min) / 30.0 : (abs(S_max) > 0 ? abs(S_max) * 1e-6 : "
           "1e-6)\n"
-       << "set title \"" << name << "\"\nset xtics rotate by -30\n"
-       << "plot 'fits.csv' using (ok(0) ? w * floor(column('" << name
+       << "set title \"" << name << "\"\nset xtics rotate by -30\n";
+    if (study.truth) {
+      gp << StringPrintf(
+          "set arrow 1 from %.17g, graph 0 to %.17g, graph 1 nohead lw 2 lc rgb "
+          "\"#d62728\"\n",
+          (*study.truth)[i], (*study.truth)[i]);
+    }
+    gp << "plot 'fits.csv' using (ok(0) ? w * floor(column('" << name
        << "') / w + 0.5) : NaN):(1.0) smooth frequency with boxes notitle\n";
   }
-  gp << "unset multiplot\nunset output\n";
+  gp << "unset multiplot\nunset output\nunset arrow 1\n";
   if (study.axis_keys.size() == 1) {
     gp << "# Profile: cost and estimates against " << study.axis_keys[0] << "\n"
        << "set output \"profile.\".fmt\nset multiplot layout 2,4 title \"profile over "
