@@ -151,13 +151,17 @@ std::vector<VaryAxis> ParseVaryFlag(const std::string& flag_value, const std::st
 }
 
 bool SensitivityOptions::IsValid(std::string* why) const {
-  if (replicas < 1) return *why = "--replicas must be >= 1", false;
+  auto fail = [why](const std::string& text) {
+    *why = text;
+    return false;
+  };
+  if (replicas < 1) return fail("--replicas must be >= 1");
   if (!plan && replicas != 1)
-    return *why = "--replicas needs --plan (replicas are noisy simulations of a plan)", false;
-  if (!(noise >= 0.0) || !std::isfinite(noise)) return *why = "--noise must be >= 0", false;
-  if (threads < 1) return *why = "--threads must be >= 1", false;
+    return fail("--replicas needs --plan (replicas are noisy simulations of a plan)");
+  if (!(noise >= 0.0) || !std::isfinite(noise)) return fail("--noise must be >= 0");
+  if (threads < 1) return fail("--threads must be >= 1");
   if (shards < 1 || shard < 0 || shard >= shards)
-    return *why = StringPrintf("--shard %d/%d: need 0 <= k < N", shard, shards), false;
+    return fail(StringPrintf("--shard %d/%d: need 0 <= k < N", shard, shards));
   return true;
 }
 
@@ -391,6 +395,11 @@ SensitivityStudy ReadStudyYaml(const std::string& path) {
   } catch (const YAML::Exception& e) {
     throw InputError(path, e.mark.line + 1, "", "not a study.yaml of a sensitivity run: " + e.msg);
   }
+  if (study.shards < 1 || study.shards > 1000000 || study.shard < 0 ||
+      study.shard >= study.shards || study.cases < 1 || study.replicas < 1 ||
+      study.total_fits != study.cases * study.replicas) {
+    throw InputError(path, 0, "shard", "inconsistent sizes; give the folders sensitivity wrote");
+  }
   return study;
 }
 
@@ -423,6 +432,15 @@ double ParseNumber(const std::string& text, const std::string& path, int line) {
   return value;
 }
 
+// A non-negative integer field (an index or a count).
+int ParseCount(const std::string& text, const std::string& path, int line) {
+  const double value = ParseNumber(text, path, line);
+  if (!(value >= 0.0 && value <= 2e9) || value != std::floor(value)) {
+    throw InputError(path, line, "", "'" + text + "' is no count");
+  }
+  return static_cast<int>(value);
+}
+
 void ReadFitRows(const std::string& path, const SensitivityStudy& shape,
                  std::vector<FitRow>* rows) {
   std::istringstream csv(ReadText(path));
@@ -437,14 +455,14 @@ void ReadFitRows(const std::string& path, const SensitivityStudy& shape,
                        StringPrintf("%zu fields, expected %zu", f.size(), columns));
     }
     FitRow row;
-    row.fit = static_cast<int>(ParseNumber(f[0], path, number));
-    row.case_index = static_cast<int>(ParseNumber(f[1], path, number));
-    row.replica = static_cast<int>(ParseNumber(f[2], path, number));
+    row.fit = ParseCount(f[0], path, number);
+    row.case_index = ParseCount(f[1], path, number);
+    row.replica = ParseCount(f[2], path, number);
     row.seed = std::strtoull(f[3].c_str(), nullptr, 10);
     row.settings.assign(f.begin() + 4, f.begin() + 4 + keys);
     row.status = f[4 + keys];
     row.cost = ParseNumber(f[5 + keys], path, number);
-    row.iterations = static_cast<int>(ParseNumber(f[6 + keys], path, number));
+    row.iterations = ParseCount(f[6 + keys], path, number);
     for (int i = 0; i < kNumParameters; ++i) {
       row.estimate[i] = ParseNumber(f[7 + keys + 2 * i], path, number);
       row.standard_error[i] = ParseNumber(f[8 + keys + 2 * i], path, number);
