@@ -1,5 +1,8 @@
 #include "dwellfit/estimator/curves/figures.h"
 
+#include <stdlib.h>
+
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -62,6 +65,17 @@ TEST(Figures, AFailingScriptIsAWarningNotAnError) {
   const RenderedFigures rendered = RenderFigures({{kFigureScriptName, "plot 'absent.csv'\n"}});
   EXPECT_FALSE(rendered.rendered);
   EXPECT_THAT(rendered.warning, HasSubstr("gnuplot failed"));
+  EXPECT_TRUE(rendered.images.empty());
+}
+
+TEST(Figures, AMissingGnuplotIsAWarningNotAnError) {
+  const char* path = std::getenv("PATH");
+  const std::string saved = path != nullptr ? path : "";
+  setenv("PATH", "/nonexistent-dwellfit-test", 1);
+  const RenderedFigures rendered = RenderFigures({{kFigureScriptName, "print 1\n"}});
+  setenv("PATH", saved.c_str(), 1);
+  EXPECT_FALSE(rendered.rendered);
+  EXPECT_THAT(rendered.warning, HasSubstr("gnuplot was not found"));
   EXPECT_TRUE(rendered.images.empty());
 }
 
