@@ -8,6 +8,7 @@
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/run/output_files.h"
+#include "dwellfit/estimator/run/run_figures.h"
 #include "glog/logging.h"
 #include "yaml-cpp/yaml.h"
 
@@ -123,10 +124,13 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
   MarkUnidentifiable(&outcome->report);
   const IdentificationReport& report = outcome->report;
   PrintReport(report, out);
-  WriteFilesAtomically(config.output_dir, {{"result.yaml", ReportToYaml(report)},
-                                           {"predictions.csv", ReportToPredictionsCsv(report)}});
-  out << "\nwrote " << config.output_dir << "/result.yaml and predictions.csv (listed in "
-      << kManifestFileName << ")\n";
+  std::vector<NamedFile> files = {{"result.yaml", ReportToYaml(report)},
+                                  {"predictions.csv", ReportToPredictionsCsv(report)}};
+  AppendCurvesAndFigures(report, &files, out);
+  WriteFilesAtomically(config.output_dir, files);
+  out << "\nwrote into " << config.output_dir << ":";
+  for (const NamedFile& file : files) out << " " << file.first;
+  out << " (listed in " << kManifestFileName << ")\n";
   return outcome;
 }
 

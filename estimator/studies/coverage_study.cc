@@ -10,6 +10,7 @@
 #include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/fit/identification.h"
 #include "dwellfit/estimator/run/resolved_run.h"
+#include "dwellfit/estimator/studies/replica_run.h"
 
 namespace dwellfit {
 namespace {
@@ -81,7 +82,8 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
   const auto start = std::chrono::steady_clock::now();
   CoverageStudy study;
   study.replicas = options.replicas;
-  study.omega_ref_rad_s = config.omega_ref_rad_s ? *config.omega_ref_rad_s : plan.truth[kNaturalFrequency];
+  study.omega_ref_rad_s =
+      config.omega_ref_rad_s ? *config.omega_ref_rad_s : plan.truth[kNaturalFrequency];
 
   // Rows: the free parameters, then alpha_e (index kNumParameters).
   std::vector<int> rows;
@@ -101,12 +103,10 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
 
   double sum_noise_sigma = 0.0;
   for (int r = 0; r < options.replicas; ++r) {
-    DwellPlan replica_plan = plan;
-    replica_plan.noise.relative_sigma = options.relative_noise;
-    replica_plan.noise.seed = options.first_seed + static_cast<std::uint64_t>(r);
     // The simulated sweeps go the way of measured ones: labelled, the
     // config's jumps applied, selected, the start found from them.
-    const ResolvedRun run = ResolveRun(config, SimulateDwells(replica_plan));
+    const ResolvedRun run = ResolveReplicaRun(config, plan, options.relative_noise,
+                                              options.first_seed + static_cast<std::uint64_t>(r));
     const IdentificationResult result = FitRun(run).best;
     const ParameterUncertainty u =
         EstimateUncertainty(run.fitted, run.options, result.parameters, study.omega_ref_rad_s);

@@ -1,0 +1,54 @@
+#include "dwellfit/config/result_parameters.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "dwellfit/estimator/common/input_error.h"
+#include "yaml-cpp/yaml.h"
+
+namespace dwellfit {
+
+ParameterVector ReadResultParameters(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) {
+    throw InputError(path, 0, "",
+                     "cannot open the file; give the result.yaml an identify run wrote");
+  }
+  std::stringstream text;
+  text << in.rdbuf();
+  YAML::Node document;
+  try {
+    document = YAML::Load(text.str());
+  } catch (const YAML::Exception& e) {
+    throw InputError(path, e.mark.line + 1, "", "not YAML: " + e.msg);
+  }
+  const YAML::Node parameters = document.IsMap() ? document["parameters"] : YAML::Node();
+  if (!parameters.IsMap()) {
+    throw InputError(path, 0, "parameters",
+                     "no parameters block; give the result.yaml an identify run wrote");
+  }
+  ParameterVector p{};
+  for (int i = 0; i < kNumParameters; ++i) {
+    const std::string field = std::string("parameters.") + ParameterName(i) + ".value";
+    const YAML::Node entry = parameters[ParameterName(i)];
+    const YAML::Node value = entry.IsMap() ? entry["value"] : YAML::Node();
+    double number = NAN;
+    const int line = entry.IsDefined() ? entry.Mark().line + 1 : parameters.Mark().line + 1;
+    if (value.IsScalar()) {
+      try {
+        number = value.as<double>();
+      } catch (const YAML::Exception&) {
+      }
+    }
+    if (!std::isfinite(number)) {
+      throw InputError(path, line, field,
+                       "missing or not a finite number; the file must be a "
+                       "result.yaml written by identify");
+    }
+    p[i] = number;
+  }
+  return p;
+}
+
+}  // namespace dwellfit

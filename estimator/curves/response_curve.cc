@@ -1,0 +1,433 @@
+#include "dwellfit/estimator/curves/response_curve.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+
+#include "boost/math/tools/toms748_solve.hpp"
+#include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/string_printf.h"
+#include "dwellfit/residuals/model/response_model.h"
+
+namespace dwellfit {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// C^2 x^2 + c1 x + c0 = 0 in x = Omega^2 at amplitude a (header comment).
+struct FrequencyQuadratic {
+  double c2 = 0.0, c1 = 0.0, c0 = 0.0, disc = 0.0;
+  double backbone_x = kNaN;  // B / C
+};
+
+FrequencyQuadratic MakeQuadratic(const ParameterVector& p, double a_base, double a) {
+  const double eta_e = p[kEtaE];
+  const double w = p[kNaturalFrequency];
+  const double d = (p[kMu1] + 4.0 * p[kMu2] * a / (3.0 * kPi)) * a / eta_e;
+  const double b = a * (4.0 * w * w + 3.0 * p[kAlpha] * a * a) / (8.0 * eta_e);
+  const double c = a * (4.0 + 2.0 * p[kDelta] * a * a) / (8.0 * eta_e);
+  FrequencyQuadratic q;
+  q.c2 = c * c;
+  q.c1 = d * d - 2.0 * b * c;
+  q.c0 = (b - a_base) * (b + a_base);
+  q.disc = d * d * (d * d - 4.0 * b * c) + 4.0 * c * c * a_base * a_base;
+  if (c != 0.0) q.backbone_x = b / c;
+  return q;
+}
+
+// The roots x- <= x+ (NaN where the discriminant is negative); `clamp` sets
+// a discriminant rounded just below 0 at a piece's end to 0.
+void QuadraticRoots(const FrequencyQuadratic& q, bool clamp, double* x_minus, double* x_plus) {
+  *x_minus = *x_plus = kNaN;
+  double disc = q.disc;
+  if (disc < 0.0 && clamp) disc = 0.0;
+  if (!(disc >= 0.0) || !(q.c2 > 0.0)) return;
+  const double s = std::sqrt(disc);
+  const double big = -0.5 * (q.c1 + std::copysign(s, q.c1));
+  double r1 = big / q.c2;
+  double r2 = big != 0.0 ? q.c0 / big : r1;
+  if (r1 > r2) std::swap(r1, r2);
+  *x_minus = r1;
+  *x_plus = r2;
+}
+
+// Omega [rad/s] on `side` (0: left root, 1: right root) at amplitude a; NaN
+// where that root is not a positive x.
+double SideFrequency(const ParameterVector& p, double a_base, double a, int side, bool clamp) {
+  double x_minus, x_plus;
+  QuadraticRoots(MakeQuadratic(p, a_base, a), clamp, &x_minus, &x_plus);
+  const double x = side == 0 ? x_minus : x_plus;
+  return x > 0.0 ? std::sqrt(x) : kNaN;
+}
+
+double DgDa(const ParameterVector& p, double omega, double a) {
+  return ResponseCoefficients<double>::FromParameters(p.data(), omega).dG(a);
+}
+
+// Solves f on [lo, hi] (a sign change) to full double precision.
+template <typename F>
+double Toms748(const F& f, double lo, double hi) {
+  const double f_lo = f(lo);
+  const double f_hi = f(hi);
+  if (f_lo == 0.0) return lo;
+  if (f_hi == 0.0) return hi;
+  if (!(f_lo * f_hi < 0.0)) return kNaN;
+  std::uintmax_t iterations = 200;
+  const auto bracket = boost::math::tools::toms748_solve(
+      f, lo, hi, f_lo, f_hi, boost::math::tools::eps_tolerance<double>(52), iterations);
+  return 0.5 * (bracket.first + bracket.second);
+}
+
+// A point of the trace before folds and segments are assigned.
+struct RawPoint {
+  double a = 0.0;
+  double omega = 0.0;
+  double a_base = 0.0;
+  int side = 0;         // frequency: 2 * piece + (0 left, 1 right); amplitude: 0
+  bool breaks = false;  // does not continue from the previous point
+};
+
+CurvePoint MakePoint(const ParameterVector& p, double omega, double a_base, double a) {
+  const auto k = ResponseCoefficients<double>::FromParameters(p.data(), omega);
+  CurvePoint point;
+  point.omega_rad_s = omega;
+  point.a_base = a_base;
+  point.a = a;
+  point.dG_da = k.dG(a);
+  point.stable = point.dG_da > 0.0;
+  point.phase_rad = std::atan2(k.P(a), k.Q(a));
+  return point;
+}
+
+// An upper bound of the frequency response's amplitude over the range:
+// P = Omega D(a) <= a_base with Omega >= control_low.
+double FrequencyAmplitudeBound(const ParameterVector& p, const CurveSpec& spec) {
+  const double rhs = spec.a_base * p[kEtaE] / spec.control_low;
+  const double k = 4.0 * p[kMu2] / (3.0 * kPi);
+  if (k > 0.0) return (-p[kMu1] + std::sqrt(p[kMu1] * p[kMu1] + 4.0 * k * rhs)) / (2.0 * k);
+  return rhs / p[kMu1];
+}
+
+// Samples of [lo, hi]: geometric (the off-resonance tails) and dense towards
+// hi (the peak, where Omega(a) turns like a square root), ascending.
+std::vector<double> PieceSamples(double lo, double hi, int n) {
+  std::vector<double> samples;
+  for (int i = 0; i <= n; ++i) {
+    const double t = static_cast<double>(i) / n;
+    samples.push_back(lo * std::pow(hi / lo, t));
+    samples.push_back(hi - (hi - lo) * (1.0 - t) * (1.0 - t));
+  }
+  samples.front() = lo;
+  std::sort(samples.begin(), samples.end());
+  samples.erase(std::unique(samples.begin(), samples.end()), samples.end());
+  samples.back() = hi;
+  return samples;
+}
+
+// The intervals of a where the frequency quadratic has real roots, each end
+// refined on the discriminant; `lo` and `hi` bound the search.
+std::vector<std::pair<double, double>> RealPieces(const ParameterVector& p, double a_base,
+                                                  double lo, double hi) {
+  constexpr int kScan = 4000;
+  auto disc = [&](double a) { return MakeQuadratic(p, a_base, a).disc; };
+  std::vector<std::pair<double, double>> pieces;
+  double previous = lo;
+  bool inside = disc(lo) >= 0.0;
+  double start = lo;
+  for (int i = 1; i <= kScan; ++i) {
+    const double a = lo * std::pow(hi / lo, static_cast<double>(i) / kScan);
+    const bool now = disc(a) >= 0.0;
+    if (now != inside) {
+      const double edge = Toms748(disc, previous, a);
+      if (inside) pieces.emplace_back(start, edge);
+      start = edge;
+      inside = now;
+    }
+    previous = a;
+  }
+  if (inside) pieces.emplace_back(start, hi);
+  return pieces;
+}
+
+bool InRange(const CurveSpec& spec, double control) {
+  const double slack = 1e-12 * std::abs(spec.control_high);
+  return control >= spec.control_low - slack && control <= spec.control_high + slack;
+}
+
+// Walks the samples of one side in tracing order, keeping those inside the
+// swept range, and adds the exact point where the curve crosses an end of the
+// range between two samples (so the curve spans the whole range).
+class RangeWalker {
+ public:
+  RangeWalker(const CurveSpec& spec, std::function<double(double)> control, int side,
+              std::vector<RawPoint>* trace)
+      : spec_(spec), control_(std::move(control)), side_(side), trace_(trace) {}
+
+  void Add(double a) {
+    const double c = control_(a);
+    const bool in = std::isfinite(c) && InRange(spec_, c);
+    if (has_previous_ && in != previous_in_ && std::isfinite(c) && std::isfinite(previous_c_)) {
+      const double outside = in ? previous_c_ : c;
+      const double bound = outside < spec_.control_low ? spec_.control_low : spec_.control_high;
+      const double crossing = Toms748([&](double x) { return control_(x) - bound; },
+                                      std::min(previous_a_, a), std::max(previous_a_, a));
+      if (std::isfinite(crossing)) {
+        Push(crossing, control_(crossing), in);
+        open_ = in;
+      }
+    }
+    if (in) {
+      Push(a, c, !open_);
+      open_ = true;
+    } else {
+      open_ = false;
+    }
+    has_previous_ = true;
+    previous_in_ = in;
+    previous_a_ = a;
+    previous_c_ = c;
+  }
+
+ private:
+  void Push(double a, double control, bool breaks) {
+    const bool frequency = spec_.kind == SweepKind::kFrequency;
+    trace_->push_back({a, frequency ? control : spec_.omega_rad_s,
+                       frequency ? spec_.a_base : control, side_, breaks});
+  }
+
+  const CurveSpec& spec_;
+  std::function<double(double)> control_;
+  int side_;
+  std::vector<RawPoint>* trace_;
+  bool has_previous_ = false, previous_in_ = false, open_ = false;
+  double previous_a_ = 0.0, previous_c_ = 0.0;
+};
+
+std::vector<RawPoint> FrequencyTrace(const ParameterVector& p, const CurveSpec& spec) {
+  const auto k_lo = ResponseCoefficients<double>::FromParameters(p.data(), spec.control_low);
+  const auto k_hi = ResponseCoefficients<double>::FromParameters(p.data(), spec.control_high);
+  const double a_start = 0.25 * spec.a_base / std::sqrt(std::max(k_lo.c2(), k_hi.c2()));
+  const double a_bound = FrequencyAmplitudeBound(p, spec);
+  std::vector<RawPoint> trace;
+  if (!(a_start > 0.0) || !(a_bound > a_start)) return trace;
+  const auto pieces = RealPieces(p, spec.a_base, a_start, a_bound);
+  for (size_t piece = 0; piece < pieces.size(); ++piece) {
+    const std::vector<double> samples =
+        PieceSamples(pieces[piece].first, pieces[piece].second, spec.points_per_side);
+    for (int side = 0; side < 2; ++side) {
+      RangeWalker walker(
+          spec,
+          [&p, &spec, side](double a) { return SideFrequency(p, spec.a_base, a, side, true); },
+          static_cast<int>(2 * piece + side), &trace);
+      for (size_t i = 0; i < samples.size(); ++i)
+        walker.Add(side == 0 ? samples[i] : samples[samples.size() - 1 - i]);
+    }
+  }
+  // The right side continues the left one over the peak.
+  for (size_t i = 1; i < trace.size(); ++i) {
+    const RawPoint& before = trace[i - 1];
+    if (trace[i].breaks && trace[i].side == before.side + 1 && trace[i].side % 2 == 1 &&
+        trace[i].a == before.a) {
+      trace[i].breaks = false;
+    }
+  }
+  return trace;
+}
+
+std::vector<RawPoint> AmplitudeTrace(const ParameterVector& p, const CurveSpec& spec) {
+  const auto k = ResponseCoefficients<double>::FromParameters(p.data(), spec.omega_rad_s);
+  const TurningPoints tp = FindTurningPoints(k);
+  const double target = spec.control_high * spec.control_high;
+  const double seed =
+      std::max(spec.control_high / std::sqrt(k.c2()), tp.exist ? 2.0 * tp.a_upper_end : 0.0);
+  const double a_hi = internal::ExpandUntil(seed, [&](double a) { return k.G(a) > target; });
+  std::vector<RawPoint> trace;
+  if (!std::isfinite(a_hi)) return trace;
+  const int n = 2 * spec.points_per_side;
+  RangeWalker walker(
+      spec, [&k](double a) { return std::sqrt(k.G(a)); }, 0, &trace);
+  for (int i = 0; i <= n; ++i) walker.Add(a_hi * i / n);
+  return trace;
+}
+
+}  // namespace
+
+bool CurveSpec::IsValid(std::string* why) const {
+  auto fail = [why](const std::string& text) {
+    *why = text;
+    return false;
+  };
+  if (kind == SweepKind::kFrequency && !(a_base > 0.0 && std::isfinite(a_base)))
+    return fail(StringPrintf("a frequency curve needs a base level a_base > 0 (got %g)", a_base));
+  if (kind == SweepKind::kAmplitude && !(omega_rad_s > 0.0 && std::isfinite(omega_rad_s)))
+    return fail("an amplitude curve needs a drive frequency > 0");
+  const double min_low = kind == SweepKind::kFrequency ? 0.0 : -1.0;
+  if (!(control_low > min_low && control_high > control_low && std::isfinite(control_high)))
+    return fail(StringPrintf("the swept range [%g, %g] must be finite, positive and increasing",
+                             control_low, control_high));
+  if (points_per_side < 10 || points_per_side > 1000000)
+    return fail(StringPrintf("points_per_side %d is outside [10, 1000000]", points_per_side));
+  return true;
+}
+
+namespace {
+
+// The swept control on `side` at amplitude a: Omega [rad/s] or a_base.
+double SideControl(const ParameterVector& p, const CurveSpec& spec, double a, int side) {
+  if (spec.kind == SweepKind::kFrequency) return SideFrequency(p, spec.a_base, a, side % 2, true);
+  const auto k = ResponseCoefficients<double>::FromParameters(p.data(), spec.omega_rad_s);
+  return std::sqrt(k.G(a));
+}
+
+CurvePoint PointAt(const ParameterVector& p, const CurveSpec& spec, double a, int side) {
+  const double control = SideControl(p, spec, a, side);
+  const bool frequency = spec.kind == SweepKind::kFrequency;
+  return MakePoint(p, frequency ? control : spec.omega_rad_s, frequency ? spec.a_base : control, a);
+}
+
+// The fold between two points of one side whose stability differs: the root
+// of dG/da(a, Omega(a)) on [a0, a1]; false when it cannot be bracketed.
+bool FindFold(const ParameterVector& p, const CurveSpec& spec, double a0, double a1, int side,
+              CurvePoint* fold) {
+  auto dg = [&](double a) {
+    const CurvePoint point = PointAt(p, spec, a, side);
+    return point.dG_da;
+  };
+  const double a = Toms748(dg, std::min(a0, a1), std::max(a0, a1));
+  if (!std::isfinite(a)) return false;
+  *fold = PointAt(p, spec, a, side);
+  const auto k = ResponseCoefficients<double>::FromParameters(p.data(), fold->omega_rad_s);
+  fold->fold = true;
+  fold->fold_kind = k.d2G(a) < 0.0 ? JumpKind::kJumpUp : JumpKind::kJumpDown;
+  return std::isfinite(fold->omega_rad_s) && std::isfinite(fold->a_base);
+}
+
+void AddBackbone(const ParameterVector& p, const std::vector<RawPoint>& trace,
+                 ResponseCurve* curve) {
+  const CurveSpec& spec = curve->spec;
+  if (spec.kind == SweepKind::kAmplitude) {
+    const auto k = ResponseCoefficients<double>::FromParameters(p.data(), spec.omega_rad_s);
+    const double a2 = k.k4 != 0.0 ? -k.k3 / k.k4 : kNaN;
+    if (a2 > 0.0) {
+      const double a = std::sqrt(a2);
+      curve->backbone.push_back({spec.omega_rad_s, a, std::abs(k.P(a))});
+    }
+    return;
+  }
+  for (const RawPoint& raw : trace) {
+    if (raw.side % 2 != 0) continue;
+    const double x = MakeQuadratic(p, spec.a_base, raw.a).backbone_x;
+    if (!(x > 0.0) || !InRange(spec, std::sqrt(x))) continue;
+    const auto k = ResponseCoefficients<double>::FromParameters(p.data(), std::sqrt(x));
+    curve->backbone.push_back({std::sqrt(x), raw.a, std::abs(k.P(raw.a))});
+  }
+}
+
+}  // namespace
+
+ResponseCurve TraceResponseCurve(const ParameterVector& p, const CurveSpec& spec) {
+  std::string why;
+  if (!spec.IsValid(&why)) throw InputError(spec.name, 0, "curve", why);
+  if (!(p[kEtaE] > 0.0) || !(p[kMu1] >= 0.0) || !(p[kMu2] >= 0.0) || !(p[kMu1] + p[kMu2] > 0.0)) {
+    throw InputError(spec.name, 0, "curve",
+                     "the parameters make no response curve: it needs eta_e > 0, mu1 >= 0, "
+                     "mu2 >= 0 and some damping (mu1 + mu2 > 0); give physical parameters");
+  }
+  const std::vector<RawPoint> trace =
+      spec.kind == SweepKind::kFrequency ? FrequencyTrace(p, spec) : AmplitudeTrace(p, spec);
+  ResponseCurve curve;
+  curve.spec = spec;
+  int segment = 0;
+  for (size_t i = 0; i < trace.size(); ++i) {
+    CurvePoint point = MakePoint(p, trace[i].omega, trace[i].a_base, trace[i].a);
+    point.side = trace[i].side;
+    point.continues = i > 0 && !trace[i].breaks;
+    if (i > 0 && !point.continues) ++segment;
+    const CurvePoint* previous = i > 0 ? &curve.points.back() : nullptr;
+    if (point.continues && previous->stable != point.stable) {
+      CurvePoint fold;
+      if (previous->side == point.side &&
+          FindFold(p, spec, previous->a, point.a, point.side, &fold)) {
+        fold.side = point.side;
+        fold.continues = true;
+        fold.stable = previous->stable;
+        fold.segment = segment;
+        curve.points.push_back(fold);
+        curve.folds.push_back({fold.fold_kind, curve.Control(fold), fold.a});
+        fold.stable = point.stable;
+        fold.segment = ++segment;
+        curve.points.push_back(fold);
+      } else {
+        ++segment;
+      }
+    }
+    point.segment = segment;
+    curve.points.push_back(point);
+  }
+  AddBackbone(p, trace, &curve);
+  return curve;
+}
+
+std::vector<CurveRoot> CurveAmplitudesAt(const ParameterVector& p, const ResponseCurve& curve,
+                                         double control) {
+  const CurveSpec& spec = curve.spec;
+  std::vector<CurveRoot> roots;
+  for (size_t i = 1; i < curve.points.size(); ++i) {
+    const CurvePoint& a0 = curve.points[i - 1];
+    const CurvePoint& a1 = curve.points[i];
+    if (!a1.continues || a0.side != a1.side || a0.a == a1.a) continue;
+    const double c0 = curve.Control(a0) - control;
+    const double c1 = curve.Control(a1) - control;
+    const double omega = spec.kind == SweepKind::kFrequency ? control : spec.omega_rad_s;
+    // A point of the trace at the control (to rounding: the exact ends of
+    // the range) is a root itself.
+    bool at_point = false;
+    for (const CurvePoint* point : {&a0, &a1}) {
+      if (std::abs(curve.Control(*point) - control) <= 1e-13 * std::abs(control)) {
+        roots.push_back({point->a, DgDa(p, omega, point->a) > 0.0});
+        at_point = true;
+      }
+    }
+    if (at_point || c0 * c1 > 0.0) continue;
+    const int side = a1.side;
+    auto f = [&](double a) { return SideControl(p, spec, a, side) - control; };
+    const double a = Toms748(f, std::min(a0.a, a1.a), std::max(a0.a, a1.a));
+    if (!std::isfinite(a)) continue;
+    roots.push_back({a, DgDa(p, omega, a) > 0.0});
+  }
+  std::sort(roots.begin(), roots.end(),
+            [](const CurveRoot& x, const CurveRoot& y) { return x.a < y.a; });
+  std::vector<CurveRoot> distinct;
+  for (const CurveRoot& root : roots) {
+    if (!distinct.empty() && std::abs(root.a - distinct.back().a) <= 1e-12 * root.a) continue;
+    distinct.push_back(root);
+  }
+  return distinct;
+}
+
+double CurveAmplitudeOnBranch(const std::vector<CurveRoot>& roots, Branch branch, double a_guess) {
+  double best = kNaN;
+  for (const CurveRoot& root : roots) {
+    if (!root.stable) continue;
+    if (branch == Branch::kLower) return root.a;
+    if (branch == Branch::kUpper || !std::isfinite(best) ||
+        std::abs(root.a - a_guess) < std::abs(best - a_guess)) {
+      best = root.a;
+    }
+  }
+  return best;
+}
+
+std::vector<double> FrequenciesAtAmplitude(const ParameterVector& p, double a_base, double a) {
+  double x_minus, x_plus;
+  QuadraticRoots(MakeQuadratic(p, a_base, a), false, &x_minus, &x_plus);
+  std::vector<double> omegas;
+  for (double x : {x_minus, x_plus}) {
+    if (x > 0.0) omegas.push_back(std::sqrt(x));
+  }
+  return omegas;
+}
+
+}  // namespace dwellfit

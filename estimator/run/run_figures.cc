@@ -1,0 +1,97 @@
+#include "dwellfit/estimator/run/run_figures.h"
+
+#include <algorithm>
+
+#include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/string_printf.h"
+#include "dwellfit/estimator/curves/sweep_curves.h"
+#include "glog/logging.h"
+
+namespace dwellfit {
+namespace {
+
+std::string HeldControl(const CurveSpec& spec) {
+  return spec.kind == SweepKind::kFrequency
+             ? StringPrintf("a_base = %.6g", spec.a_base)
+             : StringPrintf("%.6g Hz", RadPerSecondToHz(spec.omega_rad_s));
+}
+
+FigureSweep MakeFigureSweep(const IdentificationReport& report, const ResponseCurve& curve) {
+  FigureSweep figure;
+  figure.id = curve.spec.name;
+  figure.kind = curve.spec.kind;
+  figure.held = HeldControl(curve.spec);
+  figure.segments = curve.points.empty() ? 1 : curve.points.back().segment + 1;
+  figure.role = "validation";
+  for (const SweepPrediction& prediction : report.predictions) {
+    if (prediction.sweep->id != figure.id) continue;
+    if (prediction.fitted) figure.role = "fitted";
+    figure.dwells += static_cast<int>(prediction.sweep->points.size());
+    for (const PredictedJump& jump : prediction.jumps) {
+      if (!jump.measured) continue;
+      for (double control : {jump.bracket.control_before, jump.bracket.control_after}) {
+        figure.jump_lines.push_back(figure.kind == SweepKind::kFrequency ? RadPerSecondToHz(control)
+                                                                         : control);
+      }
+    }
+  }
+  return figure;
+}
+
+}  // namespace
+
+std::vector<std::string> EstimateLines(const IdentificationReport& report) {
+  std::vector<std::string> lines;
+  const ParameterUncertainty& u = report.uncertainty;
+  for (int i = 0; i < kNumParameters; ++i) {
+    const bool omega = i == kNaturalFrequency;
+    const double scale = omega ? 1.0 / kTwoPi : 1.0;
+    std::string line = StringPrintf("%s = %.6g", omega ? "omega_hz" : ParameterName(i),
+                                    report.result.parameters[i] * scale);
+    if (report.options.fixed[i]) {
+      line += " (fixed)";
+    } else if (u.available) {
+      line += StringPrintf(" ± %.2g", u.standard_error[i] * scale);
+    }
+    lines.push_back(line);
+  }
+  return lines;
+}
+
+void AppendCurvesAndFigures(const IdentificationReport& report, std::vector<NamedFile>* files,
+                            std::ostream& out) {
+  std::vector<const Sweep*> sweeps;
+  for (const SweepPrediction& prediction : report.predictions) sweeps.push_back(prediction.sweep);
+  std::vector<ResponseCurve> curves;
+  try {
+    curves = TraceCurves(report.result.parameters, CurveSpecsForSweeps(sweeps));
+  } catch (const InputError& error) {
+    // Parameters where the model has no curve (a fit that stopped with no
+    // damping, say): the run's status says what happened; the files it can
+    // write are still written.
+    out << "warning: no curves or figures: " << error.what() << "\n";
+    return;
+  }
+  FigureSet figures;
+  figures.corner_lines = EstimateLines(report);
+  for (const ResponseCurve& curve : curves)
+    figures.sweeps.push_back(MakeFigureSweep(report, curve));
+  files->emplace_back("curves.csv", CurvesToCsv(curves));
+  files->emplace_back(kFigureScriptName, GnuplotFigureScript(figures));
+  std::vector<NamedFile> inputs;
+  for (const NamedFile& file : *files) {
+    if (file.first == "curves.csv" || file.first == "predictions.csv" ||
+        file.first == kFigureScriptName) {
+      inputs.push_back(file);
+    }
+  }
+  const RenderedFigures rendered = RenderFigures(inputs);
+  if (!rendered.rendered) {
+    LOG(WARNING) << rendered.warning;
+    out << "warning: " << rendered.warning << "\n";
+    return;
+  }
+  files->insert(files->end(), rendered.images.begin(), rendered.images.end());
+}
+
+}  // namespace dwellfit

@@ -1,0 +1,28 @@
+// The curves and figures of an identify run: curves.csv (the model's whole
+// response curve of every fitted and validation sweep, sweep_curves.h),
+// figures.gp (figures.h) and, when gnuplot is there, its PNG and SVG images.
+#ifndef DWELLFIT_ESTIMATOR_RUN_RUN_FIGURES_H_
+#define DWELLFIT_ESTIMATOR_RUN_RUN_FIGURES_H_
+
+#include <ostream>
+#include <vector>
+
+#include "dwellfit/estimator/analysis/identification_report.h"
+#include "dwellfit/estimator/curves/figures.h"
+
+namespace dwellfit {
+
+// Appends curves.csv and figures.gp to `files` (which must hold
+// predictions.csv, read by the script), and the rendered images when gnuplot
+// draws them; a missing or failing gnuplot is a warning on `out` and in the
+// log, never an error.
+void AppendCurvesAndFigures(const IdentificationReport& report, std::vector<NamedFile>* files,
+                            std::ostream& out);
+
+// The estimates as the figures' corner shows them: "eta_e = 100 ± 0.02",
+// omega in Hz, "(fixed)" for fixed parameters.
+std::vector<std::string> EstimateLines(const IdentificationReport& report);
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_ESTIMATOR_RUN_RUN_FIGURES_H_
