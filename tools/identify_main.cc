@@ -26,6 +26,9 @@ DEFINE_string(validate, "", "Overrides the validation sweeps: comma list");
 DEFINE_bool(accept_no_convergence, false,
             "Exit 0 also when the fit stopped at its iteration limit (status no_convergence), "
             "for scripted studies that read result.yaml's status themselves");
+DEFINE_bool(figures, true,
+            "Render the figures (PNG and SVG) with gnuplot; without, curves.csv and the gnuplot "
+            "script figures.gp are still written");
 DEFINE_string(set, "",
               "Overrides any config value: key.path=value[,key.path=value...], each key once, "
               "e.g. initial_guess.mu1=0.3,solver.function_tolerance=1e-12");
@@ -84,7 +87,9 @@ int main(int argc, char** argv) {
   try {
     const dwellfit::IdentifyConfig config =
         dwellfit::LoadIdentifyConfig(FLAGS_config, OverridesFromFlags());
-    const auto outcome = dwellfit::RunIdentify(config, std::cout);
+    dwellfit::IdentifyRunOptions run_options;
+    run_options.render_figures = FLAGS_figures;
+    const auto outcome = dwellfit::RunIdentify(config, std::cout, run_options);
     const dwellfit::IdentificationResult& result = outcome->report.result;
     const int exit_status = dwellfit::ExitStatusFor(result.status, FLAGS_accept_no_convergence);
     if (result.status != dwellfit::FitStatus::kConverged) {

@@ -87,7 +87,8 @@ int ExitStatusFor(FitStatus status, bool accept_no_convergence) {
   return kExitFailure;
 }
 
-std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::ostream& out) {
+std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::ostream& out,
+                                             const IdentifyRunOptions& run_options) {
   out << "# config in effect\n" << ConfigToYaml(config) << "\n";
   CheckOutputDirectory(config.output_dir, "output_dir");
   auto outcome = std::make_unique<IdentifyOutcome>();
@@ -126,7 +127,7 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
   PrintReport(report, out);
   std::vector<NamedFile> files = {{"result.yaml", ReportToYaml(report)},
                                   {"predictions.csv", ReportToPredictionsCsv(report)}};
-  AppendCurvesAndFigures(report, &files, out);
+  AppendCurvesAndFigures(report, &files, out, run_options.render_figures);
   WriteFilesAtomically(config.output_dir, files);
   out << "\nwrote into " << config.output_dir << ":";
   for (const NamedFile& file : files) out << " " << file.first;

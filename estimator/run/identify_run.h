@@ -28,7 +28,14 @@ struct IdentifyOutcome {
 // reason, and result.yaml records it. Throws InputError on bad input or when
 // no fit could be made at all (the model cannot be evaluated from the start,
 // or the estimate is not finite); nothing is written then.
-std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::ostream& out);
+// How a run writes, beyond what the config says.
+struct IdentifyRunOptions {
+  // Render the figures with gnuplot (curves.csv and figures.gp are written
+  // either way; rendering takes longer than the fit on small data).
+  bool render_figures = true;
+};
+std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::ostream& out,
+                                             const IdentifyRunOptions& options = {});
 
 // identify's exit status (README, "Exit status"):
 inline constexpr int kExitConverged = 0;       // a converged, identifiable fit

@@ -59,7 +59,7 @@ std::vector<std::string> EstimateLines(const IdentificationReport& report) {
 }
 
 void AppendCurvesAndFigures(const IdentificationReport& report, std::vector<NamedFile>* files,
-                            std::ostream& out) {
+                            std::ostream& out, bool render) {
   std::vector<const Sweep*> sweeps;
   for (const SweepPrediction& prediction : report.predictions) sweeps.push_back(prediction.sweep);
   std::vector<ResponseCurve> curves;
@@ -78,6 +78,7 @@ void AppendCurvesAndFigures(const IdentificationReport& report, std::vector<Name
     figures.sweeps.push_back(MakeFigureSweep(report, curve));
   files->emplace_back("curves.csv", CurvesToCsv(curves));
   files->emplace_back(kFigureScriptName, GnuplotFigureScript(figures));
+  if (!render) return;
   std::vector<NamedFile> inputs;
   for (const NamedFile& file : *files) {
     if (file.first == "curves.csv" || file.first == "predictions.csv" ||

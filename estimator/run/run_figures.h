@@ -13,11 +13,11 @@
 namespace dwellfit {
 
 // Appends curves.csv and figures.gp to `files` (which must hold
-// predictions.csv, read by the script), and the rendered images when gnuplot
-// draws them; a missing or failing gnuplot is a warning on `out` and in the
-// log, never an error.
+// predictions.csv, read by the script), and with `render` the images gnuplot
+// draws from them; a missing or failing gnuplot is a warning on `out` and in
+// the log, never an error.
 void AppendCurvesAndFigures(const IdentificationReport& report, std::vector<NamedFile>* files,
-                            std::ostream& out);
+                            std::ostream& out, bool render = true);
 
 // The estimates as the figures' corner shows them: "eta_e = 100 ± 0.02",
 // omega in Hz, "(fixed)" for fixed parameters.

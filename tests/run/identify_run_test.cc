@@ -34,6 +34,27 @@ std::string ReadFile(const fs::path& path) {
   return text.str();
 }
 
+// Without rendering, the run writes the data files and the gnuplot script,
+// no image, and records its status and the config it ran.
+TEST(RunIdentify, WithoutRenderingWritesTheScriptButNoImage) {
+  const std::string out_dir = FreshDir("no_figures");
+  const IdentifyConfig config = LoadIdentifyConfig(kConfig, {{"output_dir", out_dir, "--test"}});
+  std::ostringstream printed;
+  IdentifyRunOptions options;
+  options.render_figures = false;
+  RunIdentify(config, printed, options);
+  const YAML::Node manifest = YAML::LoadFile(out_dir + "/manifest.yaml");
+  std::vector<std::string> names;
+  for (const YAML::Node& file : manifest["files"]) names.push_back(file["name"].as<std::string>());
+  EXPECT_EQ(names, (std::vector<std::string>{"result.yaml", "predictions.csv", "curves.csv",
+                                             "figures.gp"}));
+  const YAML::Node result = YAML::LoadFile(out_dir + "/result.yaml");
+  EXPECT_EQ(result["status"].as<std::string>(), "converged");
+  EXPECT_FALSE(result["dwellfit_version"].as<std::string>().empty());
+  EXPECT_EQ(result["config_in_effect"]["fit"].size(), 2u);
+  EXPECT_FALSE(result["config_in_effect"]["output_dir"]);
+}
+
 TEST(RunIdentify, WritesResultYamlAndPredictionsForTheThesisCase) {
   const std::string out_dir = FreshDir("thesis");
   const IdentifyConfig config = LoadIdentifyConfig(kConfig, {{"output_dir", out_dir, "--test"}});
