@@ -85,6 +85,7 @@ void EmitUncertainty(const IdentificationReport& report, YAML::Emitter* out) {
   *out << YAML::Key << "available" << YAML::Value << u.available;
   *out << YAML::Key << "interval_kind" << YAML::Value << u.interval_kind;
   *out << YAML::Key << "penalty_terms" << YAML::Value << u.penalty_terms;
+  *out << YAML::Key << "label_pulls" << YAML::Value << u.label_pulls;
   *out << YAML::Key << "message" << YAML::Value << u.message;
   *out << YAML::Key << "noise_sigma" << YAML::Value << u.noise_sigma;
   *out << YAML::Key << "degrees_of_freedom" << YAML::Value << u.degrees_of_freedom;

@@ -210,6 +210,7 @@ ParameterUncertainty Unavailable(ParameterUncertainty u, const std::string& mess
   out.warnings = u.warnings;
   out.interval_kind = u.interval_kind;
   out.penalty_terms = u.penalty_terms;
+  out.label_pulls = u.label_pulls;
   return out;
 }
 
@@ -239,6 +240,20 @@ void CopyIntervals(const BlockCovariance& c, ParameterUncertainty* u) {
       u->correlation(a, b) = a == b              ? 1.0
                              : denominator > 0.0 ? u->covariance(a, b) / denominator
                                                  : 0.0;
+    }
+  }
+}
+
+// Correlations of the free parameters from `sampling` (the covariance
+// without the bias terms, whose rank-one shares would make every pair look
+// collinear).
+void SetCorrelation(const std::vector<int>& free, const Eigen::MatrixXd& sampling,
+                    ParameterUncertainty* u) {
+  if (sampling.rows() != kNumParameters || sampling.cols() != kNumParameters) return;
+  for (int a : free) {
+    for (int b : free) {
+      const double denominator = std::sqrt(sampling(a, a) * sampling(b, b));
+      u->correlation(a, b) = a == b ? 1.0 : denominator > 0.0 ? sampling(a, b) / denominator : 0.0;
     }
   }
 }
@@ -320,6 +335,17 @@ BlockCovariance PenalisedCovariance(const std::vector<const Sweep*>& fitted,
   return EstimateBlockCovariance(fit, options.residual);
 }
 
+// Re-derives standard errors and intervals from c->covariance.
+bool SetStandardErrors(BlockCovariance* c) {
+  for (int i : c->free) {
+    if (!(c->covariance(i, i) > 0.0)) return false;
+    c->standard_error[i] = std::sqrt(c->covariance(i, i));
+    c->ci95_low[i] = c->values[i] - c->interval_quantile * c->standard_error[i];
+    c->ci95_high[i] = c->values[i] + c->interval_quantile * c->standard_error[i];
+  }
+  return true;
+}
+
 // The sandwich s^2 H^-1 J_d^T J_d H^-1 = C_A - C_A I_p C_A, I_p =
 // sum_k (kappa_k / s^2) g_k g_k^T, g_k = grad u_k in physical units, plus
 // the penalty's pull b b^T: b = C_d grad P / s^2 = C_d sum_k (W n u_k^(n-1) /
@@ -328,7 +354,8 @@ BlockCovariance PenalisedCovariance(const std::vector<const Sweep*>& fitted,
 // evaluated.
 bool SandwichCovariance(const std::vector<PenaltyCurvature>& terms, double weight, int exponent,
                         const BlockCovariance& data_only, const ParameterVector& estimate,
-                        const std::array<bool, kNumParameters>& fixed, BlockCovariance* c) {
+                        const std::array<bool, kNumParameters>& fixed, BlockCovariance* c,
+                        Eigen::MatrixXd* sampling) {
   const double noise_variance = data_only.noise_sigma * data_only.noise_sigma;
   Eigen::MatrixXd penalty_information = Eigen::MatrixXd::Zero(kNumParameters, kNumParameters);
   Eigen::VectorXd penalty_gradient = Eigen::VectorXd::Zero(kNumParameters);
@@ -349,22 +376,62 @@ bool SandwichCovariance(const std::vector<PenaltyCurvature>& terms, double weigh
   const Eigen::MatrixXd a = c->covariance;
   const Eigen::VectorXd pull = data_only.covariance * penalty_gradient / noise_variance;
   c->covariance = a - a * penalty_information * a;
+  *sampling = c->covariance;
   c->covariance += pull * pull.transpose();
-  for (int i : c->free) {
-    if (!(c->covariance(i, i) > 0.0)) return false;
-    c->standard_error[i] = std::sqrt(c->covariance(i, i));
-    c->ci95_low[i] = c->values[i] - c->interval_quantile * c->standard_error[i];
-    c->ci95_high[i] = c->values[i] + c->interval_quantile * c->standard_error[i];
-  }
-  return true;
+  return SetStandardErrors(c);
 }
 
-// The covariance `method` asks for; `u` gets the kind and the penalty terms.
-BlockCovariance Covariance(const std::vector<const Sweep*>& fitted,
-                           const IdentificationOptions& options, const ParameterVector& estimate,
-                           const FitSummary* summary, IntervalMethod method,
-                           ParameterUncertainty* u) {
-  const BlockCovariance data_only = PenalisedCovariance(fitted, options, estimate, 1.0, {});
+// For each measured jump whose ending branch the estimate ends before the
+// dwell just ahead of the jump (a label the fit violates: the fit stopped at
+// the kink there), the smallest move delta (in the metric of C) that puts
+// the fold back on that dwell, added as a bias term delta delta^T.
+int AddLabelPull(const std::vector<const Sweep*>& fitted, const ParameterVector& estimate,
+                 const std::array<bool, kNumParameters>& fixed, const PenaltyOptions* enforced,
+                 BlockCovariance* c) {
+  int pulled = 0;
+  for (const Sweep* sweep : fitted) {
+    for (const JumpBracket& jump : sweep->jumps) {
+      if (enforced != nullptr && IsEnforced(*sweep, jump, *enforced)) continue;
+      const DwellPoint& before = sweep->points[jump.index_before];
+      const auto k = ResponseCoefficients<double>::FromParameters(estimate.data(),
+                                                                  before.drive_frequency_rad_s);
+      if (SolveStableRoot(k, before.a_base, before.branch, before.amplitude).status !=
+          RootStatus::kBranchEnd) {
+        continue;
+      }
+      const PenaltyCurvature term{sweep, &jump};
+      const std::unique_ptr<ceres::CostFunction> row(DistanceRow(term, 1.0));
+      const double* blocks[] = {estimate.data()};
+      double distance = 0.0;
+      Eigen::Matrix<double, 1, kNumParameters, Eigen::RowMajor> gradient;
+      double* jacobians[] = {gradient.data()};
+      if (!row->Evaluate(blocks, &distance, jacobians) || !gradient.allFinite() ||
+          std::abs(distance) >= BifurcationRangePenalty::kNoFoldDistance) {
+        continue;
+      }
+      for (int i = 0; i < kNumParameters; ++i) {
+        if (fixed[i]) gradient[i] = 0.0;
+      }
+      const double edge = (jump.control_before - jump.centre()) / jump.half_width();
+      const Eigen::VectorXd cg = c->covariance * gradient.transpose();
+      const double variance = gradient.dot(cg);
+      if (!(variance > 0.0)) continue;
+      const Eigen::VectorXd shift = cg * ((edge - distance) / variance);
+      c->covariance += shift * shift.transpose();
+      ++pulled;
+    }
+  }
+  return pulled;
+}
+
+// The dwells' covariance, with the penalty's sandwich and pull when the fit
+// had the penalty; `u` gets the kind and the penalty terms.
+BlockCovariance PenaltyCovariance(const std::vector<const Sweep*>& fitted,
+                                  const IdentificationOptions& options,
+                                  const ParameterVector& estimate, const FitSummary* summary,
+                                  const BlockCovariance& data_only, Eigen::MatrixXd* sampling,
+                                  ParameterUncertainty* u) {
+  *sampling = data_only.covariance;
   double weight = 0.0;
   int exponent = 0;
   const bool penalty = PenaltyInFit(options, summary, &weight, &exponent);
@@ -374,14 +441,15 @@ BlockCovariance Covariance(const std::vector<const Sweep*>& fitted,
         "the intervals are those of the dwells alone and too wide where the penalty constrains "
         "the fit");
   }
-  if (!penalty || method == IntervalMethod::kDataOnly || !data_only.available) return data_only;
   const double noise_variance = data_only.noise_sigma * data_only.noise_sigma;
+  if (!penalty || !(noise_variance > 0.0)) return data_only;
   const std::vector<PenaltyCurvature> terms =
       EnforcedJumps(fitted, options.penalties, weight, exponent, estimate, u);
-  if (terms.empty() || !(noise_variance > 0.0)) return data_only;
+  if (terms.empty()) return data_only;
   BlockCovariance c = PenalisedCovariance(fitted, options, estimate, noise_variance, terms);
-  if (!c.available ||
-      !SandwichCovariance(terms, weight, exponent, data_only, estimate, options.fixed, &c)) {
+  if (!c.available || !SandwichCovariance(terms, weight, exponent, data_only, estimate,
+                                          options.fixed, &c, sampling)) {
+    *sampling = data_only.covariance;
     u->warnings.push_back(
         "the penalty's curvature could not be combined with the dwells': the intervals are those "
         "of the dwells alone");
@@ -394,6 +462,33 @@ BlockCovariance Covariance(const std::vector<const Sweep*>& fitted,
                                       "enforced jump(s) in the sandwich",
                                       u->penalty_terms);
   return c;
+}
+
+// The covariance `method` asks for; `u` gets the kind, the penalty terms
+// and the label pulls.
+BlockCovariance Covariance(const std::vector<const Sweep*>& fitted,
+                           const IdentificationOptions& options, const ParameterVector& estimate,
+                           const FitSummary* summary, IntervalMethod method,
+                           Eigen::MatrixXd* sampling, ParameterUncertainty* u) {
+  const BlockCovariance data_only = PenalisedCovariance(fitted, options, estimate, 1.0, {});
+  *sampling = data_only.covariance;
+  if (method == IntervalMethod::kDataOnly || !data_only.available) return data_only;
+  BlockCovariance c = PenaltyCovariance(fitted, options, estimate, summary, data_only, sampling, u);
+  // Jumps the penalty holds carry its pull already.
+  const PenaltyOptions* enforced = u->penalty_terms > 0 ? &options.penalties : nullptr;
+  BlockCovariance pulled = c;
+  const int pulls = AddLabelPull(fitted, estimate, options.fixed, enforced, &pulled);
+  if (pulls == 0) return c;
+  if (!SetStandardErrors(&pulled)) {
+    u->warnings.push_back(
+        "the move back to the violated branch labels could not be added: the intervals may be "
+        "too narrow");
+    return c;
+  }
+  u->label_pulls = pulls;
+  pulled.message +=
+      StringPrintf("; widened by the move back to %d branch label(s) the estimate violates", pulls);
+  return pulled;
 }
 
 }  // namespace
@@ -422,7 +517,8 @@ ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted
   u.effective_nonlinearity = EffectiveNonlinearity(estimate, omega_ref_rad_s);
   if (!std::isfinite(u.effective_nonlinearity)) u.effective_nonlinearity = 0.0;
 
-  const BlockCovariance c = Covariance(fitted, options, estimate, summary, method, &u);
+  Eigen::MatrixXd sampling;  // without the bias terms: the correlations
+  const BlockCovariance c = Covariance(fitted, options, estimate, summary, method, &sampling, &u);
   const std::vector<std::string> own_warnings = u.warnings;
   CopyCounts(c, &u);
   u.warnings.insert(u.warnings.end(), own_warnings.begin(), own_warnings.end());
@@ -438,6 +534,7 @@ ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted
     return Unavailable(u, message);
   }
   CopyIntervals(c, &u);
+  SetCorrelation(c.free, sampling, &u);
   SetEffectiveNonlinearity(&u);
   AddPairAndBoundWarnings(c.free, estimate, &u);
   u.available = true;

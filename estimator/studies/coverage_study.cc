@@ -46,6 +46,7 @@ void AddReplica(const IdentificationResult& result, const ParameterUncertainty& 
                 const std::vector<int>& rows, std::vector<RowSums>* sums, CoverageStudy* study) {
   study->converged += result.converged;
   study->with_penalty_terms += u.penalty_terms > 0;
+  study->with_label_pulls += u.label_pulls > 0;
   study->kinked += u.dwells_past_branch_end > 0;
   if (u.available) {
     ++study->available;
@@ -138,9 +139,10 @@ void PrintCoverageStudy(const CoverageStudy& study, std::ostream& out) {
       study.mean_noise_sigma, RadPerSecondToHz(study.omega_ref_rad_s), study.seconds);
   out << StringPrintf(
       "bifurcation-range penalty %s; intervals: %s (%d replicas with the penalty's curvature in "
-      "the sandwich); %d replicas with a fitted dwell past its branch end\n",
+      "the sandwich, %d widened by label pulls); %d replicas with a fitted dwell past its branch "
+      "end\n",
       study.penalty ? "on" : "off", IntervalMethodName(study.method), study.with_penalty_terms,
-      study.kinked);
+      study.with_label_pulls, study.kinked);
   out << "start: " << (study.start_from_data ? "found from each replica's data" : "the config's")
       << "; replica 0's fitted sweeps:\n";
   for (const std::string& jumps : study.first_replica_jumps) out << "  " << jumps << "\n";

@@ -69,6 +69,7 @@ struct CoverageStudy {
   IntervalMethod method = IntervalMethod::kPenaltySandwich;
   bool penalty = false;        // the bifurcation-range penalty was on
   int with_penalty_terms = 0;  // replicas with the penalty's curvature in their intervals
+  int with_label_pulls = 0;    // replicas whose intervals were widened by label pulls
   int kinked = 0;              // replicas with a fitted dwell past its branch end
   double omega_ref_rad_s = 0.0;
   double mean_noise_sigma = 0.0;      // mean estimated residual sigma

@@ -350,7 +350,7 @@ Eigen::VectorXd DistanceGradient(const Sweep& sweep, const JumpBracket& jump,
 //   C = C_A C_d^-1 C_A + b b^T,  b = C_d sum_k (W n u_k^(n - 1) / 2) g_k / s^2,
 // with C_d the dwells' own covariance.
 TEST_F(UncertaintyThesisNumerical, PenaltyEntersTheCovarianceAsASandwichWithItsPull) {
-  const ResolvedRun noisy = NoisyRun(20261121);
+  const ResolvedRun noisy = NoisyRun(1);  // a fit that keeps every branch label
   IdentificationOptions options = config_.identification;
   options.penalties.bifurcation_range.enabled = true;
   const IdentificationResult result = Identify(noisy.fitted, options);
@@ -364,6 +364,7 @@ TEST_F(UncertaintyThesisNumerical, PenaltyEntersTheCovarianceAsASandwichWithItsP
   EXPECT_EQ(data.interval_kind, "gauss_newton");
   EXPECT_EQ(u.interval_kind, "gauss_newton_sandwich_with_penalty");
   EXPECT_EQ(u.penalty_terms, 2);  // F0.01/up jump_down and A41.5/up jump_up
+  ASSERT_EQ(u.label_pulls, 0);
   EXPECT_THAT(u.message, HasSubstr("penalty's curvature at 2 enforced jump(s)"));
 
   const StageSummary& stage = result.stages.back();
@@ -423,9 +424,57 @@ TEST_F(UncertaintyThesisNumerical, PenaltyEntersTheCovarianceAsASandwichWithItsP
   EXPECT_DOUBLE_EQ(unknown.standard_error[kMu2], data.standard_error[kMu2]);
 }
 
+// A fit that ends F0.01/up's upper branch before its 42.2 Hz dwell (the
+// label says the fold lies beyond it) has its intervals widened by the move
+// back: C = C_d + delta delta^T, and p + delta puts the fold on that dwell to
+// first order.
+TEST_F(UncertaintyThesisNumerical, ViolatedBranchLabelWidensByTheMoveBackToIt) {
+  // The exact data at the truth with 1 % less alpha: the fold moves below
+  // the 42.2 Hz dwell (as in WarnsWhenTheModelsFoldFallsShortOfMeasuredDwells).
+  ParameterVector soft = kTruth;
+  soft[kAlpha] *= 0.99;
+  const ParameterUncertainty data = EstimateUncertainty(
+      Fitted(exact_), config_.identification, soft, omega_ref_, nullptr, IntervalMethod::kDataOnly);
+  const ParameterUncertainty u =
+      EstimateUncertainty(Fitted(exact_), config_.identification, soft, omega_ref_);
+  ASSERT_TRUE(data.available) << data.message;
+  ASSERT_TRUE(u.available) << u.message;
+  EXPECT_EQ(data.label_pulls, 0);
+  ASSERT_EQ(u.label_pulls, 1);
+  EXPECT_EQ(u.interval_kind, "gauss_newton");
+  EXPECT_THAT(u.message, HasSubstr("widened by the move back to 1 branch label(s)"));
+
+  // The difference is rank one: delta delta^T.
+  const ParameterMatrix difference = u.covariance - data.covariance;
+  ASSERT_GT(difference(kAlpha, kAlpha), 0.0);
+  const Eigen::Matrix<double, kNumParameters, 1> delta =
+      difference.col(kAlpha) / std::sqrt(difference(kAlpha, kAlpha));
+  EXPECT_TRUE(difference.isApprox(delta * delta.transpose(), 1e-9));
+  EXPECT_GT(u.standard_error[kAlpha], data.standard_error[kAlpha]);
+  // The correlations stay those of the dwells: the bias term is left out.
+  EXPECT_TRUE(u.correlation.isApprox(data.correlation, 1e-12));
+
+  // Where the fold sits, in half-widths of the bracket 42.2..42.3 Hz (-1: on
+  // the 42.2 Hz dwell), and its change along delta by finite differences:
+  // to first order delta moves it onto the dwell.
+  const Sweep* up = Named(exact_, {"F0.01"}).front();
+  ASSERT_EQ(up->direction, SweepDirection::kUp);
+  ASSERT_EQ(up->jumps.size(), 1u);
+  double before = 0.0, nudged = 0.0;
+  DistanceGradient(*up, up->jumps[0], soft, &before);
+  EXPECT_LT(before, -1.0);  // past the dwell
+  constexpr double kStep = 1e-4;
+  ParameterVector towards = soft;
+  for (int i = 0; i < kNumParameters; ++i) towards[i] += kStep * delta[i];
+  DistanceGradient(*up, up->jumps[0], towards, &nudged);
+  // delta delta^T fixes delta up to its sign.
+  EXPECT_NEAR(std::abs(nudged - before) / kStep, -1.0 - before, 1e-3 * std::abs(1.0 + before))
+      << before << " -> " << nudged;
+}
+
 // The bar: over 200 noisy replicas each free parameter's 95 % interval
 // covers the truth in 90-98 % of them (binomial sd of the rate: 1.5 %), and
-// the mean standard error matches the spread of the estimates.
+// the mean standard error is near the spread of the estimates.
 TEST(UncertaintyCoverage, NinetyFivePercentIntervalsCoverTheTruthOnTheThesisCase) {
   const IdentifyConfig config = LoadIdentifyConfig(kDataset + "/beam.yaml");
   const DwellPlan plan = ReadDwellPlan(kDataset + "/plan.yaml");
@@ -444,8 +493,11 @@ TEST(UncertaintyCoverage, NinetyFivePercentIntervalsCoverTheTruthOnTheThesisCase
     EXPECT_GE(row.Coverage(), 0.90) << row.name;
     EXPECT_LE(row.Coverage(), 0.98) << row.name;
     EXPECT_GT(row.mean_standard_error, 0.75 * row.empirical_std) << row.name;
-    EXPECT_LT(row.mean_standard_error, 1.33 * row.empirical_std) << row.name;
+    // Two thirds of these fits stop short of a branch label and carry its
+    // pull, a bias term: mu1 and mu2, correlated with the fold, get 1.43.
+    EXPECT_LT(row.mean_standard_error, 1.5 * row.empirical_std) << row.name;
   }
+  EXPECT_GT(study.with_label_pulls, study.replicas / 2);
 }
 
 }  // namespace
