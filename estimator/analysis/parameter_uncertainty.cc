@@ -309,9 +309,10 @@ void WarnAboutDwellsPastTheirBranchEnd(const std::vector<const Sweep*>& fitted,
   if (u->dwells_past_branch_end == 0) return;
   u->warnings.push_back(StringPrintf(
       "%d fitted dwell(s) lie past the end of their branch at the estimate (%s%s): the model's "
-      "fold falls short of where they were measured, the fit is not smooth there and the "
-      "intervals may be too narrow; check the branch labels or enable the branch-stability "
-      "penalty",
+      "fold falls short of where they were measured and the fit is not smooth there; where the "
+      "sweep's measured jump ends that branch the intervals are widened by the move back to it "
+      "(label pulls), elsewhere they may be too narrow; check the branch labels or enable the "
+      "branch-stability penalty",
       u->dwells_past_branch_end, examples.c_str(), u->dwells_past_branch_end > 3 ? ", ..." : ""));
 }
 
