@@ -2,7 +2,7 @@
 //
 //   coverage_study --config datasets/thesis-numerical/beam.yaml \
 //                  --plan datasets/thesis-numerical/plan.yaml --replicas 200 --noise 0.01 \
-//                  [--set 'initial_guess=auto,fixed=[]']
+//                  [--set 'initial_guess=auto,fixed=[]'] [--interval_method data_only]
 //
 // Fits `replicas` noisy simulations of the plan with the config (each taking
 // the path of a measured run: labelled, the config's jumps applied, the
@@ -25,6 +25,9 @@ DEFINE_string(plan, "", "YAML dwell plan: truth and sweeps to simulate (required
 DEFINE_int32(replicas, 200, "number of noisy replicas.");
 DEFINE_double(noise, 0.01, "relative noise sigma: a *= 1 + noise N(0, 1).");
 DEFINE_uint64(first_seed, 1, "seed of the first replica; replica r uses first_seed + r.");
+DEFINE_string(interval_method, "penalty_sandwich",
+              "how the intervals treat the bifurcation-range penalty: penalty_sandwich "
+              "(identify's) or data_only.");
 DEFINE_string(set, "",
               "Overrides config values as identify's --set does: key.path=value[,...], e.g. "
               "'initial_guess=auto,fixed=[]'");
@@ -49,6 +52,11 @@ int main(int argc, char** argv) {
     options.replicas = FLAGS_replicas;
     options.relative_noise = FLAGS_noise;
     options.first_seed = FLAGS_first_seed;
+    if (!dwellfit::ParseIntervalMethod(FLAGS_interval_method, &options.method)) {
+      std::cerr << "coverage_study: --interval_method '" << FLAGS_interval_method
+                << "': give penalty_sandwich or data_only\n";
+      return 2;
+    }
     dwellfit::PrintCoverageStudy(dwellfit::RunCoverageStudy(config, plan, options), std::cout);
   } catch (const dwellfit::InputError& e) {
     std::cerr << "coverage_study: " << e.what() << "\n";

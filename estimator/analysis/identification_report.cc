@@ -84,6 +84,9 @@ void EmitUncertainty(const IdentificationReport& report, YAML::Emitter* out) {
   const ParameterUncertainty& u = report.uncertainty;
   *out << YAML::Key << "uncertainty" << YAML::Value << YAML::BeginMap;
   *out << YAML::Key << "available" << YAML::Value << u.available;
+  *out << YAML::Key << "interval_kind" << YAML::Value << u.interval_kind;
+  *out << YAML::Key << "penalty_terms" << YAML::Value << u.penalty_terms;
+  *out << YAML::Key << "label_pulls" << YAML::Value << u.label_pulls;
   *out << YAML::Key << "message" << YAML::Value << u.message;
   *out << YAML::Key << "noise_sigma" << YAML::Value << u.noise_sigma;
   *out << YAML::Key << "degrees_of_freedom" << YAML::Value << u.degrees_of_freedom;
@@ -288,7 +291,7 @@ void PrintParameters(const IdentificationReport& report, std::ostream& out) {
   out << StringPrintf("starts: %zu, %d reached the best (start %d)\n",
                       report.multi_start.starts.size(), report.multi_start.reached_best,
                       report.multi_start.best_start);
-  out << "uncertainty: " << u.message << "\n";
+  out << "uncertainty (" << u.interval_kind << "): " << u.message << "\n";
   for (const std::string& warning : u.warnings) out << "warning: " << warning << "\n";
 }
 

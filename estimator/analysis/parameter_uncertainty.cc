@@ -10,6 +10,8 @@
 
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/fit/fit_description.h"
+#include "dwellfit/estimator/fit/problem_builder.h"
+#include "dwellfit/residuals/functors/bifurcation_range_penalty.h"
 #include "dwellfit/residuals/model/response_model.h"
 #include "dwellfit/residuals/model/stable_root.h"
 
@@ -119,6 +121,79 @@ int DwellsPastTheirBranchEnd(const std::vector<const Sweep*>& fitted,
   return count;
 }
 
+// One enforced jump of the bifurcation-range penalty at the estimate: its
+// distance u from the bracket's centre in half-widths and the curvature
+// kappa = (1/2) W n (n - 1) u^(n - 2) of its cost (1/2) W u^n along grad u.
+struct PenaltyCurvature {
+  const Sweep* sweep;
+  const JumpBracket* jump;
+  double distance = 0.0;   // u
+  double curvature = 0.0;  // kappa
+};
+
+// The penalty's W and n in the fit's last stage that had it; false when
+// the penalty is off or no stage had it.
+bool PenaltyInFit(const IdentificationOptions& options, const FitSummary* summary, double* weight,
+                  int* exponent) {
+  if (!options.penalties.bifurcation_range.enabled || summary == nullptr) return false;
+  for (auto stage = summary->stages.rbegin(); stage != summary->stages.rend(); ++stage) {
+    if (stage->penalty_exponent <= 0) continue;
+    *weight = options.penalties.bifurcation_range.weight * stage->penalty_unit;
+    *exponent = stage->penalty_exponent;
+    return *weight > 0.0 && std::isfinite(*weight);
+  }
+  return false;
+}
+
+bool IsEnforced(const Sweep& sweep, const JumpBracket& jump, const PenaltyOptions& penalties) {
+  const BifurcationRangeOptions& range = penalties.bifurcation_range;
+  return range.enabled && std::find(range.enforce.begin(), range.enforce.end(),
+                                    TargetOf(sweep, jump)) != range.enforce.end();
+}
+
+// A row whose residual is sqrt(weight) u (BifurcationRangePenalty, n = 2).
+ceres::CostFunction* DistanceRow(const PenaltyCurvature& term, double weight) {
+  BifurcationRangeOptions reading;
+  reading.exponent = 2;
+  reading.weight = weight;
+  return MakeBifurcationRangePenalty(*term.sweep, *term.jump, reading);
+}
+
+// Every enforced jump's distance and curvature at `estimate`, with warnings
+// for folds missing or outside their bracket.
+std::vector<PenaltyCurvature> EnforcedJumps(const std::vector<const Sweep*>& fitted,
+                                            const PenaltyOptions& penalties, double weight,
+                                            int exponent, const ParameterVector& estimate,
+                                            ParameterUncertainty* u) {
+  std::vector<PenaltyCurvature> terms;
+  for (const Sweep* sweep : fitted) {
+    for (const JumpBracket& jump : sweep->jumps) {
+      if (!IsEnforced(*sweep, jump, penalties)) continue;
+      PenaltyCurvature term{sweep, &jump};
+      const std::unique_ptr<ceres::CostFunction> row(DistanceRow(term, 1.0));
+      const double* blocks[] = {estimate.data()};
+      const std::string name = sweep->Name() + " " + JumpKindName(jump.kind);
+      if (!row->Evaluate(blocks, &term.distance, nullptr) || !std::isfinite(term.distance) ||
+          std::abs(term.distance) >= BifurcationRangePenalty::kNoFoldDistance) {
+        u->warnings.push_back(name +
+                              ": the model has no fold for this enforced jump at the "
+                              "estimate; the intervals leave this jump's penalty out");
+        continue;
+      }
+      if (std::abs(term.distance) > 1.0) {
+        u->warnings.push_back(StringPrintf(
+            "%s: the model's fold lies %.2f half-widths from the centre of its measured bracket, "
+            "outside it; the penalty dominates there and the intervals are poor",
+            name.c_str(), term.distance));
+      }
+      term.curvature = 0.5 * weight * exponent * (exponent - 1) *
+                       std::pow(std::abs(term.distance), exponent - 2);
+      terms.push_back(term);
+    }
+  }
+  return terms;
+}
+
 ParameterUncertainty Unavailable(ParameterUncertainty u, const std::string& message) {
   ParameterUncertainty out;
   out.available = false;
@@ -133,6 +208,9 @@ ParameterUncertainty Unavailable(ParameterUncertainty u, const std::string& mess
   out.effective_nonlinearity = u.effective_nonlinearity;
   out.dwells_past_branch_end = u.dwells_past_branch_end;
   out.warnings = u.warnings;
+  out.interval_kind = u.interval_kind;
+  out.penalty_terms = u.penalty_terms;
+  out.label_pulls = u.label_pulls;
   return out;
 }
 
@@ -162,6 +240,20 @@ void CopyIntervals(const BlockCovariance& c, ParameterUncertainty* u) {
       u->correlation(a, b) = a == b              ? 1.0
                              : denominator > 0.0 ? u->covariance(a, b) / denominator
                                                  : 0.0;
+    }
+  }
+}
+
+// Correlations of the free parameters from `sampling` (the covariance
+// without the bias terms, whose rank-one shares would make every pair look
+// collinear).
+void SetCorrelation(const std::vector<int>& free, const Eigen::MatrixXd& sampling,
+                    ParameterUncertainty* u) {
+  if (sampling.rows() != kNumParameters || sampling.cols() != kNumParameters) return;
+  for (int a : free) {
+    for (int b : free) {
+      const double denominator = std::sqrt(sampling(a, a) * sampling(b, b));
+      u->correlation(a, b) = a == b ? 1.0 : denominator > 0.0 ? sampling(a, b) / denominator : 0.0;
     }
   }
 }
@@ -217,27 +309,220 @@ void WarnAboutDwellsPastTheirBranchEnd(const std::vector<const Sweep*>& fitted,
   if (u->dwells_past_branch_end == 0) return;
   u->warnings.push_back(StringPrintf(
       "%d fitted dwell(s) lie past the end of their branch at the estimate (%s%s): the model's "
-      "fold falls short of where they were measured, the fit is not smooth there and the "
-      "intervals may be too narrow; check the branch labels or enable the branch-stability "
-      "penalty",
+      "fold falls short of where they were measured and the fit is not smooth there; where the "
+      "sweep's measured jump ends that branch the intervals are widened by the move back to it "
+      "(label pulls), elsewhere they may be too narrow; check the branch labels or enable the "
+      "branch-stability penalty",
       u->dwells_past_branch_end, examples.c_str(), u->dwells_past_branch_end > 3 ? ", ..." : ""));
+}
+
+// A = J_d^T J_d / s^2 + sum_k (kappa_k / s^2) g_k g_k^T inverted: the
+// covariance with each enforced jump's curvature as a row (the caller's
+// residual blocks of EstimateBlockCovariance).
+BlockCovariance PenalisedCovariance(const std::vector<const Sweep*>& fitted,
+                                    const IdentificationOptions& options,
+                                    const ParameterVector& estimate, double noise_variance,
+                                    const std::vector<PenaltyCurvature>& terms) {
+  ParameterVector parameters = estimate;  // the block the problem reads
+  FitDescription fit = SingleBlockFit(fitted, options.fixed, &parameters);
+  if (!terms.empty()) {
+    fit.add_residuals = [&terms, &parameters, noise_variance](ceres::Problem* problem) {
+      for (const PenaltyCurvature& term : terms) {
+        problem->AddResidualBlock(DistanceRow(term, term.curvature / noise_variance), nullptr,
+                                  parameters.data());
+      }
+    };
+  }
+  return EstimateBlockCovariance(fit, options.residual);
+}
+
+// Re-derives standard errors and intervals from c->covariance.
+bool SetStandardErrors(BlockCovariance* c) {
+  for (int i : c->free) {
+    if (!(c->covariance(i, i) > 0.0)) return false;
+    c->standard_error[i] = std::sqrt(c->covariance(i, i));
+    c->ci95_low[i] = c->values[i] - c->interval_quantile * c->standard_error[i];
+    c->ci95_high[i] = c->values[i] + c->interval_quantile * c->standard_error[i];
+  }
+  return true;
+}
+
+// The sandwich s^2 H^-1 J_d^T J_d H^-1 = C_A - C_A I_p C_A, I_p =
+// sum_k (kappa_k / s^2) g_k g_k^T, g_k = grad u_k in physical units, plus
+// the penalty's pull b b^T: b = C_d grad P / s^2 = C_d sum_k (W n u_k^(n-1) /
+// (2 s^2)) g_k, how far the penalty moved the estimate from the dwells' own
+// minimum (C_d: the dwells' covariance). False when a gradient cannot be
+// evaluated.
+bool SandwichCovariance(const std::vector<PenaltyCurvature>& terms, double weight, int exponent,
+                        const BlockCovariance& data_only, const ParameterVector& estimate,
+                        const std::array<bool, kNumParameters>& fixed, BlockCovariance* c,
+                        Eigen::MatrixXd* sampling) {
+  const double noise_variance = data_only.noise_sigma * data_only.noise_sigma;
+  Eigen::MatrixXd penalty_information = Eigen::MatrixXd::Zero(kNumParameters, kNumParameters);
+  Eigen::VectorXd penalty_gradient = Eigen::VectorXd::Zero(kNumParameters);
+  for (const PenaltyCurvature& term : terms) {
+    const std::unique_ptr<ceres::CostFunction> row(DistanceRow(term, 1.0));
+    const double* blocks[] = {estimate.data()};
+    double distance = 0.0;
+    Eigen::Matrix<double, 1, kNumParameters, Eigen::RowMajor> gradient;
+    double* jacobians[] = {gradient.data()};
+    if (!row->Evaluate(blocks, &distance, jacobians) || !gradient.allFinite()) return false;
+    for (int i = 0; i < kNumParameters; ++i) {
+      if (fixed[i]) gradient[i] = 0.0;
+    }
+    penalty_information += (term.curvature / noise_variance) * gradient.transpose() * gradient;
+    penalty_gradient +=
+        0.5 * weight * exponent * std::pow(distance, exponent - 1) * gradient.transpose();
+  }
+  const Eigen::MatrixXd a = c->covariance;
+  const Eigen::VectorXd pull = data_only.covariance * penalty_gradient / noise_variance;
+  c->covariance = a - a * penalty_information * a;
+  *sampling = c->covariance;
+  c->covariance += pull * pull.transpose();
+  return SetStandardErrors(c);
+}
+
+// For each measured jump whose ending branch the estimate ends before the
+// dwell just ahead of the jump (a label the fit violates: the fit stopped at
+// the kink there), the smallest move delta (in the metric of C) that puts
+// the fold back on that dwell, added as a bias term delta delta^T.
+int AddLabelPull(const std::vector<const Sweep*>& fitted, const ParameterVector& estimate,
+                 const std::array<bool, kNumParameters>& fixed, const PenaltyOptions* enforced,
+                 BlockCovariance* c) {
+  int pulled = 0;
+  for (const Sweep* sweep : fitted) {
+    for (const JumpBracket& jump : sweep->jumps) {
+      if (enforced != nullptr && IsEnforced(*sweep, jump, *enforced)) continue;
+      const DwellPoint& before = sweep->points[jump.index_before];
+      const auto k = ResponseCoefficients<double>::FromParameters(estimate.data(),
+                                                                  before.drive_frequency_rad_s);
+      if (SolveStableRoot(k, before.a_base, before.branch, before.amplitude).status !=
+          RootStatus::kBranchEnd) {
+        continue;
+      }
+      const PenaltyCurvature term{sweep, &jump};
+      const std::unique_ptr<ceres::CostFunction> row(DistanceRow(term, 1.0));
+      const double* blocks[] = {estimate.data()};
+      double distance = 0.0;
+      Eigen::Matrix<double, 1, kNumParameters, Eigen::RowMajor> gradient;
+      double* jacobians[] = {gradient.data()};
+      if (!row->Evaluate(blocks, &distance, jacobians) || !gradient.allFinite() ||
+          std::abs(distance) >= BifurcationRangePenalty::kNoFoldDistance) {
+        continue;
+      }
+      for (int i = 0; i < kNumParameters; ++i) {
+        if (fixed[i]) gradient[i] = 0.0;
+      }
+      const double edge = (jump.control_before - jump.centre()) / jump.half_width();
+      const Eigen::VectorXd cg = c->covariance * gradient.transpose();
+      const double variance = gradient.dot(cg);
+      if (!(variance > 0.0)) continue;
+      const Eigen::VectorXd shift = cg * ((edge - distance) / variance);
+      c->covariance += shift * shift.transpose();
+      ++pulled;
+    }
+  }
+  return pulled;
+}
+
+// The dwells' covariance, with the penalty's sandwich and pull when the fit
+// had the penalty; `u` gets the kind and the penalty terms.
+BlockCovariance PenaltyCovariance(const std::vector<const Sweep*>& fitted,
+                                  const IdentificationOptions& options,
+                                  const ParameterVector& estimate, const FitSummary* summary,
+                                  const BlockCovariance& data_only, Eigen::MatrixXd* sampling,
+                                  ParameterUncertainty* u) {
+  *sampling = data_only.covariance;
+  double weight = 0.0;
+  int exponent = 0;
+  const bool penalty = PenaltyInFit(options, summary, &weight, &exponent);
+  if (options.penalties.bifurcation_range.enabled && !penalty) {
+    u->warnings.push_back(
+        "the bifurcation-range penalty was on, but the fit's penalty weight is not known here: "
+        "the intervals are those of the dwells alone and too wide where the penalty constrains "
+        "the fit");
+  }
+  const double noise_variance = data_only.noise_sigma * data_only.noise_sigma;
+  if (!penalty || !(noise_variance > 0.0)) return data_only;
+  const std::vector<PenaltyCurvature> terms =
+      EnforcedJumps(fitted, options.penalties, weight, exponent, estimate, u);
+  if (terms.empty()) return data_only;
+  BlockCovariance c = PenalisedCovariance(fitted, options, estimate, noise_variance, terms);
+  if (!c.available || !SandwichCovariance(terms, weight, exponent, data_only, estimate,
+                                          options.fixed, &c, sampling)) {
+    *sampling = data_only.covariance;
+    u->warnings.push_back(
+        "the penalty's curvature could not be combined with the dwells': the intervals are those "
+        "of the dwells alone");
+    return data_only;
+  }
+  u->interval_kind = "gauss_newton_sandwich_with_penalty";
+  u->penalty_terms = static_cast<int>(terms.size());
+  c.message = data_only.message + StringPrintf(
+                                      "; the bifurcation-range penalty's curvature at %d "
+                                      "enforced jump(s) in the sandwich",
+                                      u->penalty_terms);
+  return c;
+}
+
+// The covariance `method` asks for; `u` gets the kind, the penalty terms
+// and the label pulls.
+BlockCovariance Covariance(const std::vector<const Sweep*>& fitted,
+                           const IdentificationOptions& options, const ParameterVector& estimate,
+                           const FitSummary* summary, IntervalMethod method,
+                           Eigen::MatrixXd* sampling, ParameterUncertainty* u) {
+  const BlockCovariance data_only = PenalisedCovariance(fitted, options, estimate, 1.0, {});
+  *sampling = data_only.covariance;
+  if (method == IntervalMethod::kDataOnly || !data_only.available) return data_only;
+  BlockCovariance c = PenaltyCovariance(fitted, options, estimate, summary, data_only, sampling, u);
+  // Jumps the penalty holds carry its pull already.
+  const PenaltyOptions* enforced = u->penalty_terms > 0 ? &options.penalties : nullptr;
+  BlockCovariance pulled = c;
+  const int pulls = AddLabelPull(fitted, estimate, options.fixed, enforced, &pulled);
+  if (pulls == 0) return c;
+  if (!SetStandardErrors(&pulled)) {
+    u->warnings.push_back(
+        "the move back to the violated branch labels could not be added: the intervals may be "
+        "too narrow");
+    return c;
+  }
+  u->label_pulls = pulls;
+  pulled.message +=
+      StringPrintf("; widened by the move back to %d branch label(s) the estimate violates", pulls);
+  return pulled;
 }
 
 }  // namespace
 
+const char* IntervalMethodName(IntervalMethod method) {
+  return method == IntervalMethod::kDataOnly ? "data_only" : "penalty_sandwich";
+}
+
+bool ParseIntervalMethod(const std::string& name, IntervalMethod* method) {
+  for (IntervalMethod candidate : {IntervalMethod::kDataOnly, IntervalMethod::kPenaltySandwich}) {
+    if (name == IntervalMethodName(candidate)) {
+      *method = candidate;
+      return true;
+    }
+  }
+  return false;
+}
+
 ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted,
                                          const IdentificationOptions& options,
-                                         const ParameterVector& estimate, double omega_ref_rad_s) {
+                                         const ParameterVector& estimate, double omega_ref_rad_s,
+                                         const FitSummary* summary, IntervalMethod method) {
   ParameterUncertainty u;
   if (!(omega_ref_rad_s > 0.0)) omega_ref_rad_s = estimate[kNaturalFrequency];
   u.omega_ref_rad_s = omega_ref_rad_s;
   u.effective_nonlinearity = EffectiveNonlinearity(estimate, omega_ref_rad_s);
   if (!std::isfinite(u.effective_nonlinearity)) u.effective_nonlinearity = 0.0;
 
-  ParameterVector parameters = estimate;  // the block the problem reads
-  const FitDescription fit = SingleBlockFit(fitted, options.fixed, &parameters);
-  const BlockCovariance c = EstimateBlockCovariance(fit, options.residual);
+  Eigen::MatrixXd sampling;  // without the bias terms: the correlations
+  const BlockCovariance c = Covariance(fitted, options, estimate, summary, method, &sampling, &u);
+  const std::vector<std::string> own_warnings = u.warnings;
   CopyCounts(c, &u);
+  u.warnings.insert(u.warnings.end(), own_warnings.begin(), own_warnings.end());
   if (c.evaluated) WarnAboutDwellsPastTheirBranchEnd(fitted, estimate, &u);
   if (!c.available) {
     // Entries the data cannot tell apart are named in the model's terms.
@@ -250,6 +535,7 @@ ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted
     return Unavailable(u, message);
   }
   CopyIntervals(c, &u);
+  SetCorrelation(c.free, sampling, &u);
   SetEffectiveNonlinearity(&u);
   AddPairAndBoundWarnings(c.free, estimate, &u);
   u.available = true;

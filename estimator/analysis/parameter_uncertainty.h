@@ -1,12 +1,14 @@
 // How sure an identification is: standard errors, 95 % intervals and
 // correlations of the parameters, from the local linearisation of the
-// vertical-error fit at its estimate.
+// vertical-error fit at its estimate, with the bifurcation-range penalty's
+// curvature and pull when the fit had it. docs/uncertainty.md has the
+// measured coverage of both kinds of interval.
 //
-// With r(p) the data residuals (vertical error, residuals/functors/vertical_error_residual.h;
-// no penalties), J = dr/dp over the k free parameters at the estimate p^ and
-// n dwell points, the Gauss-Newton covariance of the least-squares estimate is
+// With r(p) the data residuals (vertical error, residuals/functors/vertical_error_residual.h),
+// J = dr/dp over the k free parameters at the estimate p^ and n dwell points,
+// the Gauss-Newton covariance of the least-squares estimate is
 //
-//   C = s^2 (J^T J)^-1
+//   C_d = s^2 (J^T J)^-1                                 (interval kind "gauss_newton")
 //
 // where s^2 is the variance of one residual:
 //   - the residuals carry no per-point sigma: s^2 = 2 F(p^) / (n - k), with
@@ -14,6 +16,45 @@
 //   - every residual is divided by its point's sigma: the residuals are
 //     already standardised, s = 1, and 2 F / (n - k) is reported as the
 //     reduced chi-square (about 1 when model and sigmas are right).
+//
+// With the bifurcation-range penalty (interval kind
+// "gauss_newton_sandwich_with_penalty"). The fit minimised F + sum_k (1/2) W
+// u_k^n (eq. 3.17; u_k the enforced fold's distance from its bracket's centre
+// in half-widths, n = 10, W the configured weight times the stage's
+// penalty_unit, read from the fit's FitSummary). The penalty is no
+// measurement with a noise of its own but a flat-bottomed wall: its
+// Gauss-Newton curvature 25 W u^8 (du/dp)^2 is ~0 at the bracket's centre and
+// huge at its edges, and leaving it out ignores what it pins (the dwells-alone
+// intervals were up to 1.6 times the spread of the estimates). The estimate
+// solves J^T r + grad P = 0, so a perturbation e of the data moves it by
+// -H^-1 J^T e with H = J^T J + sum_k kappa_k g_k g_k^T, g_k = grad u_k,
+// kappa_k = (1/2) W n (n - 1) u_k^(n - 2) (the term in u's second derivative
+// is dropped), and
+//
+//   C = s^2 H^-1 J^T J H^-1 + b b^T,   b = (J^T J)^-1 grad P,
+//
+// the sandwich plus the penalty's pull b (how far it moved the estimate from
+// the dwells' own minimum) as a bias term: a mean-squared-error interval,
+// since the penalty draws the folds towards their brackets' centres. Computed
+// as C_A - C_A I_p C_A + b b^T with C_A = s^2 H^-1 from the one covariance
+// path (one row sqrt(kappa_k) g_k / s per enforced jump) and I_p = sum_k
+// kappa_k g_k g_k^T / s^2.
+//
+// Violated branch labels (label_pulls). A measured jump says that the dwell
+// just before it lies on the branch that ends there. When the estimate ends
+// that branch before the dwell (RootStatus::kBranchEnd), the fit has stopped
+// at a kink of its cost where the fold crossed the dwell, short of where the
+// labels put it: such fits are biased (thesis case without the penalty: 65 %
+// of the fits, alpha_e covered in 90 % of all fits by C_d alone). For each
+// such jump (except those the penalty holds, whose pull is counted above) the
+// smallest move that puts the fold back on that dwell, in the metric of C,
+//
+//   delta = C g (u_dwell - u) / (g^T C g),   u, g as above for that jump,
+//
+// is added as a bias term delta delta^T: the intervals then reach back to
+// where the labels are satisfied. IntervalMethod::kDataOnly gives C_d
+// regardless (what identify reported before; for comparison).
+//
 // C is in physical units (omega in rad/s) with zero rows and columns for fixed
 // parameters. The 95 % interval of a free parameter is p^_j -/+ q se_j with
 // se_j = sqrt(C_jj) and q the 0.975 quantile of Student's t with n - k degrees
@@ -36,8 +77,12 @@
 // its correct standard error.
 //
 // Limits. These are the intervals of the linearised, unbounded problem: a
-// parameter on its bound 0 keeps a symmetric interval (warned), and near a
-// fold the vertical error is only piecewise smooth (dwells_past_branch_end).
+// parameter on its bound 0 keeps a symmetric interval (warned); fitted dwells
+// past the end of a branch without a measured jump get no label pull (the
+// warning about dwells past their branch end stays); an
+// enforced fold outside its bracket is warned, a missing one leaves its term
+// out (warned); the penalty on without the fit's summary gives C_d (warned:
+// too wide); the branch-stability penalty (eq. 3.19) is not in C.
 #ifndef DWELLFIT_ESTIMATOR_ANALYSIS_PARAMETER_UNCERTAINTY_H_
 #define DWELLFIT_ESTIMATOR_ANALYSIS_PARAMETER_UNCERTAINTY_H_
 
@@ -48,6 +93,7 @@
 #include "dwellfit/estimator/analysis/block_covariance.h"
 #include "dwellfit/estimator/data/sweep.h"
 #include "dwellfit/estimator/fit/identification_options.h"
+#include "dwellfit/estimator/fit/staged_solve.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 
 namespace dwellfit {
@@ -58,6 +104,17 @@ inline constexpr double kCorrelationWarning = 0.99;
 
 using ParameterMatrix = Eigen::Matrix<double, kNumParameters, kNumParameters>;
 
+// How the intervals treat the bifurcation-range penalty (see above).
+enum class IntervalMethod {
+  kDataOnly,         // the dwells alone ("gauss_newton")
+  kPenaltySandwich,  // the penalty's curvature in the sandwich (the default)
+};
+
+// "data_only", "penalty_sandwich".
+const char* IntervalMethodName(IntervalMethod method);
+// False for an unknown name.
+bool ParseIntervalMethod(const std::string& name, IntervalMethod* method);
+
 struct ParameterUncertainty {
   // False: no covariance (every parameter fixed, no degrees of freedom, the
   // residuals cannot be evaluated, or the sweeps cannot tell some parameters
@@ -66,6 +123,15 @@ struct ParameterUncertainty {
   bool available = false;
   // Plain words for a person, always set.
   std::string message;
+  // Which kind of interval: "gauss_newton" (the dwells' linearisation alone)
+  // or "gauss_newton_sandwich_with_penalty" (penalty_terms > 0); either may
+  // be widened by label pulls (label_pulls > 0, said in `message`).
+  std::string interval_kind = "gauss_newton";
+  // Enforced jumps whose penalty curvature entered the sandwich.
+  int penalty_terms = 0;
+  // Measured jumps whose branch label the estimate violates (the fit stopped
+  // at a kink) and whose move back widened the intervals.
+  int label_pulls = 0;
   // s: the residual standard deviation, in the residual's unit (the data's
   // length unit for the absolute error, ln a for the relative one); 1 when
   // every residual is standardised by its point's sigma.
@@ -79,8 +145,12 @@ struct ParameterUncertainty {
   double interval_quantile = 0.0;           // q: t_{0.975, n-k}, or the normal's 1.95996
   ParameterVector standard_error{};         // 0 for fixed parameters
   ParameterVector ci95_low{}, ci95_high{};  // estimate -/+ q standard_error
-  ParameterMatrix covariance = ParameterMatrix::Zero();   // physical units
-  ParameterMatrix correlation = ParameterMatrix::Zero();  // 1 on free diagonal
+  // Physical units; with the bias terms (penalty pull, label pulls) when
+  // there are any, as the standard errors.
+  ParameterMatrix covariance = ParameterMatrix::Zero();
+  // 1 on the free diagonal; of the covariance without the bias terms (their
+  // rank-one shares would make every pair look collinear).
+  ParameterMatrix correlation = ParameterMatrix::Zero();
   // sigma_max / sigma_min of the column-normalised Jacobian of the free
   // parameters (1: orthogonal effects; +inf: exactly collinear; 0 when not
   // computed).
@@ -104,14 +174,17 @@ struct ParameterUncertainty {
 };
 
 // Linearises the vertical-error fit of `fitted` at `estimate` (residual error
-// measure, point sigmas and fixed parameters from `options`; penalties and
-// stages are ignored) and returns the parameters' uncertainty.
+// measure, point sigmas, fixed parameters and the bifurcation-range penalty's
+// enforced jumps from `options`; the stages are ignored), with the fold
+// brackets `rule` names, and returns the parameters' uncertainty.
 // `omega_ref_rad_s` <= 0 means the estimate's omega (as in
 // MakeIdentificationReport). Never throws for degenerate data: `available`
 // and `message` say what went wrong.
 ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted,
                                          const IdentificationOptions& options,
-                                         const ParameterVector& estimate, double omega_ref_rad_s);
+                                         const ParameterVector& estimate, double omega_ref_rad_s,
+                                         const FitSummary* summary = nullptr,
+                                         IntervalMethod method = IntervalMethod::kPenaltySandwich);
 
 }  // namespace dwellfit
 

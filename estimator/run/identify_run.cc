@@ -120,7 +120,8 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
   outcome->report.initial_guess_steps = run.initial_guess_steps;
   outcome->report.multi_start = multi_start;
   outcome->report.uncertainty =
-      EstimateUncertainty(run.fitted, options, result.parameters, outcome->report.omega_ref_rad_s);
+      EstimateUncertainty(run.fitted, options, result.parameters, outcome->report.omega_ref_rad_s,
+                          &result);
   outcome->report.config_in_effect = ConfigAffectingTheResult(config);
   MarkUnidentifiable(&outcome->report);
   const IdentificationReport& report = outcome->report;

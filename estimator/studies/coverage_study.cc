@@ -46,6 +46,9 @@ void Finish(const RowSums& sums, CoverageRow* row) {
 void AddReplica(const IdentificationResult& result, const ParameterUncertainty& u,
                 const std::vector<int>& rows, std::vector<RowSums>* sums, CoverageStudy* study) {
   study->converged += result.converged;
+  study->with_penalty_terms += u.penalty_terms > 0;
+  study->with_label_pulls += u.label_pulls > 0;
+  study->kinked += u.dwells_past_branch_end > 0;
   if (u.available) {
     ++study->available;
   } else if (std::find(study->messages.begin(), study->messages.end(), u.message) ==
@@ -82,6 +85,8 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
   const auto start = std::chrono::steady_clock::now();
   CoverageStudy study;
   study.replicas = options.replicas;
+  study.method = options.method;
+  study.penalty = config.identification.penalties.bifurcation_range.enabled;
   study.omega_ref_rad_s =
       config.omega_ref_rad_s ? *config.omega_ref_rad_s : plan.truth[kNaturalFrequency];
 
@@ -108,8 +113,8 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
     const ResolvedRun run = ResolveReplicaRun(config, plan, options.relative_noise,
                                               options.first_seed + static_cast<std::uint64_t>(r));
     const IdentificationResult result = FitRun(run).best;
-    const ParameterUncertainty u =
-        EstimateUncertainty(run.fitted, run.options, result.parameters, study.omega_ref_rad_s);
+    const ParameterUncertainty u = EstimateUncertainty(
+        run.fitted, run.options, result.parameters, study.omega_ref_rad_s, &result, options.method);
     if (r == 0) {
       study.degrees_of_freedom = u.degrees_of_freedom;
       study.start_from_data = run.guessed_from_data;
@@ -131,6 +136,12 @@ void PrintCoverageStudy(const CoverageStudy& study, std::ostream& out) {
       "noise sigma %.4g; alpha_e at Omega_ref = 2 pi %.4g Hz; %.2f s\n",
       study.replicas, study.converged, study.available, study.degrees_of_freedom,
       study.mean_noise_sigma, RadPerSecondToHz(study.omega_ref_rad_s), study.seconds);
+  out << StringPrintf(
+      "bifurcation-range penalty %s; intervals: %s (%d replicas with the penalty's curvature in "
+      "the sandwich, %d widened by label pulls); %d replicas with a fitted dwell past its branch "
+      "end\n",
+      study.penalty ? "on" : "off", IntervalMethodName(study.method), study.with_penalty_terms,
+      study.with_label_pulls, study.kinked);
   out << "start: " << (study.start_from_data ? "found from each replica's data" : "the config's")
       << "; replica 0's fitted sweeps:\n";
   for (const std::string& jumps : study.first_replica_jumps) out << "  " << jumps << "\n";

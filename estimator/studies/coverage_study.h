@@ -10,6 +10,9 @@
 // for alpha_e = alpha - (2/3) delta Omega_ref^2 it counts the replicas whose 95 % interval contains
 // the plan's truth, and compares the mean standard error with the empirical standard deviation of
 // the estimates over the replicas (the two agree when the linearised covariance is right).
+// The intervals are those identify reports (IntervalMethod::kPenaltySandwich: with the
+// bifurcation-range penalty's curvature and pull when the config has it), or the dwells'
+// alone (kDataOnly) for comparison; docs/uncertainty.md has the measured table.
 #ifndef DWELLFIT_ESTIMATOR_STUDIES_COVERAGE_STUDY_H_
 #define DWELLFIT_ESTIMATOR_STUDIES_COVERAGE_STUDY_H_
 
@@ -19,6 +22,7 @@
 #include <vector>
 
 #include "dwellfit/config/identify_config.h"
+#include "dwellfit/estimator/analysis/parameter_uncertainty.h"
 #include "dwellfit/estimator/simulation/dwell_simulator.h"
 
 namespace dwellfit {
@@ -27,6 +31,9 @@ struct CoverageStudyOptions {
   int replicas = 200;
   double relative_noise = 0.01;  // sigma_rel of DwellNoise
   std::uint64_t first_seed = 1;  // replica r uses seed first_seed + r
+  // How the intervals treat the bifurcation-range penalty
+  // (parameter_uncertainty.h); identify uses the default.
+  IntervalMethod method = IntervalMethod::kPenaltySandwich;
 };
 
 // A fit that leaves this many fitted dwells past the end of their branch
@@ -59,6 +66,11 @@ struct CoverageStudy {
   int replicas = 0;
   int converged = 0;  // fits whose last stage converged
   int available = 0;  // replicas with a covariance
+  IntervalMethod method = IntervalMethod::kPenaltySandwich;
+  bool penalty = false;        // the bifurcation-range penalty was on
+  int with_penalty_terms = 0;  // replicas with the penalty's curvature in their intervals
+  int with_label_pulls = 0;    // replicas whose intervals were widened by label pulls
+  int kinked = 0;              // replicas with a fitted dwell past its branch end
   double omega_ref_rad_s = 0.0;
   double mean_noise_sigma = 0.0;      // mean estimated residual sigma
   int degrees_of_freedom = 0;         // of the first replica

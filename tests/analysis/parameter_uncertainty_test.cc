@@ -8,12 +8,15 @@
 #include <cmath>
 #include <cstdint>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "Eigen/LU"
 #include "dwellfit/config/dwell_plan_reader.h"
 #include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/fit/identification.h"
+#include "dwellfit/estimator/fit/problem_builder.h"
 #include "dwellfit/estimator/run/resolved_run.h"
 #include "dwellfit/estimator/simulation/dwell_simulator.h"
 #include "dwellfit/estimator/studies/coverage_study.h"
@@ -313,9 +316,165 @@ TEST_F(UncertaintyThesisNumerical, NothingToEstimateIsReportedInWords) {
   ExpectAllFinite(few);
 }
 
+// The finite-difference gradient of the distance u of `jump`'s fold from its
+// bracket's centre (in half-widths), independent of the functor's Jets.
+Eigen::VectorXd DistanceGradient(const Sweep& sweep, const JumpBracket& jump,
+                                 const ParameterVector& p, double* distance) {
+  BifurcationRangeOptions reading;
+  reading.exponent = 2;
+  reading.weight = 1.0;
+  const std::unique_ptr<ceres::CostFunction> row(MakeBifurcationRangePenalty(sweep, jump, reading));
+  auto evaluate = [&row](const ParameterVector& at) {
+    const double* blocks[] = {at.data()};
+    double u = 0.0;
+    EXPECT_TRUE(row->Evaluate(blocks, &u, nullptr));
+    return u;
+  };
+  *distance = evaluate(p);
+  Eigen::VectorXd gradient(kNumParameters);
+  for (int i = 0; i < kNumParameters; ++i) {
+    const double h = 1e-6 * std::abs(p[i]);
+    ParameterVector up = p, down = p;
+    up[i] += h;
+    down[i] -= h;
+    gradient[i] = (evaluate(up) - evaluate(down)) / (2.0 * h);
+  }
+  return gradient;
+}
+
+// With the bifurcation-range penalty (W u^n, eq. 3.17) on, the covariance is
+// the penalised fit's sandwich plus the penalty's pull, recomputed here in
+// another algebraic form with finite-difference gradients:
+//   C_A = (C_d^-1 + I_p)^-1,  I_p = sum_k (kappa_k / s^2) g_k g_k^T,
+//   kappa_k = (1/2) W n (n - 1) u_k^(n - 2),
+//   C = C_A C_d^-1 C_A + b b^T,  b = C_d sum_k (W n u_k^(n - 1) / 2) g_k / s^2,
+// with C_d the dwells' own covariance.
+TEST_F(UncertaintyThesisNumerical, PenaltyEntersTheCovarianceAsASandwichWithItsPull) {
+  const ResolvedRun noisy = NoisyRun(1);  // a fit that keeps every branch label
+  IdentificationOptions options = config_.identification;
+  options.penalties.bifurcation_range.enabled = true;
+  const IdentificationResult result = Identify(noisy.fitted, options);
+  ASSERT_TRUE(result.converged) << result.message;
+  const ParameterVector& p = result.parameters;
+  const ParameterUncertainty data =
+      EstimateUncertainty(noisy.fitted, options, p, omega_ref_, &result, IntervalMethod::kDataOnly);
+  const ParameterUncertainty u = EstimateUncertainty(noisy.fitted, options, p, omega_ref_, &result);
+  ASSERT_TRUE(data.available) << data.message;
+  ASSERT_TRUE(u.available) << u.message;
+  EXPECT_EQ(data.interval_kind, "gauss_newton");
+  EXPECT_EQ(u.interval_kind, "gauss_newton_sandwich_with_penalty");
+  EXPECT_EQ(u.penalty_terms, 2);  // F0.01/up jump_down and A41.5/up jump_up
+  ASSERT_EQ(u.label_pulls, 0);
+  EXPECT_THAT(u.message, HasSubstr("penalty's curvature at 2 enforced jump(s)"));
+
+  const StageSummary& stage = result.stages.back();
+  ASSERT_EQ(stage.penalty_exponent, 10);
+  const double weight = options.penalties.bifurcation_range.weight * stage.penalty_unit;
+  const double s2 = data.noise_sigma * data.noise_sigma;
+  // Free parameters only (omega is fixed), scaled by their values.
+  const std::vector<int> free = {kEtaE, kMu1, kMu2, kDelta, kAlpha};
+  Eigen::VectorXd scale(5);
+  Eigen::MatrixXd data_cov(5, 5);
+  for (int a = 0; a < 5; ++a) {
+    scale[a] = std::abs(p[free[a]]);
+    for (int b = 0; b < 5; ++b) {
+      data_cov(a, b) = data.covariance(free[a], free[b]) / (scale[a] * std::abs(p[free[b]]));
+    }
+  }
+  Eigen::MatrixXd penalty_information = Eigen::MatrixXd::Zero(5, 5);
+  Eigen::VectorXd penalty_gradient = Eigen::VectorXd::Zero(5);
+  int enforced = 0;
+  for (const Sweep* sweep : noisy.fitted) {
+    for (const JumpBracket& jump : sweep->jumps) {
+      const JumpTarget target = TargetOf(*sweep, jump);
+      if (target != JumpTarget::kFrequencyJumpDown && target != JumpTarget::kAmplitudeJumpUp) {
+        continue;
+      }
+      ++enforced;
+      double distance = 0.0;
+      const Eigen::VectorXd full = DistanceGradient(*sweep, jump, p, &distance);
+      Eigen::VectorXd g(5);
+      for (int a = 0; a < 5; ++a) g[a] = full[free[a]] * scale[a];
+      EXPECT_LT(std::abs(distance), 1.0);  // the fold inside its bracket
+      const double kappa = 0.5 * weight * 90.0 * std::pow(distance, 8);
+      penalty_information += (kappa / s2) * g * g.transpose();
+      penalty_gradient += 0.5 * weight * 10.0 * std::pow(distance, 9) * g;
+    }
+  }
+  ASSERT_EQ(enforced, 2);
+  const Eigen::MatrixXd data_information = data_cov.inverse();
+  const Eigen::MatrixXd a = (data_information + penalty_information).inverse();
+  const Eigen::VectorXd pull = data_cov * penalty_gradient / s2;
+  const Eigen::MatrixXd expected = a * data_information * a + pull * pull.transpose();
+  for (int k = 0; k < 5; ++k) {
+    const int i = free[k];
+    EXPECT_NEAR(u.standard_error[i] / scale[k], std::sqrt(expected(k, k)),
+                1e-4 * std::sqrt(expected(k, k)))
+        << ParameterName(i);
+  }
+  // The penalty narrows mu2's interval: the dwells alone leave out what the
+  // enforced folds pin.
+  EXPECT_LT(u.standard_error[kMu2], data.standard_error[kMu2]);
+
+  // Without the fit's summary the weight is unknown: the dwells alone, said.
+  const ParameterUncertainty unknown = EstimateUncertainty(noisy.fitted, options, p, omega_ref_);
+  EXPECT_EQ(unknown.interval_kind, "gauss_newton");
+  EXPECT_THAT(unknown.warnings,
+              ::testing::Contains(HasSubstr("the fit's penalty weight is not known here")));
+  EXPECT_DOUBLE_EQ(unknown.standard_error[kMu2], data.standard_error[kMu2]);
+}
+
+// A fit that ends F0.01/up's upper branch before its 42.2 Hz dwell (the
+// label says the fold lies beyond it) has its intervals widened by the move
+// back: C = C_d + delta delta^T, and p + delta puts the fold on that dwell to
+// first order.
+TEST_F(UncertaintyThesisNumerical, ViolatedBranchLabelWidensByTheMoveBackToIt) {
+  // The exact data at the truth with 1 % less alpha: the fold moves below
+  // the 42.2 Hz dwell (as in WarnsWhenTheModelsFoldFallsShortOfMeasuredDwells).
+  ParameterVector soft = kTruth;
+  soft[kAlpha] *= 0.99;
+  const ParameterUncertainty data = EstimateUncertainty(
+      Fitted(exact_), config_.identification, soft, omega_ref_, nullptr, IntervalMethod::kDataOnly);
+  const ParameterUncertainty u =
+      EstimateUncertainty(Fitted(exact_), config_.identification, soft, omega_ref_);
+  ASSERT_TRUE(data.available) << data.message;
+  ASSERT_TRUE(u.available) << u.message;
+  EXPECT_EQ(data.label_pulls, 0);
+  ASSERT_EQ(u.label_pulls, 1);
+  EXPECT_EQ(u.interval_kind, "gauss_newton");
+  EXPECT_THAT(u.message, HasSubstr("widened by the move back to 1 branch label(s)"));
+
+  // The difference is rank one: delta delta^T.
+  const ParameterMatrix difference = u.covariance - data.covariance;
+  ASSERT_GT(difference(kAlpha, kAlpha), 0.0);
+  const Eigen::Matrix<double, kNumParameters, 1> delta =
+      difference.col(kAlpha) / std::sqrt(difference(kAlpha, kAlpha));
+  EXPECT_TRUE(difference.isApprox(delta * delta.transpose(), 1e-9));
+  EXPECT_GT(u.standard_error[kAlpha], data.standard_error[kAlpha]);
+  // The correlations stay those of the dwells: the bias term is left out.
+  EXPECT_TRUE(u.correlation.isApprox(data.correlation, 1e-12));
+
+  // Where the fold sits, in half-widths of the bracket 42.2..42.3 Hz (-1: on
+  // the 42.2 Hz dwell), and its change along delta by finite differences:
+  // to first order delta moves it onto the dwell.
+  const Sweep* up = Named(exact_, {"F0.01"}).front();
+  ASSERT_EQ(up->direction, SweepDirection::kUp);
+  ASSERT_EQ(up->jumps.size(), 1u);
+  double before = 0.0, nudged = 0.0;
+  DistanceGradient(*up, up->jumps[0], soft, &before);
+  EXPECT_LT(before, -1.0);  // past the dwell
+  constexpr double kStep = 1e-4;
+  ParameterVector towards = soft;
+  for (int i = 0; i < kNumParameters; ++i) towards[i] += kStep * delta[i];
+  DistanceGradient(*up, up->jumps[0], towards, &nudged);
+  // delta delta^T fixes delta up to its sign.
+  EXPECT_NEAR(std::abs(nudged - before) / kStep, -1.0 - before, 1e-3 * std::abs(1.0 + before))
+      << before << " -> " << nudged;
+}
+
 // The bar: over 200 noisy replicas each free parameter's 95 % interval
 // covers the truth in 90-98 % of them (binomial sd of the rate: 1.5 %), and
-// the mean standard error matches the spread of the estimates.
+// the mean standard error is near the spread of the estimates.
 TEST(UncertaintyCoverage, NinetyFivePercentIntervalsCoverTheTruthOnTheThesisCase) {
   const IdentifyConfig config = LoadIdentifyConfig(kDataset + "/beam.yaml");
   const DwellPlan plan = ReadDwellPlan(kDataset + "/plan.yaml");
@@ -334,8 +493,11 @@ TEST(UncertaintyCoverage, NinetyFivePercentIntervalsCoverTheTruthOnTheThesisCase
     EXPECT_GE(row.Coverage(), 0.90) << row.name;
     EXPECT_LE(row.Coverage(), 0.98) << row.name;
     EXPECT_GT(row.mean_standard_error, 0.75 * row.empirical_std) << row.name;
-    EXPECT_LT(row.mean_standard_error, 1.33 * row.empirical_std) << row.name;
+    // Two thirds of these fits stop short of a branch label and carry its
+    // pull, a bias term: mu1 and mu2, correlated with the fold, get 1.43.
+    EXPECT_LT(row.mean_standard_error, 1.5 * row.empirical_std) << row.name;
   }
+  EXPECT_GT(study.with_label_pulls, study.replicas / 2);
 }
 
 }  // namespace
