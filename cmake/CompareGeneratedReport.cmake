@@ -3,6 +3,8 @@
 # report stays reproducible by one command.
 # Arguments: TOOL, ARGS (;-separated, run from SOURCE_DIR), OUTPUT (the
 # tool's --output), COMMITTED (path of the committed copy under SOURCE_DIR).
+get_filename_component(output_dir ${OUTPUT} DIRECTORY)
+file(MAKE_DIRECTORY ${output_dir})
 execute_process(
   COMMAND ${TOOL} ${ARGS} --output ${OUTPUT}
   WORKING_DIRECTORY ${SOURCE_DIR}
