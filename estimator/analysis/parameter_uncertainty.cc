@@ -145,12 +145,6 @@ bool PenaltyInFit(const IdentificationOptions& options, const FitSummary* summar
   return false;
 }
 
-bool IsEnforced(const Sweep& sweep, const JumpBracket& jump, const PenaltyOptions& penalties) {
-  const BifurcationRangeOptions& range = penalties.bifurcation_range;
-  return range.enabled && std::find(range.enforce.begin(), range.enforce.end(),
-                                    TargetOf(sweep, jump)) != range.enforce.end();
-}
-
 // A row whose residual is sqrt(weight) u (BifurcationRangePenalty, n = 2).
 ceres::CostFunction* DistanceRow(const PenaltyCurvature& term, double weight) {
   BifurcationRangeOptions reading;
@@ -168,7 +162,7 @@ std::vector<PenaltyCurvature> EnforcedJumps(const std::vector<const Sweep*>& fit
   std::vector<PenaltyCurvature> terms;
   for (const Sweep* sweep : fitted) {
     for (const JumpBracket& jump : sweep->jumps) {
-      if (!IsEnforced(*sweep, jump, penalties)) continue;
+      if (!IsEnforced(penalties.bifurcation_range, *sweep, jump)) continue;
       PenaltyCurvature term{sweep, &jump};
       const std::unique_ptr<ceres::CostFunction> row(DistanceRow(term, 1.0));
       const double* blocks[] = {estimate.data()};
@@ -392,7 +386,7 @@ int AddLabelPull(const std::vector<const Sweep*>& fitted, const ParameterVector&
   int pulled = 0;
   for (const Sweep* sweep : fitted) {
     for (const JumpBracket& jump : sweep->jumps) {
-      if (enforced != nullptr && IsEnforced(*sweep, jump, *enforced)) continue;
+      if (enforced != nullptr && IsEnforced(enforced->bifurcation_range, *sweep, jump)) continue;
       const DwellPoint& before = sweep->points[jump.index_before];
       const auto k = ResponseCoefficients<double>::FromParameters(estimate.data(),
                                                                   before.drive_frequency_rad_s);

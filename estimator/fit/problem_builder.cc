@@ -95,6 +95,11 @@ JumpTarget TargetOf(const Sweep& sweep, const JumpBracket& jump) {
   return up ? JumpTarget::kAmplitudeJumpUp : JumpTarget::kAmplitudeJumpDown;
 }
 
+bool IsEnforced(const BifurcationRangeOptions& range, const Sweep& sweep, const JumpBracket& jump) {
+  return range.enabled && std::find(range.enforce.begin(), range.enforce.end(),
+                                    TargetOf(sweep, jump)) != range.enforce.end();
+}
+
 ceres::CostFunction* MakeBifurcationRangePenalty(const Sweep& sweep, const JumpBracket& jump,
                                                  const BifurcationRangeOptions& options,
                                                  ResidualKind residual) {
@@ -143,17 +148,12 @@ int ProblemBuilder::AddPenalties(const Sweep& sweep, const ParameterLayout& layo
   int blocks = 0;
   const bool algebraic = options_.residual == ResidualKind::kAlgebraic;
   const BifurcationRangeOptions& range = options_.penalties.bifurcation_range;
-  if (range.enabled) {
-    for (const JumpBracket& jump : sweep.jumps) {
-      const JumpTarget target = TargetOf(sweep, jump);
-      if (std::find(range.enforce.begin(), range.enforce.end(), target) == range.enforce.end()) {
-        continue;
-      }
-      Add(algebraic ? MakeFoldCondition(sweep, jump)
-                    : MakeBifurcationRangePenalty(sweep, jump, range, options_.residual),
-          layout, problem, evaluator);
-      ++blocks;
-    }
+  for (const JumpBracket& jump : sweep.jumps) {
+    if (!IsEnforced(range, sweep, jump)) continue;
+    Add(algebraic ? MakeFoldCondition(sweep, jump)
+                  : MakeBifurcationRangePenalty(sweep, jump, range, options_.residual),
+        layout, problem, evaluator);
+    ++blocks;
   }
   const BranchStabilityOptions& stability = options_.penalties.branch_stability;
   if (stability.enabled && !algebraic && !sweep.points.empty()) {

@@ -89,6 +89,9 @@ class ProblemBuilder {
 // Which enforceable target a measured jump of `sweep` is.
 JumpTarget TargetOf(const Sweep& sweep, const JumpBracket& jump);
 
+// Whether `range` (enabled) enforces this measured jump of `sweep`.
+bool IsEnforced(const BifurcationRangeOptions& range, const Sweep& sweep, const JumpBracket& jump);
+
 // The bifurcation-range penalty of one measured jump (eq. 3.17; for the
 // all-roots residual, RootTransitionPenalty: the range enforced through the
 // roots), owned by the caller; Ceres takes it.

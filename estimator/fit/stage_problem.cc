@@ -74,11 +74,7 @@ std::vector<std::string> StageProblem::MissingFolds(const BifurcationRangeOption
     for (int i = 0; i < kNumParameters; ++i) p[i] = layout.blocks[layout.block[i]][layout.index[i]];
     for (const Sweep* sweep : fit_.datasets[d].sweeps) {
       for (const JumpBracket& jump : sweep->jumps) {
-        const JumpTarget target = TargetOf(*sweep, jump);
-        if (std::find(range.enforce.begin(), range.enforce.end(), target) == range.enforce.end() ||
-            FoldExists(*sweep, jump, p)) {
-          continue;
-        }
+        if (!IsEnforced(range, *sweep, jump) || FoldExists(*sweep, jump, p)) continue;
         const bool frequency = sweep->kind == SweepKind::kFrequency;
         const double scale = frequency ? 1.0 / kTwoPi : 1.0;
         missing.push_back(StringPrintf("%s: no %s fold near its measured bracket %.6g..%.6g %s",

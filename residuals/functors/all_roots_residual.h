@@ -53,14 +53,7 @@ class AllRootsResidual {
     if (!NearestStableRoot(ScalarCoefficients(k), a_base_, a_measured_, &root.a)) return false;
     root.status = RootStatus::kOnBranch;
     const T a_model = LiftRoot(k, a_base_, root);
-    if (error_ == ErrorMeasure::kAbsolute) {
-      residual[0] = weight_ * (a_measured_ - a_model);
-    } else {
-      if (!(ScalarPart(a_model) > 0.0)) return false;  // log undefined
-      residual[0] =
-          weight_ * (std::log(a_measured_ + amplitude_floor_) - log(a_model + amplitude_floor_));
-    }
-    return std::isfinite(ScalarPart(residual[0]));
+    return AmplitudeError(a_measured_, a_model, error_, weight_, amplitude_floor_, residual);
   }
 
   static ceres::CostFunction* Create(double drive_frequency_rad_s, double a_base, double a_measured,

@@ -51,6 +51,22 @@ enum class ErrorMeasure {
   kRelative,  // ln(a_i + f) - ln(a_model + f), f the amplitude floor
 };
 
+// The weighted error of a model amplitude against a measured one, as
+// `error` measures it. False where it is undefined: the log of a model
+// amplitude that is not positive, or a value that is not finite (a root that
+// overflowed at an extreme trial step).
+template <typename T>
+bool AmplitudeError(double a_measured, const T& a_model, ErrorMeasure error, double weight,
+                    double amplitude_floor, T* residual) {
+  if (error == ErrorMeasure::kAbsolute) {
+    *residual = weight * (a_measured - a_model);
+  } else {
+    if (!(ScalarPart(a_model) > 0.0)) return false;
+    *residual = weight * (std::log(a_measured + amplitude_floor) - log(a_model + amplitude_floor));
+  }
+  return std::isfinite(ScalarPart(*residual));
+}
+
 class VerticalErrorResidual {
  public:
   VerticalErrorResidual(double drive_frequency_rad_s, double a_base, double a_measured,
@@ -77,15 +93,7 @@ class VerticalErrorResidual {
       last_root_.store(root.a, std::memory_order_relaxed);
     }
     const T a_model = LiftRoot(k, a_base_, root);
-    if (error_ == ErrorMeasure::kAbsolute) {
-      residual[0] = weight_ * (a_measured_ - a_model);
-    } else {
-      if (!(ScalarPart(a_model) > 0.0)) return false;  // log undefined
-      residual[0] =
-          weight_ * (std::log(a_measured_ + amplitude_floor_) - log(a_model + amplitude_floor_));
-    }
-    // Undefined evaluation: a root that overflowed at an extreme trial step.
-    return std::isfinite(ScalarPart(residual[0]));
+    return AmplitudeError(a_measured_, a_model, error_, weight_, amplitude_floor_, residual);
   }
 
   static ceres::CostFunction* Create(double drive_frequency_rad_s, double a_base, double a_measured,
