@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "Eigen/Cholesky"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/fit/fit_description.h"
 #include "dwellfit/estimator/fit/problem_builder.h"
@@ -341,11 +342,43 @@ bool SetStandardErrors(BlockCovariance* c) {
   return true;
 }
 
-// The sandwich s^2 H^-1 J_d^T J_d H^-1 = C_A - C_A I_p C_A, I_p =
+// The share of the pull's square b b^T that is bias rather than noise. b is
+// estimated at the estimate, so its square overstates the squared bias by
+// b's own variance V (b moves by C_d I_p dp when the estimate moves by dp:
+// V = (C_d I_p) S (C_d I_p)^T, S the sampling covariance). Along b, in the
+// metric of S (z = L^-1 b, L L^T = S over the free entries), the unbiased
+// estimate of the squared bias is |z|^2 - z^T (L^-1 V L^-T) z / |z|^2: the
+// share 1 - z^T L^-1 V L^-T z / |z|^4, floored at 0. 1 where S cannot be
+// factored.
+double PullShare(const Eigen::VectorXd& pull, const Eigen::MatrixXd& pull_variance,
+                 const Eigen::MatrixXd& sampling, const std::vector<int>& free) {
+  const int k = static_cast<int>(free.size());
+  Eigen::MatrixXd s(k, k), v(k, k);
+  Eigen::VectorXd b(k);
+  for (int i = 0; i < k; ++i) {
+    b[i] = pull[free[i]];
+    for (int j = 0; j < k; ++j) {
+      s(i, j) = sampling(free[i], free[j]);
+      v(i, j) = pull_variance(free[i], free[j]);
+    }
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(s);
+  if (llt.info() != Eigen::Success) return 1.0;
+  const Eigen::VectorXd z = llt.matrixL().solve(b);
+  const double length_squared = z.squaredNorm();
+  if (!(length_squared > 0.0)) return 0.0;
+  const Eigen::VectorXd w = llt.matrixL().solve(v * llt.matrixU().solve(z));
+  // z^T L^-1 V L^-T z = (L^-1 b)^T (L^-1 V L^-T)(L^-1 b)
+  const double noise = z.dot(w);
+  return std::max(0.0, 1.0 - noise / (length_squared * length_squared));
+}
+
+// The sandwich S = s^2 H^-1 J_d^T J_d H^-1 = C_A - C_A I_p C_A, I_p =
 // sum_k (kappa_k / s^2) g_k g_k^T, g_k = grad u_k in physical units, plus
-// the penalty's pull b b^T: b = C_d grad P / s^2 = C_d sum_k (W n u_k^(n-1) /
-// (2 s^2)) g_k, how far the penalty moved the estimate from the dwells' own
-// minimum (C_d: the dwells' covariance). False when a gradient cannot be
+// the penalty's pull beta b b^T: b = C_d grad P / s^2 = C_d sum_k (W n
+// u_k^(n-1) / (2 s^2)) g_k, how far the penalty moved the estimate from the
+// dwells' own minimum (C_d: the dwells' covariance), beta its share that is
+// bias (PullShare). False when a gradient cannot be
 // evaluated.
 bool SandwichCovariance(const std::vector<PenaltyCurvature>& terms, double weight, int exponent,
                         const BlockCovariance& data_only, const ParameterVector& estimate,
@@ -372,7 +405,10 @@ bool SandwichCovariance(const std::vector<PenaltyCurvature>& terms, double weigh
   const Eigen::VectorXd pull = data_only.covariance * penalty_gradient / noise_variance;
   c->covariance = a - a * penalty_information * a;
   *sampling = c->covariance;
-  c->covariance += pull * pull.transpose();
+  const Eigen::MatrixXd pull_response = data_only.covariance * penalty_information;
+  const double share =
+      PullShare(pull, pull_response * *sampling * pull_response.transpose(), *sampling, c->free);
+  c->covariance += share * pull * pull.transpose();
   return SetStandardErrors(c);
 }
 

@@ -31,12 +31,15 @@
 // kappa_k = (1/2) W n (n - 1) u_k^(n - 2) (the term in u's second derivative
 // is dropped), and
 //
-//   C = s^2 H^-1 J^T J H^-1 + b b^T,   b = (J^T J)^-1 grad P,
+//   C = S + beta b b^T,   S = s^2 H^-1 J^T J H^-1,   b = (J^T J)^-1 grad P,
 //
 // the sandwich plus the penalty's pull b (how far it moved the estimate from
 // the dwells' own minimum) as a bias term: a mean-squared-error interval,
-// since the penalty draws the folds towards their brackets' centres. Computed
-// as C_A - C_A I_p C_A + b b^T with C_A = s^2 H^-1 from the one covariance
+// since the penalty draws the folds towards their brackets' centres. b is
+// estimated at the estimate, so only the share beta of b b^T that stands out
+// of b's own variance V = (C_d I_p) S (C_d I_p)^T counts (along b, in the
+// metric of S: beta = max(0, 1 - b^T S^-1 V S^-1 b / (b^T S^-1 b)^2)).
+// Computed as S = C_A - C_A I_p C_A with C_A = s^2 H^-1 from the one covariance
 // path (one row sqrt(kappa_k) g_k / s per enforced jump) and I_p = sum_k
 // kappa_k g_k g_k^T / s^2.
 //
