@@ -23,12 +23,11 @@ packages=(
   libbenchmark-dev
   libfccp-dev
   libboost-dev
+  libtbb-dev
   gnuplot-nox
-  # The fuzzers (tests/fuzz): Clang, its libFuzzer and sanitizer runtimes, and
-  # its OpenMP runtime (the library uses OpenMP).
+  # The fuzzers (tests/fuzz): Clang with its libFuzzer and sanitizer runtimes.
   clang-14
   libclang-rt-14-dev
-  libomp-14-dev
 )
 
 is_installed() {

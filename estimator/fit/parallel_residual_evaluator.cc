@@ -1,19 +1,20 @@
 #include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <array>
 #include <utility>
 
 #include "glog/logging.h"
+#include "tbb/blocked_range.h"
+#include "tbb/info.h"
+#include "tbb/parallel_for.h"
 
 namespace dwellfit {
 
 namespace {
 
-// Blocks each thread gets at the least (fewer threads below that).
-constexpr int kMinBlocksPerThread = 256;
+// Residuals (dwells) each thread gets at the least (fewer threads below that).
+constexpr int kMinRowsPerThread = 256;
 
 }  // namespace
 
@@ -21,7 +22,7 @@ int ResolveThreadCount(int num_threads) {
   if (num_threads > 0) return num_threads;
   // The processors this process may run on (its affinity mask), not every
   // processor of the host.
-  return std::max(1, omp_get_num_procs());
+  return std::max(1, tbb::info::default_concurrency());
 }
 
 // Owns one wrapped cost function and the values it had at the last point the
@@ -175,7 +176,7 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
 };
 
 ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads)
-    : blocks_(std::move(blocks)), num_threads_(num_threads) {
+    : blocks_(std::move(blocks)), num_threads_(num_threads), arena_(num_threads) {
   CHECK(!blocks_.empty());
   for (const Block& block : blocks_) {
     CHECK(block.values != nullptr);
@@ -205,6 +206,7 @@ ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_f
   }
   auto* wrapper = new ReplayingCostFunction(cost_function, std::move(offsets), this);
   wrappers_.push_back(wrapper);
+  rows_ += cost_function->num_residuals();
   return wrapper;
 }
 
@@ -213,6 +215,7 @@ ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_f
   CHECK_EQ(cost_function->parameter_block_sizes()[0], blocks_[0].size);
   auto* wrapper = new ReplayingCostFunction(cost_function, {0}, this);
   wrappers_.push_back(wrapper);
+  rows_ += cost_function->num_residuals();
   return wrapper;
 }
 
@@ -243,11 +246,19 @@ void ParallelResidualEvaluator::PrecomputeAll() {
   computed_ = true;
   const double* copy = last_point_.data();
   const int count = static_cast<int>(wrappers_.size());
-  // A parallel region costs microseconds: threads only for enough blocks.
-  const int threads = std::max(1, std::min(num_threads_, count / kMinBlocksPerThread));
-  // schedule(static): fixed contiguous chunks, one per thread.
-#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
-  for (int i = 0; i < count; ++i) wrappers_[i]->Precompute(copy);
+  // Handing work to a thread costs microseconds: threads only for enough rows.
+  const int threads = std::max(1, std::min({num_threads_, count, rows_ / kMinRowsPerThread}));
+  if (threads == 1) {
+    for (int i = 0; i < count; ++i) wrappers_[i]->Precompute(copy);
+    return;
+  }
+  // Idle workers sleep, and a worker the machine is slow to run leaves its
+  // blocks to the others (work stealing): more threads never wait for one.
+  arena_.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, count), [&](const tbb::blocked_range<int>& range) {
+      for (int i = range.begin(); i < range.end(); ++i) wrappers_[i]->Precompute(copy);
+    });
+  });
 }
 
 bool ParallelResidualEvaluator::CostGradient(const double* point, std::vector<double>* gradient) {

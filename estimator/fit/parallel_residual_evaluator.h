@@ -34,6 +34,7 @@
 
 #include "ceres/cost_function.h"
 #include "ceres/evaluation_callback.h"
+#include "tbb/task_arena.h"
 
 namespace dwellfit {
 
@@ -90,7 +91,9 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   std::vector<int> offsets_;  // of each block in a point
   int size_ = 0;              // of a point
   const int num_threads_;
+  tbb::task_arena arena_;  // at most num_threads_ threads, the caller's included
   std::vector<ReplayingCostFunction*> wrappers_;  // owned by the problem
+  int rows_ = 0;                                  // residuals over the wrappers
   bool computed_ = false;                         // last_point_ holds a point evaluated
   std::vector<double> last_point_;                // the point the wrappers hold values for
   std::int64_t replayed_ = 0;

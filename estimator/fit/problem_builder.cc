@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/fit/batched_cost_function.h"
 #include "dwellfit/estimator/fit/mapped_cost_function.h"
 #include "dwellfit/residuals/functors/algebraic_residual.h"
 #include "dwellfit/residuals/functors/all_roots_residual.h"
@@ -78,7 +81,18 @@ int ProblemBuilder::AddSweep(const Sweep& sweep, const ParameterLayout& layout,
                            "column, or choose other stages");
     }
   }
-  for (const DwellPoint& point : sweep.points) Add(MakeResidual(point), layout, problem, evaluator);
+  if (evaluator == nullptr) {
+    for (const DwellPoint& point : sweep.points) Add(MakeResidual(point), layout, problem, nullptr);
+  } else {
+    const size_t count = sweep.points.size();
+    for (size_t first = 0; first < count; first += kDwellsPerBatch) {
+      std::vector<ceres::CostFunction*> batch;
+      for (size_t i = first; i < std::min(count, first + kDwellsPerBatch); ++i) {
+        batch.push_back(MakeResidual(sweep.points[i]));
+      }
+      Add(new BatchedCostFunction(std::move(batch)), layout, problem, evaluator);
+    }
+  }
   return static_cast<int>(sweep.points.size());
 }
 

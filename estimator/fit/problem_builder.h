@@ -45,16 +45,23 @@ struct ProblemBuilderOptions {
 
 class ProblemBuilder {
  public:
+  // Dwells per residual block on the evaluator's path: enough that Ceres'
+  // work per block is small beside the dwells', few enough that a sweep's
+  // batches spread over the threads.
+  static constexpr size_t kDwellsPerBatch = 32;
+
   // `options` should be valid (IsValid); the staged solve checks them.
   explicit ProblemBuilder(const ProblemBuilderOptions& options);
 
-  // Adds one residual block per dwell of `sweep` (two residuals each for
+  // Adds the residuals of every dwell of `sweep` (one each, two for
   // kPhaseLag, which throws InputError naming the dwell when one has no
-  // measured phase), each reading the six
-  // parameters where `layout` puts them (the blocks are owned by the caller
-  // and must outlive `problem`). Returns the number of residual blocks
-  // added. With an `evaluator` (the problem's evaluation callback, watching
-  // the layout's blocks) the blocks are evaluated through it, on its threads.
+  // measured phase), each reading the six parameters where `layout` puts
+  // them (the blocks are owned by the caller and must outlive `problem`).
+  // Without an `evaluator`: one residual block per dwell, in order. With an
+  // `evaluator` (the problem's evaluation callback, watching the layout's
+  // blocks): up to kDwellsPerBatch consecutive dwells per residual block
+  // (BatchedCostFunction), evaluated through it on its threads. Returns the
+  // number of dwells added.
   int AddSweep(const Sweep& sweep, const ParameterLayout& layout, ceres::Problem* problem,
                ParallelResidualEvaluator* evaluator = nullptr) const;
   // The same on one 6-double block `parameters` (SingleBlockLayout).

@@ -65,13 +65,17 @@ void StageProblem::AddPenalties(const PenaltyOptions& penalties) {
   penalty_blocks_.insert(penalty_blocks_.end(), all.begin() + before, all.end());
 }
 
+ParameterVector StageProblem::ValuesOf(const ParameterLayout& layout) {
+  ParameterVector p;
+  for (int i = 0; i < kNumParameters; ++i) p[i] = layout.blocks[layout.block[i]][layout.index[i]];
+  return p;
+}
+
 std::vector<std::string> StageProblem::MissingFolds(const BifurcationRangeOptions& range) const {
   std::vector<std::string> missing;
   if (!range.enabled) return missing;
   for (size_t d = 0; d < fit_.datasets.size(); ++d) {
-    const ParameterLayout& layout = layouts_[d];
-    ParameterVector p;
-    for (int i = 0; i < kNumParameters; ++i) p[i] = layout.blocks[layout.block[i]][layout.index[i]];
+    const ParameterVector p = ValuesOf(layouts_[d]);
     for (const Sweep* sweep : fit_.datasets[d].sweeps) {
       for (const JumpBracket& jump : sweep->jumps) {
         if (!IsEnforced(range, *sweep, jump) || FoldExists(*sweep, jump, p)) continue;
@@ -203,19 +207,17 @@ std::vector<BoundRestWatcher::Entry> StageProblem::WatchedBounds() const {
   return watched;
 }
 
-bool StageProblem::EvaluatesFinite(ceres::ResidualBlockId block) {
-  const ceres::CostFunction* cost = problem_.GetCostFunctionForResidualBlock(block);
-  std::vector<double*> blocks;
-  problem_.GetParameterBlocksForResidualBlock(block, &blocks);
-  std::vector<double> residuals(cost->num_residuals());
+bool StageProblem::EvaluatesFinite(const ceres::CostFunction& cost,
+                                   const std::vector<double*>& blocks) {
+  std::vector<double> residuals(cost.num_residuals());
   std::vector<std::vector<double>> jacobian(blocks.size());
   std::vector<double*> jacobians;
   for (size_t b = 0; b < blocks.size(); ++b) {
-    jacobian[b].resize(cost->num_residuals() * cost->parameter_block_sizes()[b]);
+    jacobian[b].resize(cost.num_residuals() * cost.parameter_block_sizes()[b]);
     jacobians.push_back(jacobian[b].data());
   }
   std::vector<const double*> point(blocks.begin(), blocks.end());
-  if (!cost->Evaluate(point.data(), residuals.data(), jacobians.data())) return false;
+  if (!cost.Evaluate(point.data(), residuals.data(), jacobians.data())) return false;
   bool finite = true;
   for (double r : residuals) finite = finite && std::isfinite(r);
   for (const std::vector<double>& j : jacobian) {
@@ -224,35 +226,42 @@ bool StageProblem::EvaluatesFinite(ceres::ResidualBlockId block) {
   return finite;
 }
 
+bool StageProblem::EvaluatesFinite(ceres::ResidualBlockId block) {
+  std::vector<double*> blocks;
+  problem_.GetParameterBlocksForResidualBlock(block, &blocks);
+  return EvaluatesFinite(*problem_.GetCostFunctionForResidualBlock(block), blocks);
+}
+
 std::string StageProblem::DescribeFailure(const std::string& ceres_message) {
-  std::vector<std::pair<const Sweep*, const DwellPoint*>> dwells;
-  for (const FitDataset& dataset : fit_.datasets) {
-    for (const Sweep* sweep : dataset.sweeps) {
-      for (const DwellPoint& point : sweep->points) dwells.emplace_back(sweep, &point);
-    }
-  }
-  CHECK_EQ(dwells.size(), dwell_blocks_.size()) << "one residual block per dwell";
-  std::vector<ceres::ResidualBlockId> blocks;
-  problem_.GetResidualBlocks(&blocks);
+  // Each dwell on its own (the problem may hold them in batches).
+  int dwells = 0;
   int bad_dwells = 0;
-  int first_bad = -1;
-  bool bad_other = false;
-  for (size_t i = 0; i < blocks.size(); ++i) {
-    if (EvaluatesFinite(blocks[i])) continue;
-    if (i >= dwells.size()) {
-      bad_other = true;
-    } else if (bad_dwells++ == 0) {
-      first_bad = static_cast<int>(i);
+  const Sweep* sweep = nullptr;  // of the first dwell that fails
+  const DwellPoint* point = nullptr;
+  for (size_t d = 0; d < fit_.datasets.size(); ++d) {
+    ParameterVector p = ValuesOf(layouts_[d]);
+    const std::vector<double*> block = {p.data()};
+    for (const Sweep* s : fit_.datasets[d].sweeps) {
+      for (const DwellPoint& dwell : s->points) {
+        ++dwells;
+        const std::unique_ptr<ceres::CostFunction> cost(builder_.MakeResidual(dwell));
+        if (EvaluatesFinite(*cost, block) || bad_dwells++ > 0) continue;
+        sweep = s;
+        point = &dwell;
+      }
     }
   }
-  if (first_bad < 0) {
+  bool bad_other = false;
+  for (const std::vector<ceres::ResidualBlockId>* ids : {&penalty_blocks_, &caller_blocks_}) {
+    for (ceres::ResidualBlockId id : *ids) bad_other = bad_other || !EvaluatesFinite(id);
+  }
+  if (point == nullptr) {
     return bad_other ? "a penalty or caller's term is not finite there (penalties, "
                        "config/README.md)"
                      : "Ceres: " + ceres_message;
   }
-  const auto [sweep, point] = dwells[first_bad];
   std::ostringstream text;
-  text << (bad_dwells == static_cast<int>(dwells.size())
+  text << (bad_dwells == dwells
                ? "no dwell's residual is finite there, so the parameters are at fault (the "
                  "first dwell: "
                : std::to_string(bad_dwells) + " dwell(s) have a residual that is not finite " +

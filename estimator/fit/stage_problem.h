@@ -83,6 +83,9 @@ class StageProblem {
   // residual or Jacobian is not finite at the blocks' current values, named
   // by file, line and sweep, or else `ceres_message`.
   std::string DescribeFailure(const std::string& ceres_message);
+  // The dwells' residual blocks, in dwell order: one per dwell without
+  // threaded evaluation, batches of consecutive dwells with it
+  // (ProblemBuilder::AddSweep).
   const std::vector<ceres::ResidualBlockId>& dwell_blocks() const { return dwell_blocks_; }
   // The caller's residual blocks (after AddCallerResiduals).
   const std::vector<ceres::ResidualBlockId>& caller_blocks() const { return caller_blocks_; }
@@ -90,6 +93,10 @@ class StageProblem {
  private:
   // Whether the residual block evaluates, with finite residuals and Jacobian.
   bool EvaluatesFinite(ceres::ResidualBlockId block);
+  // The same for `cost` on `blocks`.
+  static bool EvaluatesFinite(const ceres::CostFunction& cost, const std::vector<double*>& blocks);
+  // The six parameters where `layout` reads them.
+  static ParameterVector ValuesOf(const ParameterLayout& layout);
 
   static ceres::Problem::Options ProblemOptions(ParallelResidualEvaluator* evaluator,
                                                 bool threaded);

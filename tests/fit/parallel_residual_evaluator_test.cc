@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <chrono>
+#include <condition_variable>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -110,41 +112,60 @@ Fit FitWithoutEvaluator(const std::vector<Sample>& data) {
 }
 
 // Records the threads it is evaluated on, and otherwise is DecayingCosine.
+// Until `wait_for` distinct threads have evaluated some block (or its
+// deadline, 10 s after the record was made, has passed), each evaluation
+// waits for another thread to arrive: a pool that really runs blocks on
+// several threads gets them, whatever the machine's load, and one that does
+// not is found out.
 class ThreadRecordingCost : public ceres::SizedCostFunction<1, 3> {
  public:
-  ThreadRecordingCost(const Sample& sample, std::mutex* mutex, std::set<std::thread::id>* threads)
-      : cost_(NewDecayingCosine(sample)), mutex_(mutex), threads_(threads) {}
+  struct Record {
+    std::mutex mutex;
+    std::condition_variable arrived;
+    std::set<std::thread::id> threads;
+    size_t wait_for = 1;
+    std::chrono::steady_clock::time_point deadline =
+        std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  };
+
+  ThreadRecordingCost(const Sample& sample, Record* record)
+      : cost_(NewDecayingCosine(sample)), record_(record) {}
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
     {
-      std::lock_guard<std::mutex> lock(*mutex_);
-      threads_->insert(std::this_thread::get_id());
+      std::unique_lock<std::mutex> lock(record_->mutex);
+      if (record_->threads.insert(std::this_thread::get_id()).second) {
+        record_->arrived.notify_all();
+      }
+      record_->arrived.wait_until(lock, record_->deadline, [this] {
+        return record_->threads.size() >= record_->wait_for;
+      });
     }
     return cost_->Evaluate(parameters, residuals, jacobians);
   }
 
  private:
   const std::unique_ptr<ceres::CostFunction> cost_;
-  std::mutex* const mutex_;
-  std::set<std::thread::id>* const threads_;
+  Record* const record_;
 };
 
 // The distinct threads that evaluate `blocks` wrapped blocks in one
-// CostGradient with `num_threads` threads.
-int ThreadsUsed(int blocks, int num_threads) {
+// CostGradient with `num_threads` threads, the blocks waiting for
+// `wait_for` of them.
+int ThreadsUsed(int blocks, int num_threads, size_t wait_for) {
   const std::vector<Sample> data = SyntheticData(blocks);
-  std::mutex mutex;
-  std::set<std::thread::id> threads;
+  ThreadRecordingCost::Record record;
+  record.wait_for = wait_for;
   Parameters parameters = kStart;
   ParallelResidualEvaluator evaluator(parameters.data(), 3, num_threads);
   std::vector<std::unique_ptr<ceres::CostFunction>> wrappers;
   for (const Sample& sample : data) {
-    wrappers.emplace_back(evaluator.Wrap(new ThreadRecordingCost(sample, &mutex, &threads)));
+    wrappers.emplace_back(evaluator.Wrap(new ThreadRecordingCost(sample, &record)));
   }
   std::vector<double> gradient;
   EXPECT_TRUE(evaluator.CostGradient(parameters.data(), &gradient));
-  return static_cast<int>(threads.size());
+  return static_cast<int>(record.threads.size());
 }
 
 // r = sqrt(x - shift), which fails to evaluate for x < shift.
@@ -165,13 +186,13 @@ class SqrtCost : public ceres::SizedCostFunction<1, 1> {
   const double shift_;
 };
 
-// The threads the other tests rely on are really used: one per chunk of at
-// least 256 blocks, up to the number asked for.
+// The threads the other tests rely on are really used: one thread (the
+// caller's) when asked for one or below 256 residuals per thread, two when
+// asked for two with enough residuals.
 TEST(ParallelResidualEvaluator, PrecomputesOnTheRequestedThreads) {
-  EXPECT_EQ(ThreadsUsed(kNumSamples, 1), 1);
-  EXPECT_EQ(ThreadsUsed(kNumSamples, 3), 3);
-  EXPECT_EQ(ThreadsUsed(600, 3), 2);
-  EXPECT_EQ(ThreadsUsed(300, 3), 1);
+  EXPECT_EQ(ThreadsUsed(kNumSamples, 1, 1), 1);
+  EXPECT_EQ(ThreadsUsed(300, 3, 1), 1);
+  EXPECT_EQ(ThreadsUsed(kNumSamples, 2, 2), 2);
 }
 
 // The solve does not depend on the number of threads: the final parameters

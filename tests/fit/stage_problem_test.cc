@@ -24,6 +24,19 @@ StageSetup SetupFor(const FitDescription& fit, ResidualKind kind) {
   return setup;
 }
 
+// The dwells' residual blocks on the threaded path: each sweep's dwells in
+// batches of ProblemBuilder::kDwellsPerBatch.
+int Batches(const FitDescription& fit) {
+  const size_t size = ProblemBuilder::kDwellsPerBatch;
+  int batches = 0;
+  for (const FitDataset& dataset : fit.datasets) {
+    for (const Sweep* sweep : dataset.sweeps) {
+      batches += static_cast<int>((sweep->points.size() + size - 1) / size);
+    }
+  }
+  return batches;
+}
+
 TEST(StageProblem, OneBlockGetsBoundsFixedEntriesAndScaling) {
   const std::vector<Sweep> sweeps = SimulateDataset(kThesisTruth, 0.0, 0);
   ParameterVector p = kThesisTruth;
@@ -33,7 +46,8 @@ TEST(StageProblem, OneBlockGetsBoundsFixedEntriesAndScaling) {
   vertical.Configure();
   ceres::Problem& problem = *vertical.problem();
   EXPECT_EQ(vertical.dwells(), fit.NumDwells());
-  EXPECT_EQ(problem.NumResidualBlocks(), fit.NumDwells());
+  EXPECT_EQ(problem.NumResiduals(), fit.NumDwells());
+  EXPECT_EQ(problem.NumResidualBlocks(), Batches(fit));
   EXPECT_EQ(problem.ParameterBlockTangentSize(p.data()), 4);
   for (int i : {kEtaE, kMu1, kMu2}) EXPECT_EQ(problem.GetParameterLowerBound(p.data(), i), 0.0);
   EXPECT_EQ(problem.GetParameterLowerBound(p.data(), kDelta), kNoBound);
@@ -73,7 +87,8 @@ TEST(StageProblem, SharedEntriesAreBoundedAndEachBlockIsScaled) {
   stage.Configure();
   ceres::Problem& problem = *stage.problem();
   EXPECT_EQ(problem.NumParameterBlocks(), 3);
-  EXPECT_EQ(problem.NumResidualBlocks(), fit.NumDwells());
+  EXPECT_EQ(problem.NumResiduals(), fit.NumDwells());
+  EXPECT_EQ(problem.NumResidualBlocks(), Batches(fit));
   EXPECT_EQ(problem.ParameterBlockTangentSize(model.shared), 5);
   EXPECT_EQ(problem.ParameterBlockTangentSize(model.w_b), 1);
   for (int i : {0, 1, 2}) EXPECT_EQ(problem.GetParameterLowerBound(model.shared, i), 0.0);
