@@ -128,6 +128,7 @@ TEST_F(ClampedBeamIdentification, SameMinimumWithoutNonmonotonicStepsOrTheAlgebr
   monotonic.solver.nonmonotonic_steps = false;
   IdentificationOptions vertical_only = config_->identification;
   vertical_only.stages = {ResidualKind::kVertical};
+  vertical_only.algebraic_start_candidate = false;  // no algebraic stage at all
   for (const IdentificationOptions& options : {monotonic, vertical_only}) {
     const IdentificationResult fit = Identify(data_->fitted, options);
     std::cout << "final cost " << fit.final_cost << " against " << committed_->final_cost << "\n";
