@@ -19,7 +19,8 @@ IdentificationReport MakeIdentificationReport(const std::string& config_path,
   report.config_path = config_path;
   report.options = options;
   report.result = result;
-  report.omega_ref_rad_s = omega_ref_rad_s > 0.0 ? omega_ref_rad_s : result.parameters[kNaturalFrequency];
+  report.omega_ref_rad_s =
+      omega_ref_rad_s > 0.0 ? omega_ref_rad_s : result.parameters[kNaturalFrequency];
   for (const Sweep* sweep : fitted) {
     report.predictions.push_back(PredictSweep(result.parameters, *sweep, /*fitted=*/true));
   }
@@ -68,7 +69,8 @@ void EmitParameters(const IdentificationReport& report, YAML::Emitter* out) {
     *out << YAML::EndMap;
   }
   *out << YAML::EndMap;
-  *out << YAML::Key << "natural_frequency_hz" << YAML::Value << RadPerSecondToHz(p[kNaturalFrequency]);
+  *out << YAML::Key << "natural_frequency_hz" << YAML::Value
+       << RadPerSecondToHz(p[kNaturalFrequency]);
   *out << YAML::Key << "effective_nonlinearity" << YAML::Value << YAML::BeginMap;
   *out << YAML::Key << "definition" << YAML::Value << "-(1/3)(2 delta Omega_ref^2 - 3 alpha)";
   *out << YAML::Key << "value" << YAML::Value << EffectiveNonlinearity(p, report.omega_ref_rad_s);
@@ -128,6 +130,7 @@ void EmitStage(const StageSummary& stage, YAML::Emitter* out) {
   *out << YAML::BeginMap;
   *out << YAML::Key << "residual" << YAML::Value << ResidualKindName(stage.residual);
   if (stage.fold_stage) *out << YAML::Key << "fold_conditions" << YAML::Value << true;
+  if (stage.start_stage) *out << YAML::Key << "start_stage" << YAML::Value << true;
   *out << YAML::Key << "dwells" << YAML::Value << stage.residual_blocks;
   *out << YAML::Key << "initial_cost" << YAML::Value << stage.initial_cost;
   *out << YAML::Key << "final_cost" << YAML::Value << stage.final_cost;
@@ -249,7 +252,8 @@ namespace {
 
 void PrintStages(const IdentificationResult& result, std::ostream& out) {
   for (const StageSummary& stage : result.stages) {
-    out << ResidualKindName(stage.residual) << (stage.fold_stage ? " + fold conditions" : "");
+    out << ResidualKindName(stage.residual) << (stage.fold_stage ? " + fold conditions" : "")
+        << (stage.start_stage ? " (start stage)" : "");
     if (stage.penalty_unit > 0.0) out << " + penalties (exponent " << stage.penalty_exponent << ")";
     out << " stage: cost " << StringPrintf("%.7g -> %.7g", stage.initial_cost, stage.final_cost)
         << ", " << stage.iterations << " iterations";

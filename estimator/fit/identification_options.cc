@@ -176,6 +176,7 @@ StagedSolveOptions IdentificationOptions::SolveOptions() const {
   options.residual = residual;
   options.penalties = penalties;
   options.solver = solver;
+  options.algebraic_start_candidate = algebraic_start_candidate;
   return options;
 }
 

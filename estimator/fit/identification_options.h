@@ -112,6 +112,12 @@ struct StagedSolveOptions {
   // Soft constraints added to every vertical-error stage.
   PenaltyOptions penalties;
   SolverSettings solver;
+  // When the first stage is branch-labelled (vertical or all_roots), an
+  // algebraic stage from the given start runs first and the first stage
+  // starts from the better of the given start and where that ended
+  // (staged_solve.h, "start stage"). false: the first stage starts at the
+  // given start, as written (for studying a residual's own basin).
+  bool algebraic_start_candidate = true;
   bool IsValid(std::string* error) const;
 };
 
@@ -128,8 +134,10 @@ struct IdentificationOptions {
   // Soft constraints added to every vertical-error stage.
   PenaltyOptions penalties;
   SolverSettings solver;
+  // As StagedSolveOptions::algebraic_start_candidate.
+  bool algebraic_start_candidate = true;
   bool IsValid(std::string* error) const;
-  // stages, residual, penalties and solver.
+  // stages, residual, penalties, solver and algebraic_start_candidate.
   StagedSolveOptions SolveOptions() const;
 };
 

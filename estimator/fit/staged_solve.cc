@@ -344,8 +344,9 @@ std::string JoinLines(const std::vector<std::string>& lines) {
   return joined;
 }
 
-// How good a point is as the start of a vertical stage: fewer enforced folds
-// missing first, then a lower cost of the dwells.
+// How good a point is as the start of a branch-labelled stage: fewer
+// enforced folds missing first, then a lower cost of the dwells under the
+// stage's own residual.
 struct StartRating {
   std::vector<std::string> missing_folds;
   double data_cost = 0.0;
@@ -358,58 +359,107 @@ struct StartRating {
   }
 };
 
-// Rates `values` (written into the blocks) as a vertical stage's start.
-StartRating RateStart(const SolveContext& context, const std::vector<double>& values,
-                      const PenaltyOptions& penalties) {
+bool IsBranchLabelled(ResidualKind kind) {
+  return kind == ResidualKind::kVertical || kind == ResidualKind::kAllRoots;
+}
+
+// Rates `values` (written into the blocks) as the start of a `kind` stage.
+StartRating RateStart(const SolveContext& context, ResidualKind kind,
+                      const std::vector<double>& values, const PenaltyOptions& penalties) {
   context.fit.SetValues(values);
-  StageProblem problem(context.fit, MakeSetup(context, ResidualKind::kVertical));
+  StageProblem problem(context.fit, MakeSetup(context, kind));
   return {problem.MissingFolds(penalties.bifurcation_range), problem.DataCost()};
 }
 
-std::string DescribeRating(const StartRating& rating) {
-  if (!rating.missing_folds.empty()) return "it lacks " + JoinLines(rating.missing_folds);
+// "the dwells' vertical cost is 8.77", after the missing folds, if any.
+std::string DescribeRating(ResidualKind kind, const StartRating& rating) {
   std::ostringstream text;
-  text << "its dwells' cost is " << rating.data_cost;
+  if (!rating.missing_folds.empty()) text << "it lacks " << JoinLines(rating.missing_folds) << "; ";
+  text << "the dwells' " << ResidualKindName(kind) << " cost is " << rating.data_cost;
   return text.str();
 }
 
-// Where a vertical stage starts. Of the points the previous stage started
-// and ended at, the better (StartRating): a stage may end where the next
-// one does worse (the algebraic residual does not know branches, and an
-// enforced fold may vanish on its way). When that point still lacks an
-// enforced fold, a fold stage (the algebraic residual with the enforced
-// jumps' fold conditions, FoldConditionResidual) runs from it first, once
-// per solve, and the better of its start and end is taken. Leaves the
-// blocks at the chosen start; false when the fold stage failed.
-bool ChooseVerticalStart(const SolveContext& context, const std::vector<double>* previous_start,
-                         bool* fold_stage_ran, const PenaltyOptions& penalties,
-                         FitSummary* summary, std::string* note, std::string* failure) {
+// The start stage of a run whose first stage is branch-labelled: the
+// algebraic residual (eq. 3.11, the dwells alone) from the given start,
+// whose end is a candidate start for that first stage (ChooseStart). A
+// start stage that cannot evaluate its cost is recorded and passed over:
+// the blocks go back to the given start. Returns whether it ended usably.
+bool RunStartStage(const SolveContext& context, ResidualKind first, FitSummary* summary) {
+  const std::vector<double> given = context.fit.Values();
+  summary->stages.emplace_back();
+  StageSummary& stage = summary->stages.back();
+  stage.start_stage = true;
+  stage.note = std::string(
+                   "start stage: the algebraic fit from the given start, whose end is a "
+                   "candidate start for the first (") +
+               ResidualKindName(first) + ") stage";
+  std::string failure;
+  if (RunStage(context, ResidualKind::kAlgebraic, PenaltyOptions{}, &stage, &failure)) return true;
+  stage.note += "; it failed (" + failure + "), so the first stage starts at the given start";
+  context.fit.SetValues(given);
+  return false;
+}
+
+// The note of a branch-labelled stage choosing between `previous` (where
+// the previous stage started) and `ended` (where it ended).
+std::string StartNote(ResidualKind kind, bool after_start_stage, bool previous_chosen,
+                      const StartRating& previous, const StartRating& ended) {
+  const std::string ratings = DescribeRating(kind, ended) + " (at " +
+                              (after_start_stage ? "the given start" : "its start") + ": " +
+                              DescribeRating(kind, previous) + ")";
+  if (after_start_stage) {
+    return (previous_chosen ? "started at the given start, not where the start stage ended, "
+                              "since where it ended "
+                            : "started where the start stage ended, since there ") +
+           ratings;
+  }
+  return previous_chosen ? "started where the previous stage started, since at its end " + ratings
+                         : "";
+}
+
+// Where a branch-labelled stage of residual `kind` starts. Of the points
+// the previous stage started and ended at, the better (StartRating): a
+// stage may end where the next one does worse (the algebraic residual does
+// not know branches, and an enforced fold may vanish on its way). When the
+// previous stage is the start stage (RunStartStage) the choice is recorded
+// either way. When a vertical stage's start still lacks an enforced fold, a
+// fold stage (the algebraic residual with the enforced jumps' fold
+// conditions, FoldConditionResidual) runs from it first, once per solve,
+// and the better of its start and end is taken. Leaves the blocks at the
+// chosen start; false when the fold stage failed.
+bool ChooseStart(const SolveContext& context, ResidualKind kind,
+                 const std::vector<double>* previous_start, bool after_start_stage,
+                 bool* fold_stage_ran, const PenaltyOptions& penalties, FitSummary* summary,
+                 std::string* note, std::string* failure) {
   std::vector<double> best = context.fit.Values();
-  StartRating rating = RateStart(context, best, penalties);
+  StartRating rating = RateStart(context, kind, best, penalties);
   if (previous_start != nullptr) {
-    const StartRating earlier = RateStart(context, *previous_start, penalties);
-    if (earlier.BetterThan(rating)) {
-      *note = "started where the previous stage started, since at its end " +
-              DescribeRating(rating) + " (at its start: " + DescribeRating(earlier) + ")";
+    const StartRating earlier = RateStart(context, kind, *previous_start, penalties);
+    const bool earlier_better = earlier.BetterThan(rating);
+    *note = StartNote(kind, after_start_stage, earlier_better, earlier, rating);
+    if (earlier_better) {
       best = *previous_start;
       rating = earlier;
     }
   }
-  if (!rating.missing_folds.empty() && !*fold_stage_ran) {
+  if (kind == ResidualKind::kVertical && !rating.missing_folds.empty() && !*fold_stage_ran) {
     context.fit.SetValues(best);
     summary->stages.emplace_back();
     StageSummary& fold_stage = summary->stages.back();
     fold_stage.fold_stage = true;
-    fold_stage.note = "fold stage: the vertical stage's start lacks " +
-                      JoinLines(rating.missing_folds);
+    fold_stage.note =
+        "fold stage: the vertical stage's start lacks " + JoinLines(rating.missing_folds);
     if (!RunStage(context, ResidualKind::kAlgebraic, penalties, &fold_stage, failure)) {
       return false;
     }
     *fold_stage_ran = true;
     const std::vector<double> after = context.fit.Values();
-    const StartRating folded = RateStart(context, after, penalties);
+    const StartRating folded = RateStart(context, kind, after, penalties);
     if (folded.BetterThan(rating)) {
-      *note = "started where the fold stage ended";
+      *note = note->empty() ? "started where the fold stage ended"
+                            : *note +
+                                  "; then, that start lacking an enforced fold, where the "
+                                  "fold stage ended";
       best = after;
     }
   }
@@ -481,11 +531,19 @@ FitSummary SolveStaged(const FitDescription& fit, const StagedSolveOptions& opti
                              ResolveThreadCount(options.solver.num_threads)};
   std::vector<double> previous_start;
   bool fold_stage_ran = false;
-  for (ResidualKind kind : options.stages) {
+  bool after_start_stage = false;
+  for (size_t s = 0; s < options.stages.size(); ++s) {
+    const ResidualKind kind = options.stages[s];
     std::string note;
-    if (kind == ResidualKind::kVertical &&
-        !ChooseVerticalStart(context, summary.stages.empty() ? nullptr : &previous_start,
-                             &fold_stage_ran, options.penalties, &summary, &note, &error)) {
+    if (s == 0 && IsBranchLabelled(kind) && options.algebraic_start_candidate) {
+      previous_start = fit.Values();
+      after_start_stage = RunStartStage(context, kind, &summary);
+    }
+    const bool choose = kind == ResidualKind::kVertical || (s == 0 && after_start_stage);
+    if (choose &&
+        !ChooseStart(context, kind, after_start_stage || s > 0 ? &previous_start : nullptr,
+                     s == 0 && after_start_stage, &fold_stage_ran, options.penalties, &summary,
+                     &note, &error)) {
       summary.status = FitStatus::kFailure;
       summary.evaluation_failed = true;
       summary.message = error;

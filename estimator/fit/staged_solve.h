@@ -33,6 +33,16 @@
 // dwells' cost and the penalty unit (the enforced jumps and the dwells
 // disagree), or at values that are not finite.
 //
+// A run whose first stage is branch-labelled (vertical or all_roots) starts
+// with a start stage: the algebraic residual from the given start, smooth,
+// branch-free and nearly convex, so that it lands near the minimum where a
+// branch-labelled residual from the same start may not (on the noise-free
+// numerical case both slide from a start 30 % off to zero damping, a
+// minimum on the damping bound). The first stage then starts from the
+// better of the given start and the start stage's end, rated as above with
+// the stage's own residual, and its note records which and why. Off with
+// algebraic_start_candidate = false.
+//
 // Within a stage the bounds (eta_e, mu1, mu2 >= 0) are an active set: an
 // entry resting on its bound is held there (BoundRestWatcher) and the stage
 // solves again without it; a held entry whose cost gradient points into the
@@ -59,13 +69,13 @@ namespace dwellfit {
 
 // How a staged solve ended (like ceres::TerminationType).
 enum class FitStatus {
-  kConverged,      // the last stage met a convergence test
-  kNoConvergence,  // the last stage stopped at its iteration limit: usable, not a proven minimum
-  kFailure,        // not usable: a stage's solve failed (the model could not be
-                   // evaluated; the blocks hold where that solve stopped), or the fit
-                   // ended without an enforced fold, with a cost dominated by the
-                   // penalties, or with values that are not finite
-  kInvalidInput,   // invalid options or description: nothing solved, blocks untouched
+  kConverged,       // the last stage met a convergence test
+  kNoConvergence,   // the last stage stopped at its iteration limit: usable, not a proven minimum
+  kFailure,         // not usable: a stage's solve failed (the model could not be
+                    // evaluated; the blocks hold where that solve stopped), or the fit
+                    // ended without an enforced fold, with a cost dominated by the
+                    // penalties, or with values that are not finite
+  kInvalidInput,    // invalid options or description: nothing solved, blocks untouched
   kUnidentifiable,  // set by the analysis (not SolveStaged): the solve ended, but the
                     // data cannot tell the free parameters apart (no covariance)
 };
@@ -96,9 +106,14 @@ struct StageSummary {
   // (FoldConditionResidual), run before a vertical stage whose start lacks
   // an enforced fold.
   bool fold_stage = false;
+  // The algebraic stage run from the given start before a first stage that
+  // is branch-labelled (StagedSolveOptions::algebraic_start_candidate): its
+  // end is a candidate start for that stage.
+  bool start_stage = false;
   // Why the stage ran or where it started, when that is not the plain
-  // sequence: a fold stage, or a vertical stage that started where the
-  // previous stage started (ChooseVerticalStart in the .cc).
+  // sequence: a start or fold stage, a first branch-labelled stage's choice
+  // between the given start and the start stage's end, or a vertical stage
+  // that started where the previous stage started (ChooseStart in the .cc).
   std::string note;
   std::string brief_report;    // ceres::Solver::Summary::BriefReport() of its last solve
   std::vector<double> values;  // every entry where the stage ended, ambient order

@@ -43,16 +43,20 @@ TEST(FitStatus, DuffingBeamFromTheAutomaticStartReachesItsMinimum) {
 }
 
 // From a start with so much damping that no fold exists, the vertical stage
-// alone used to end at a cost of 3e33, "converged".
+// alone used to end at a cost of 3e33, "converged". Neither the start nor
+// the algebraic start stage's end has the enforced folds, so a fold stage
+// follows the start stage.
 TEST(FitStatus, DuffingBeamFromAStartWithoutFoldsRunsAFoldStage) {
   const IdentificationResult fit =
       FitRun(DuffingRun("[delta, mu2]",
                         "{eta_e: 15, mu1: 30, mu2: 0, delta: 0, alpha: 7.85e11, omega_hz: 156}",
                         "[vertical]"))
           .best;
-  ASSERT_FALSE(fit.stages.empty());
-  EXPECT_TRUE(fit.stages.front().fold_stage);
-  EXPECT_THAT(fit.stages.front().note, HasSubstr("L0.060g/up: no jump_down fold"));
+  ASSERT_GE(fit.stages.size(), 3u);
+  EXPECT_TRUE(fit.stages[0].start_stage);
+  EXPECT_TRUE(fit.stages[1].fold_stage);
+  EXPECT_THAT(fit.stages[1].note, HasSubstr("L0.060g/up: no jump_down fold"));
+  EXPECT_THAT(fit.stages[2].note, HasSubstr("where the fold stage ended"));
   EXPECT_EQ(fit.status, FitStatus::kConverged) << fit.message;
   EXPECT_NEAR(fit.final_cost, kDuffingMinimum, 0.01 * kDuffingMinimum);
 }

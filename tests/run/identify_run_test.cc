@@ -5,6 +5,7 @@
 #include <sstream>
 #include <string>
 
+#include "dwellfit/config/config_override.h"
 #include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "gmock/gmock.h"
@@ -53,6 +54,41 @@ TEST(RunIdentify, WithoutRenderingWritesTheScriptButNoImage) {
   EXPECT_FALSE(result["dwellfit_version"].as<std::string>().empty());
   EXPECT_EQ(result["config_in_effect"]["fit"].size(), 2u);
   EXPECT_FALSE(result["config_in_effect"]["output_dir"]);
+}
+
+// A vertical stage run alone begins with the algebraic start stage, and
+// result.yaml says so and which start the vertical stage took, with both
+// costs: from the config's start 30 % off the start stage's end, whose
+// vertical cost is far below the given start's.
+TEST(RunIdentify, ResultYamlRecordsTheStartStageAndTheFirstStagesChoice) {
+  const std::string out_dir = FreshDir("start_stage");
+  const IdentifyConfig config = LoadIdentifyConfig(
+      kConfig,
+      {{"output_dir", out_dir, "--test"}, ListFlagOverride("stages", "vertical", "--stages")});
+  std::ostringstream printed;
+  IdentifyRunOptions options;
+  options.render_figures = false;
+  RunIdentify(config, printed, options);
+  const YAML::Node result = YAML::LoadFile(out_dir + "/result.yaml");
+  EXPECT_EQ(result["status"].as<std::string>(), "converged");
+  const YAML::Node stages = result["stages"];
+  ASSERT_EQ(stages.size(), 2u);
+  EXPECT_EQ(stages[0]["residual"].as<std::string>(), "algebraic");
+  EXPECT_TRUE(stages[0]["start_stage"].as<bool>());
+  EXPECT_FALSE(stages[1]["start_stage"]);
+  EXPECT_EQ(stages[1]["residual"].as<std::string>(), "vertical");
+  const std::string note = stages[1]["note"].as<std::string>();
+  EXPECT_THAT(note, testing::StartsWith("started where the start stage ended, since there the "
+                                        "dwells' vertical cost is "));
+  // The given start's vertical cost, as the note states it, is far above the
+  // cost the vertical stage started from.
+  const std::string given = "(at the given start: the dwells' vertical cost is ";
+  const size_t at = note.find(given);
+  ASSERT_NE(at, std::string::npos) << note;
+  const double given_cost = std::stod(note.substr(at + given.size()));
+  EXPECT_GT(given_cost, 1.0);
+  EXPECT_LT(stages[1]["initial_cost"].as<double>(), 1e-20);
+  EXPECT_THAT(printed.str(), HasSubstr("algebraic (start stage) stage: cost"));
 }
 
 TEST(RunIdentify, WritesResultYamlAndPredictionsForTheThesisCase) {
