@@ -6,8 +6,10 @@
 // simulated datasets sharing eta_e (mapped blocks). The fits run with the
 // residual blocks evaluated on 1 and on 2 threads (the argument); their
 // results do not depend on it.
+#include <atomic>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "benchmark/benchmark.h"
@@ -124,11 +126,37 @@ BENCHMARK(BM_ThesisNumericalWholeFit)
 // The committed clamped-beam config: algebraic stage, then the vertical error
 // with the bifurcation-range penalty (exponent 2, then 10), from its start.
 // Wall time is what counts here (UseRealTime): the evaluation runs on threads.
+// threads:0 is the default setting (one thread per processor available).
 void BM_ClampedBeamFit(benchmark::State& state) { RunConfiguredFit(state, ClampedBeam()); }
 BENCHMARK(BM_ClampedBeamFit)
     ->ArgName("threads")
     ->Arg(1)
     ->Arg(2)
+    ->Arg(0)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(5)
+    ->UseRealTime();
+
+// The same on a busy machine: `busy` background threads spin for the whole
+// run, each keeping one core occupied, as other jobs do on a shared machine.
+// The default (threads:0) must not be slower than one thread here either.
+void BM_ClampedBeamFitBusy(benchmark::State& state) {
+  std::atomic<bool> stop{false};
+  std::vector<std::thread> load;
+  for (int64_t i = 0; i < state.range(1); ++i) {
+    load.emplace_back([&stop] {
+      volatile double x = 0.0;
+      while (!stop.load(std::memory_order_relaxed)) x = x + 1.0;
+    });
+  }
+  RunConfiguredFit(state, ClampedBeam());
+  stop = true;
+  for (std::thread& thread : load) thread.join();
+}
+BENCHMARK(BM_ClampedBeamFitBusy)
+    ->ArgNames({"threads", "busy"})
+    ->Args({1, 1})
+    ->Args({0, 1})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(5)
     ->UseRealTime();

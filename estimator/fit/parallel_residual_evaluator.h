@@ -8,9 +8,14 @@
 // of one-row blocks) it was also no faster (the measured-beam fit: 0.78 s on
 // two threads, 0.76 s on one). Here Ceres runs on one thread and this class,
 // its EvaluationCallback, evaluates every wrapped cost function at each new
-// point in fixed contiguous chunks, one per thread. Each block's residual and Jacobian come
-// from the same code whatever the thread count, and Ceres sums them in block
-// order, so the solve does not depend on the number of threads.
+// point on a TBB arena of `num_threads` threads (the caller's among them):
+// idle workers sleep rather than spin, and the blocks are shared out by work
+// stealing, so a worker the machine is slow to run leaves its share to the
+// others instead of holding the evaluation up. Each block's residual and
+// Jacobian come from the same code whatever the thread count and whichever
+// thread runs it, and Ceres sums them in block order, so the solve does not
+// depend on the number of threads. Below 256 residuals per thread the
+// caller evaluates alone (handing work over costs microseconds).
 //
 // A wrapped cost function (Wrap) keeps its own definition: for a dwell it is
 // the autodiff VerticalErrorResidual with its Newton root solve. Ceres then
