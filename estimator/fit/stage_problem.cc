@@ -41,6 +41,13 @@ StageProblem::StageProblem(const FitDescription& fit, const StageSetup& setup)
   for (size_t i = 0; i < mu2.size(); ++i) damping_entries_[i] = damping_entries_[i] || mu2[i];
   CHECK_EQ(setup.scale.size(), fixed_.size());
   for (const FitBlock& block : fit.blocks) problem_.AddParameterBlock(block.values, block.size);
+  if (setup.threaded_evaluation) {
+    size_t points = 0;
+    for (const FitDataset& dataset : fit.datasets) {
+      for (const Sweep* sweep : dataset.sweeps) points += sweep->points.size();
+    }
+    evaluator_.Reserve(static_cast<int>(points));
+  }
   for (const FitDataset& dataset : fit.datasets) {
     layouts_.push_back(LayoutOf(fit, dataset.parameters));
     for (const Sweep* sweep : dataset.sweeps) {
