@@ -97,8 +97,8 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   std::vector<ReplayingCostFunction*> wrappers_;  // owned by the problem
   // Every wrapper's values at last_point_, contiguous per wrapper, in order
   // (ReplayingCostFunction says what), and where each wrapper's parameter
-  // blocks start in a point: one array each rather than one per wrapper,
-  // which at a million dwells saved ~170 bytes a dwell.
+  // blocks start in a point: one array each rather than two allocations per
+  // wrapper (a million dwells hold a million wrappers).
   std::vector<double> storage_;
   std::vector<int> block_offsets_;
   bool computed_ = false;           // last_point_ holds a point evaluated
