@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "Eigen/SVD"
@@ -145,16 +146,17 @@ bool EstimateNoise(BlockCovariance* c) {
   return true;
 }
 
-// Normalises the columns of `jacobian` into c->columns and sets
+// Normalises the columns of `jacobian` into c->columns (moved there: at a
+// million dwells a copy is 40 MB more at the covariance's peak) and sets
 // c->unit_scale; false for a column without effect.
-bool NormaliseColumns(const FitDescription& fit, const Eigen::MatrixXd& jacobian,
+bool NormaliseColumns(const FitDescription& fit, Eigen::MatrixXd jacobian,
                       const std::vector<double>& tangent_scale, BlockCovariance* c) {
   const int k = c->num_free;
   c->unit_scale.resize(k);
-  c->columns = jacobian;
+  c->columns = std::move(jacobian);
   for (int j = 0; j < k; ++j) {
     const int entry = c->free[j];
-    const double norm = jacobian.col(j).norm();
+    const double norm = c->columns.col(j).norm();
     if (!(norm > 0.0)) {
       // E.g. mu1 with mu1 = mu2 = 0: G depends on the damping through k1^2,
       // k2^2 and k1 k2 only, so its first derivative vanishes there.
@@ -309,7 +311,8 @@ BlockCovariance EstimateBlockCovariance(const FitDescription& fit,
     }
     factor = 1.0;
   }
-  if (!NormaliseColumns(fit, jacobian, tangent_scale, &c) || !CheckCollinearity(fit, &c)) {
+  if (!NormaliseColumns(fit, std::move(jacobian), tangent_scale, &c) ||
+      !CheckCollinearity(fit, &c)) {
     return Unavailable(c, c.message);
   }
   if (!ComputeCovariance(fit, factor, problem.get(), &c)) {

@@ -25,23 +25,30 @@ int ResolveThreadCount(int num_threads) {
   return std::max(1, tbb::info::default_concurrency());
 }
 
-// Owns one wrapped cost function and the values it had at the last point the
-// evaluator saw. One allocation holds them all: the point (the wrapped
+// Owns one wrapped cost function. The values it had at the last point the
+// evaluator saw live in the evaluator's storage_, contiguous per wrapper and
+// wrappers in order (no allocation of their own): the point (the wrapped
 // function's parameter blocks concatenated), its residuals, and its Jacobian
-// (per parameter block, row-major, num_residuals x the block's size).
+// (per parameter block, row-major, num_residuals x the block's size). Where
+// each of its parameter blocks starts in the evaluator's point is in the
+// evaluator's block_offsets_, from first_offset_ on.
 class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunction {
  public:
   // `offsets`: where each of the wrapped function's parameter blocks starts
-  // in the evaluator's point.
-  ReplayingCostFunction(ceres::CostFunction* wrapped, std::vector<int> offsets,
+  // in the evaluator's point. Appends the wrapper's offsets and storage to
+  // the evaluator's.
+  ReplayingCostFunction(ceres::CostFunction* wrapped, const std::vector<int>& offsets,
                         ParallelResidualEvaluator* owner)
-      : wrapped_(wrapped), owner_(owner), offsets_(std::move(offsets)) {
-    CHECK_EQ(wrapped->parameter_block_sizes().size(), offsets_.size());
+      : wrapped_(wrapped), owner_(owner) {
+    CHECK_EQ(wrapped->parameter_block_sizes().size(), offsets.size());
     set_num_residuals(wrapped->num_residuals());
     *mutable_parameter_block_sizes() = wrapped->parameter_block_sizes();
     rows_ = wrapped->num_residuals();
     for (int size : parameter_block_sizes()) total_ += size;
-    storage_.resize(static_cast<size_t>(total_) * (1 + rows_) + rows_);
+    first_offset_ = owner->block_offsets_.size();
+    owner->block_offsets_.insert(owner->block_offsets_.end(), offsets.begin(), offsets.end());
+    storage_offset_ = owner->storage_.size();
+    owner->storage_.resize(storage_offset_ + static_cast<size_t>(total_) * (1 + rows_) + rows_);
   }
 
   // Adds J^T r at the precomputed point to `gradient` (a point's
@@ -54,7 +61,7 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
       const double* jacobian = Jacobian() + rows_ * start;
       for (int row = 0; row < rows_; ++row) {
         for (int col = 0; col < sizes[j]; ++col)
-          gradient[offsets_[j] + col] += jacobian[row * sizes[j] + col] * Residuals()[row];
+          gradient[Offset(j) + col] += jacobian[row * sizes[j] + col] * Residuals()[row];
       }
       start += sizes[j];
     }
@@ -64,8 +71,8 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
   // Computes the values at `point` (the evaluator's thread for this block).
   void Precompute(const double* point) {
     valid_ = true;
-    if (offsets_.size() == 1) {  // one parameter block: no per-block bookkeeping
-      std::copy(point + offsets_[0], point + offsets_[0] + total_, Point());
+    if (NumBlocks() == 1) {  // one parameter block: no per-block bookkeeping
+      std::copy(point + Offset(0), point + Offset(0) + total_, Point());
       const double* blocks[] = {Point()};
       double* jacobians[] = {Jacobian()};
       ok_ = wrapped_->Evaluate(blocks, Residuals(), jacobians);
@@ -74,7 +81,7 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
     const std::vector<int32_t>& sizes = parameter_block_sizes();
     int start = 0;
     for (size_t j = 0; j < sizes.size(); ++j) {
-      std::copy(point + offsets_[j], point + offsets_[j] + sizes[j], Point() + start);
+      std::copy(point + Offset(j), point + Offset(j) + sizes[j], Point() + start);
       start += sizes[j];
     }
     ok_ = EvaluateAtOwnPoint();
@@ -82,7 +89,7 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
-    if (offsets_.size() == 1) return EvaluateOneBlock(parameters, residuals, jacobians);
+    if (NumBlocks() == 1) return EvaluateOneBlock(parameters, residuals, jacobians);
     if (!valid_ || !AtPoint(parameters)) {
       ++owner_->evaluated_directly_;
       return wrapped_->Evaluate(parameters, residuals, jacobians);
@@ -106,12 +113,15 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
   // residual reads at most six).
   static constexpr size_t kStackBlocks = 8;
 
-  double* Point() { return storage_.data(); }
-  const double* Point() const { return storage_.data(); }
-  double* Residuals() { return storage_.data() + total_; }
-  const double* Residuals() const { return storage_.data() + total_; }
-  double* Jacobian() { return storage_.data() + total_ + rows_; }
-  const double* Jacobian() const { return storage_.data() + total_ + rows_; }
+  size_t NumBlocks() const { return parameter_block_sizes().size(); }
+  // Where the wrapped function's parameter block j starts in the evaluator's point.
+  int Offset(size_t j) const { return owner_->block_offsets_[first_offset_ + j]; }
+  double* Point() { return owner_->storage_.data() + storage_offset_; }
+  const double* Point() const { return owner_->storage_.data() + storage_offset_; }
+  double* Residuals() { return Point() + total_; }
+  const double* Residuals() const { return Point() + total_; }
+  double* Jacobian() { return Point() + total_ + rows_; }
+  const double* Jacobian() const { return Point() + total_ + rows_; }
 
   // The wrapped function at Point(), into Residuals() and Jacobian().
   bool EvaluateAtOwnPoint() {
@@ -167,10 +177,10 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
 
   const std::unique_ptr<ceres::CostFunction> wrapped_;
   ParallelResidualEvaluator* const owner_;
-  const std::vector<int> offsets_;  // of each parameter block in the evaluator's point
-  int rows_ = 0;                    // residuals
-  int total_ = 0;                   // doubles over the parameter blocks
-  std::vector<double> storage_;     // point, residuals, Jacobian
+  size_t storage_offset_ = 0;  // of the point, residuals and Jacobian in owner_->storage_
+  size_t first_offset_ = 0;    // of the blocks' offsets in owner_->block_offsets_
+  int rows_ = 0;               // residuals
+  int total_ = 0;              // doubles over the parameter blocks
   bool ok_ = false;
   bool valid_ = false;
 };
@@ -204,7 +214,7 @@ ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_f
     CHECK_EQ(cost_function->parameter_block_sizes()[j], blocks_[b].size);
     offsets.push_back(offsets_[b]);
   }
-  auto* wrapper = new ReplayingCostFunction(cost_function, std::move(offsets), this);
+  auto* wrapper = new ReplayingCostFunction(cost_function, offsets, this);
   wrappers_.push_back(wrapper);
   rows_ += cost_function->num_residuals();
   return wrapper;
@@ -217,6 +227,13 @@ ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_f
   wrappers_.push_back(wrapper);
   rows_ += cost_function->num_residuals();
   return wrapper;
+}
+
+void ParallelResidualEvaluator::Reserve(int residuals) {
+  wrappers_.reserve(wrappers_.size() + residuals);
+  block_offsets_.reserve(block_offsets_.size() + residuals);
+  // At most one wrapper per residual: its point, the residual, its Jacobian row.
+  storage_.reserve(storage_.size() + static_cast<size_t>(residuals) * (2 * size_ + 1));
 }
 
 bool ParallelResidualEvaluator::AtLastPoint() const {

@@ -69,6 +69,11 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
                             const std::vector<double*>& parameter_blocks);
   // The same for a cost function of the first watched block alone.
   ceres::CostFunction* Wrap(ceres::CostFunction* cost_function);
+  // Makes room for `residuals` more residuals over the whole point (the
+  // dwells, one each, in wrappers of one or of a batch of them), so that
+  // wrapping them copies no stored values. Only capacity: wrappers of any
+  // shape may follow.
+  void Reserve(int residuals);
 
   void PrepareForEvaluation(bool evaluate_jacobians, bool new_evaluation_point) override;
 
@@ -98,9 +103,15 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   const int num_threads_;
   tbb::task_arena arena_;  // at most num_threads_ threads, the caller's included
   std::vector<ReplayingCostFunction*> wrappers_;  // owned by the problem
-  int rows_ = 0;                                  // residuals over the wrappers
-  bool computed_ = false;                         // last_point_ holds a point evaluated
-  std::vector<double> last_point_;                // the point the wrappers hold values for
+  int rows_ = 0;  // residuals over the wrappers
+  // Every wrapper's values at last_point_, contiguous per wrapper, in order
+  // (ReplayingCostFunction says what), and where each wrapper's parameter
+  // blocks start in a point: one array each rather than two allocations per
+  // wrapper (a million dwells hold a million wrappers).
+  std::vector<double> storage_;
+  std::vector<int> block_offsets_;
+  bool computed_ = false;           // last_point_ holds a point evaluated
+  std::vector<double> last_point_;  // the point the wrappers hold values for
   std::int64_t replayed_ = 0;
   std::int64_t evaluated_directly_ = 0;
 };

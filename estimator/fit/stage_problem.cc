@@ -5,6 +5,7 @@
 #include <limits>
 #include <memory>
 #include <sstream>
+#include <unordered_set>
 #include <utility>
 
 #include "ceres/loss_function.h"
@@ -18,7 +19,18 @@ ceres::Problem::Options StageProblem::ProblemOptions(ParallelResidualEvaluator* 
                                                      bool threaded) {
   ceres::Problem::Options options;
   if (threaded) options.evaluation_callback = evaluator;
+  options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // cost_functions_ owns them
   return options;
+}
+
+void StageProblem::OwnCostFunctions(const std::vector<ceres::ResidualBlockId>& blocks, size_t first,
+                                    bool may_share) {
+  std::unordered_set<const ceres::CostFunction*> owned;
+  cost_functions_.reserve(cost_functions_.size() + blocks.size() - first);
+  for (size_t i = first; i < blocks.size(); ++i) {
+    const ceres::CostFunction* cost = problem_.GetCostFunctionForResidualBlock(blocks[i]);
+    if (!may_share || owned.insert(cost).second) cost_functions_.emplace_back(cost);
+  }
 }
 
 std::vector<ParallelResidualEvaluator::Block> StageProblem::EvaluatedBlocks(
@@ -41,13 +53,27 @@ StageProblem::StageProblem(const FitDescription& fit, const StageSetup& setup)
   for (size_t i = 0; i < mu2.size(); ++i) damping_entries_[i] = damping_entries_[i] || mu2[i];
   CHECK_EQ(setup.scale.size(), fixed_.size());
   for (const FitBlock& block : fit.blocks) problem_.AddParameterBlock(block.values, block.size);
-  for (const FitDataset& dataset : fit.datasets) {
-    layouts_.push_back(LayoutOf(fit, dataset.parameters));
-    for (const Sweep* sweep : dataset.sweeps) {
-      dwells_ += builder_.AddSweep(*sweep, layouts_.back(), &problem_, Evaluator());
+  if (setup.threaded_evaluation) {
+    size_t points = 0;
+    for (const FitDataset& dataset : fit.datasets) {
+      for (const Sweep* sweep : dataset.sweeps) points += sweep->points.size();
     }
+    evaluator_.Reserve(static_cast<int>(points));
+  }
+  try {
+    for (const FitDataset& dataset : fit.datasets) {
+      layouts_.push_back(LayoutOf(fit, dataset.parameters));
+      for (const Sweep* sweep : dataset.sweeps) {
+        dwells_ += builder_.AddSweep(*sweep, layouts_.back(), &problem_, Evaluator());
+      }
+    }
+  } catch (...) {  // a sweep the residual cannot take: the earlier ones' blocks are owned
+    problem_.GetResidualBlocks(&dwell_blocks_);
+    OwnCostFunctions(dwell_blocks_, 0, false);
+    throw;
   }
   problem_.GetResidualBlocks(&dwell_blocks_);
+  OwnCostFunctions(dwell_blocks_, 0, false);
 }
 
 void StageProblem::AddPenalties(const PenaltyOptions& penalties) {
@@ -62,6 +88,7 @@ void StageProblem::AddPenalties(const PenaltyOptions& penalties) {
   }
   std::vector<ceres::ResidualBlockId> all;
   problem_.GetResidualBlocks(&all);
+  OwnCostFunctions(all, before, false);
   penalty_blocks_.insert(penalty_blocks_.end(), all.begin() + before, all.end());
 }
 
@@ -94,9 +121,16 @@ std::vector<std::string> StageProblem::MissingFolds(const BifurcationRangeOption
 void StageProblem::AddCallerResiduals() {
   if (!fit_.add_residuals) return;
   const int before = problem_.NumResidualBlocks();
-  fit_.add_residuals(&problem_);
   std::vector<ceres::ResidualBlockId> all;
+  try {
+    fit_.add_residuals(&problem_);
+  } catch (...) {  // what it added before it threw is owned all the same
+    problem_.GetResidualBlocks(&all);
+    OwnCostFunctions(all, before, true);
+    throw;
+  }
   problem_.GetResidualBlocks(&all);
+  OwnCostFunctions(all, before, true);
   caller_blocks_.assign(all.begin() + before, all.end());
 }
 

@@ -17,6 +17,7 @@
 #ifndef DWELLFIT_ESTIMATOR_FIT_STAGE_PROBLEM_H_
 #define DWELLFIT_ESTIMATOR_FIT_STAGE_PROBLEM_H_
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -100,6 +101,11 @@ class StageProblem {
 
   static ceres::Problem::Options ProblemOptions(ParallelResidualEvaluator* evaluator,
                                                 bool threaded);
+  // Takes ownership of the cost functions of `blocks` from `first` on; each
+  // once when `may_share` (a caller's cost function may serve several
+  // blocks), else each block's own.
+  void OwnCostFunctions(const std::vector<ceres::ResidualBlockId>& blocks, size_t first,
+                        bool may_share);
   static std::vector<ParallelResidualEvaluator::Block> EvaluatedBlocks(const FitDescription& fit);
   // The evaluator the dwells and penalties go through, or none.
   ParallelResidualEvaluator* Evaluator() {
@@ -116,6 +122,11 @@ class StageProblem {
   std::vector<bool> eta_e_entries_;       // per ambient entry
   std::vector<bool> damping_entries_;
   std::vector<bool> fixed_;
+  // Every residual block's cost function. The problem does not own them
+  // (Problem::Options::cost_function_ownership): owning, Ceres keeps a map
+  // entry per cost function to count its blocks, at a million dwells some
+  // 60 MB and a tree insertion per dwell. Destroyed after problem_.
+  std::vector<std::unique_ptr<const ceres::CostFunction>> cost_functions_;
   ParallelResidualEvaluator evaluator_;  // outlives problem_, which calls it
   ceres::Problem problem_;
   std::vector<ceres::ResidualBlockId> dwell_blocks_;

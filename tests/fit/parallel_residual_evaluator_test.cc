@@ -446,6 +446,83 @@ TEST(ParallelResidualEvaluator, FailureOfAWrappedFunctionIsReplayed) {
   EXPECT_EQ(evaluator.evaluated_directly(), 0);
 }
 
+// Two residuals of {b, c} alone: the cosine's residual and its square.
+struct TwoResidualsOfBC {
+  explicit TwoResidualsOfBC(const Sample& sample) : cosine(sample) {}
+  template <typename T>
+  bool operator()(const T* const bc, T* residual) const {
+    const T p[3] = {T(kTruth[0]), bc[0], bc[1]};
+    if (!cosine(p, residual)) return false;
+    residual[1] = residual[0] * residual[0];
+    return true;
+  }
+  DecayingCosine cosine;
+};
+
+// Wrapper i of MixedShapeCost: alternately two blocks {a}, {b, c} with one
+// residual, and {b, c} alone with two.
+ceres::CostFunction* MixedShapeCost(const Sample& sample, int i) {
+  if (i % 2 == 0) {
+    return new ceres::AutoDiffCostFunction<SplitDecayingCosine, 1, 1, 2>(
+        new SplitDecayingCosine(sample));
+  }
+  return new ceres::AutoDiffCostFunction<TwoResidualsOfBC, 2, 2>(new TwoResidualsOfBC(sample));
+}
+
+// Every wrapper replays exactly its own wrapped function's values, residuals
+// and Jacobians, whatever the shapes around it, whether room was reserved
+// or not, and after wrappers added later have grown the evaluator's storage
+// (the values of the earlier ones move with it).
+TEST(ParallelResidualEvaluator, WrappersOfMixedShapesReplayTheirOwnValues) {
+  constexpr int kFirst = 900;  // wrapped before the first point: three chunks
+  constexpr int kLater = 700;  // wrapped after it, growing the storage
+  const std::vector<Sample> data = SyntheticData(kFirst + kLater);
+  double a[1] = {kStart[0]};
+  double bc[2] = {kStart[1], kStart[2]};
+  ParallelResidualEvaluator evaluator({{a, 1}, {bc, 2}}, 3);
+  evaluator.Reserve(100);  // fewer than wrapped, and of another shape
+  std::vector<std::unique_ptr<ceres::CostFunction>> wrappers;
+  std::vector<std::unique_ptr<ceres::CostFunction>> references;
+  auto wrap = [&](int i) {
+    const std::vector<double*> blocks =
+        i % 2 == 0 ? std::vector<double*>{a, bc} : std::vector<double*>{bc};
+    wrappers.emplace_back(evaluator.Wrap(MixedShapeCost(data[i], i), blocks));
+    references.emplace_back(MixedShapeCost(data[i], i));
+  };
+  // Evaluates wrapper i and its reference at the blocks' values: bitwise equal.
+  auto expect_replayed = [&](int i) {
+    const bool two_blocks = i % 2 == 0;
+    const double* blocks[] = {two_blocks ? a : bc, bc};
+    double residuals[2] = {0.0, 0.0};
+    double expected_residuals[2] = {1.0, 1.0};
+    double jacobian[6] = {0, 0, 0, 0, 0, 0};
+    double expected_jacobian[6] = {1, 1, 1, 1, 1, 1};
+    double* jacobians[] = {jacobian, jacobian + (two_blocks ? 1 : 4)};
+    double* expected_jacobians[] = {expected_jacobian, expected_jacobian + (two_blocks ? 1 : 4)};
+    ASSERT_TRUE(wrappers[i]->Evaluate(blocks, residuals, jacobians)) << i;
+    ASSERT_TRUE(references[i]->Evaluate(blocks, expected_residuals, expected_jacobians)) << i;
+    const int rows = two_blocks ? 1 : 2;
+    for (int r = 0; r < rows; ++r) EXPECT_EQ(residuals[r], expected_residuals[r]) << i;
+    for (int k = 0; k < (two_blocks ? 3 : 4); ++k)
+      EXPECT_EQ(jacobian[k], expected_jacobian[k]) << i;
+  };
+  for (int i = 0; i < kFirst; ++i) wrap(i);
+  evaluator.PrepareForEvaluation(true, true);
+  for (int i = kFirst; i < kFirst + kLater; ++i) wrap(i);
+  for (int i : {0, 1, 449, 450, kFirst - 1}) expect_replayed(i);
+  EXPECT_EQ(evaluator.replayed(), 5);
+  EXPECT_EQ(evaluator.evaluated_directly(), 0);
+
+  // A new point: every wrapper, the later ones included, replays it.
+  a[0] = 1.7;
+  bc[0] = 0.45;
+  bc[1] = 1.4;
+  evaluator.PrepareForEvaluation(true, true);
+  for (int i = 0; i < kFirst + kLater; ++i) expect_replayed(i);
+  EXPECT_EQ(evaluator.replayed(), 5 + kFirst + kLater);
+  EXPECT_EQ(evaluator.evaluated_directly(), 0);
+}
+
 // A positive thread count is itself; 0 is one per processor available, at least 1.
 TEST(ParallelResidualEvaluator, ResolveThreadCount) {
   EXPECT_EQ(ResolveThreadCount(3), 3);

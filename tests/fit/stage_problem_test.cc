@@ -5,9 +5,11 @@
 #include "dwellfit/estimator/fit/stage_problem.h"
 
 #include <limits>
+#include <stdexcept>
 #include <vector>
 
 #include "ceres/normal_prior.h"
+#include "ceres/sized_cost_function.h"
 #include "gtest/gtest.h"
 #include "tests/fit_test_support.h"
 
@@ -126,6 +128,72 @@ TEST(StageProblem, CostGradientIncludesTheCallersResidualBlocks) {
     EXPECT_NEAR(gradient[kMu1], (0.2 - 0.3) / (sigma * sigma), 1e-6) << threaded;
     EXPECT_NEAR(gradient[kEtaE], 0.0, 1e-9) << threaded;
   }
+}
+
+// Counts its destructions; r = p[mu1] - target otherwise.
+class CountedPrior : public ceres::SizedCostFunction<1, kNumParameters> {
+ public:
+  CountedPrior(double target, int* destroyed) : target_(target), destroyed_(destroyed) {}
+  ~CountedPrior() override { ++*destroyed_; }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    residuals[0] = parameters[0][kMu1] - target_;
+    if (jacobians != nullptr && jacobians[0] != nullptr) {
+      for (int i = 0; i < kNumParameters; ++i) jacobians[0][i] = i == kMu1 ? 1.0 : 0.0;
+    }
+    return true;
+  }
+
+ private:
+  const double target_;
+  int* const destroyed_;
+};
+
+// The stage problem owns every cost function, the caller's included, and
+// deletes each once: a cost function the caller gives two residual blocks
+// too, and those the caller added before it threw.
+TEST(StageProblem, OwnsEveryCostFunctionOnce) {
+  const std::vector<Sweep> sweeps = SimulateDataset(kThesisTruth, 0.0, 0);
+  ParameterVector p = kThesisTruth;
+  FitDescription fit = SingleBlockFit(Pointers(sweeps), {}, &p);
+  int destroyed = 0;
+  fit.add_residuals = [&](ceres::Problem* problem) {
+    auto* shared = new CountedPrior(0.3, &destroyed);
+    problem->AddResidualBlock(shared, nullptr, p.data());
+    problem->AddResidualBlock(shared, nullptr, p.data());
+    problem->AddResidualBlock(new CountedPrior(0.1, &destroyed), nullptr, p.data());
+  };
+  for (bool threaded : {true, false}) {
+    destroyed = 0;
+    {
+      StageSetup setup = SetupFor(fit, ResidualKind::kVertical);
+      setup.threaded_evaluation = threaded;
+      StageProblem stage(fit, setup);
+      stage.AddCallerResiduals();
+      ASSERT_EQ(stage.caller_blocks().size(), 3u);
+      EXPECT_EQ(stage.problem()->NumResidualBlocks(),
+                (threaded ? Batches(fit) : fit.NumDwells()) + 3);
+      // The dwells are exact at the truth; the priors' r = -0.1, -0.1, 0.1.
+      double cost = 0.0;
+      ASSERT_TRUE(stage.problem()->Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr,
+                                            nullptr, nullptr));
+      EXPECT_NEAR(cost, 0.5 * 3 * 0.01, 1e-12) << threaded;
+      EXPECT_EQ(destroyed, 0);
+    }
+    EXPECT_EQ(destroyed, 2) << threaded;
+  }
+
+  destroyed = 0;
+  fit.add_residuals = [&](ceres::Problem* problem) {
+    problem->AddResidualBlock(new CountedPrior(0.3, &destroyed), nullptr, p.data());
+    throw std::runtime_error("the caller's own failure");
+  };
+  {
+    StageProblem stage(fit, SetupFor(fit, ResidualKind::kVertical));
+    EXPECT_THROW(stage.AddCallerResiduals(), std::runtime_error);
+    EXPECT_EQ(destroyed, 0);
+  }
+  EXPECT_EQ(destroyed, 1);
 }
 
 }  // namespace
