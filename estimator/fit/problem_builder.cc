@@ -81,8 +81,10 @@ int ProblemBuilder::AddSweep(const Sweep& sweep, const ParameterLayout& layout,
                            "column, or choose other stages");
     }
   }
-  if (evaluator == nullptr) {
-    for (const DwellPoint& point : sweep.points) Add(MakeResidual(point), layout, problem, nullptr);
+  if (!options_.batch_dwells) {
+    for (const DwellPoint& point : sweep.points) {
+      Add(MakeResidual(point), layout, problem, evaluator);
+    }
   } else {
     const size_t count = sweep.points.size();
     for (size_t first = 0; first < count; first += kDwellsPerBatch) {

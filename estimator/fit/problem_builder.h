@@ -40,14 +40,20 @@ struct ProblemBuilderOptions {
   double dwell_weight = 1.0;
   // Soft constraints of eqs. (3.17) and (3.19); AddPenalties adds them.
   PenaltyOptions penalties;
+  // AddSweep puts up to ProblemBuilder::kDwellsPerBatch consecutive dwells in
+  // one residual block (BatchedCostFunction) instead of one block per dwell:
+  // Ceres' work and memory per block are then paid once per batch. Every
+  // stage problem (stage_problem.h) batches; a caller that wants a residual
+  // block per dwell keeps the default.
+  bool batch_dwells = false;
   bool IsValid(std::string* error) const;
 };
 
 class ProblemBuilder {
  public:
-  // Dwells per residual block on the evaluator's path: enough that Ceres'
-  // work per block is small beside the dwells', few enough that a sweep's
-  // batches spread over the threads.
+  // Dwells per residual block with `batch_dwells`: enough that Ceres' work
+  // per block is small beside the dwells', few enough that a sweep's batches
+  // spread over the threads.
   static constexpr size_t kDwellsPerBatch = 32;
 
   // `options` should be valid (IsValid); the staged solve checks them.
@@ -56,11 +62,11 @@ class ProblemBuilder {
   // Adds the residuals of every dwell of `sweep` (one each, two for
   // kPhaseLag, which throws InputError naming the dwell when one has no
   // measured phase), each reading the six parameters where `layout` puts
-  // them (the blocks are owned by the caller and must outlive `problem`).
-  // Without an `evaluator`: one residual block per dwell, in order. With an
+  // them (the blocks are owned by the caller and must outlive `problem`):
+  // one residual block per dwell, in order, or with `batch_dwells` up to
+  // kDwellsPerBatch consecutive dwells per residual block. With an
   // `evaluator` (the problem's evaluation callback, watching the layout's
-  // blocks): up to kDwellsPerBatch consecutive dwells per residual block
-  // (BatchedCostFunction), evaluated through it on its threads. Returns the
+  // blocks) the blocks are evaluated through it, on its threads. Returns the
   // number of dwells added.
   int AddSweep(const Sweep& sweep, const ParameterLayout& layout, ceres::Problem* problem,
                ParallelResidualEvaluator* evaluator = nullptr) const;

@@ -40,10 +40,19 @@ std::vector<ParallelResidualEvaluator::Block> StageProblem::EvaluatedBlocks(
   return blocks;
 }
 
+namespace {
+
+ProblemBuilderOptions Batched(ProblemBuilderOptions options) {
+  options.batch_dwells = true;
+  return options;
+}
+
+}  // namespace
+
 StageProblem::StageProblem(const FitDescription& fit, const StageSetup& setup)
     : fit_(fit),
       setup_(setup),
-      builder_(setup.residuals),
+      builder_(Batched(setup.residuals)),
       eta_e_entries_(fit.EntriesHolding(kEtaE)),
       damping_entries_(fit.EntriesHolding(kMu1)),
       fixed_(fit.FixedEntries()),

@@ -84,9 +84,8 @@ class StageProblem {
   // residual or Jacobian is not finite at the blocks' current values, named
   // by file, line and sweep, or else `ceres_message`.
   std::string DescribeFailure(const std::string& ceres_message);
-  // The dwells' residual blocks, in dwell order: one per dwell without
-  // threaded evaluation, batches of consecutive dwells with it
-  // (ProblemBuilder::AddSweep).
+  // The dwells' residual blocks, in dwell order: batches of consecutive
+  // dwells (ProblemBuilderOptions::batch_dwells).
   const std::vector<ceres::ResidualBlockId>& dwell_blocks() const { return dwell_blocks_; }
   // The caller's residual blocks (after AddCallerResiduals).
   const std::vector<ceres::ResidualBlockId>& caller_blocks() const { return caller_blocks_; }

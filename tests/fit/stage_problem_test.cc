@@ -26,7 +26,7 @@ StageSetup SetupFor(const FitDescription& fit, ResidualKind kind) {
   return setup;
 }
 
-// The dwells' residual blocks on the threaded path: each sweep's dwells in
+// The dwells' residual blocks of a stage problem: each sweep's dwells in
 // batches of ProblemBuilder::kDwellsPerBatch.
 int Batches(const FitDescription& fit) {
   const size_t size = ProblemBuilder::kDwellsPerBatch;
@@ -171,8 +171,7 @@ TEST(StageProblem, OwnsEveryCostFunctionOnce) {
       StageProblem stage(fit, setup);
       stage.AddCallerResiduals();
       ASSERT_EQ(stage.caller_blocks().size(), 3u);
-      EXPECT_EQ(stage.problem()->NumResidualBlocks(),
-                (threaded ? Batches(fit) : fit.NumDwells()) + 3);
+      EXPECT_EQ(stage.problem()->NumResidualBlocks(), Batches(fit) + 3);
       // The dwells are exact at the truth; the priors' r = -0.1, -0.1, 0.1.
       double cost = 0.0;
       ASSERT_TRUE(stage.problem()->Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr,
