@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <utility>
 
 #include "glog/logging.h"
@@ -15,6 +16,10 @@ namespace {
 
 // Residuals (dwells) each thread gets at the least (fewer threads below that).
 constexpr int kMinRowsPerThread = 256;
+// Every this many evaluations the way not preferred runs, to be timed again.
+constexpr std::int64_t kProbeInterval = 16;
+// The weight of the newest evaluation in the recent time of its way.
+constexpr double kRecentWeight = 0.25;
 
 }  // namespace
 
@@ -269,13 +274,33 @@ void ParallelResidualEvaluator::PrecomputeAll() {
     for (int i = 0; i < count; ++i) wrappers_[i]->Precompute(copy);
     return;
   }
-  // Idle workers sleep, and a worker the machine is slow to run leaves its
-  // blocks to the others (work stealing): more threads never wait for one.
-  arena_.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, count), [&](const tbb::blocked_range<int>& range) {
-      for (int i = range.begin(); i < range.end(); ++i) wrappers_[i]->Precompute(copy);
+  // The threads only where they pay on this machine now: each evaluation
+  // runs the way (threaded or in the caller alone) whose recent evaluations
+  // took less time, and every kProbeInterval-th tries the other way, so a
+  // machine that becomes busy or idle is followed. Which way runs changes no
+  // value.
+  const bool threaded_faster = threaded_seconds_ <= alone_seconds_;
+  const bool threaded = (++evaluations_ % kProbeInterval == 0) ? !threaded_faster : threaded_faster;
+  const auto start = std::chrono::steady_clock::now();
+  if (!threaded) {
+    for (int i = 0; i < count; ++i) wrappers_[i]->Precompute(copy);
+  } else {
+    // Idle workers sleep, and the blocks are split down to single batches
+    // that an idle thread steals: a worker the machine is slow to run holds
+    // up at most the batch it is in.
+    arena_.execute([&] {
+      tbb::parallel_for(
+          tbb::blocked_range<int>(0, count, 1),
+          [&](const tbb::blocked_range<int>& range) {
+            for (int i = range.begin(); i < range.end(); ++i) wrappers_[i]->Precompute(copy);
+          },
+          tbb::simple_partitioner());
     });
-  });
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  double& recent = threaded ? threaded_seconds_ : alone_seconds_;
+  recent = recent == 0.0 ? seconds : (1.0 - kRecentWeight) * recent + kRecentWeight * seconds;
 }
 
 bool ParallelResidualEvaluator::CostGradient(const double* point, std::vector<double>* gradient) {

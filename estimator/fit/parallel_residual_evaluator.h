@@ -15,7 +15,10 @@
 // Jacobian come from the same code whatever the thread count and whichever
 // thread runs it, and Ceres sums them in block order, so the solve does not
 // depend on the number of threads. Below 256 residuals per thread the
-// caller evaluates alone (handing work over costs microseconds).
+// caller evaluates alone (handing work over costs microseconds), and above
+// it each evaluation runs on the threads or in the caller alone, whichever
+// has recently been faster (each tried again every 16 evaluations): on a
+// machine whose other cores are busy, more threads do not cost time.
 //
 // A wrapped cost function (Wrap) keeps its own definition: for a dwell it is
 // the autodiff VerticalErrorResidual with its Newton root solve. Ceres then
@@ -103,7 +106,7 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   const int num_threads_;
   tbb::task_arena arena_;  // at most num_threads_ threads, the caller's included
   std::vector<ReplayingCostFunction*> wrappers_;  // owned by the problem
-  int rows_ = 0;  // residuals over the wrappers
+  int rows_ = 0;                                  // residuals over the wrappers
   // Every wrapper's values at last_point_, contiguous per wrapper, in order
   // (ReplayingCostFunction says what), and where each wrapper's parameter
   // blocks start in a point: one array each rather than two allocations per
@@ -114,6 +117,12 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   std::vector<double> last_point_;  // the point the wrappers hold values for
   std::int64_t replayed_ = 0;
   std::int64_t evaluated_directly_ = 0;
+  // PrecomputeAll on the threads or in the caller alone, whichever is
+  // faster: the recent wall time of each way [s] (0: not timed yet), and the
+  // evaluations so far.
+  double threaded_seconds_ = 0.0;
+  double alone_seconds_ = 0.0;
+  std::int64_t evaluations_ = 0;
 };
 
 }  // namespace dwellfit
