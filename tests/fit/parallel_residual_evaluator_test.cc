@@ -1,11 +1,11 @@
 #include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
 
 #include <array>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdint>
 #include <memory>
-#include <chrono>
-#include <condition_variable>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -138,9 +138,8 @@ class ThreadRecordingCost : public ceres::SizedCostFunction<1, 3> {
       if (record_->threads.insert(std::this_thread::get_id()).second) {
         record_->arrived.notify_all();
       }
-      record_->arrived.wait_until(lock, record_->deadline, [this] {
-        return record_->threads.size() >= record_->wait_for;
-      });
+      record_->arrived.wait_until(lock, record_->deadline,
+                                  [this] { return record_->threads.size() >= record_->wait_for; });
     }
     return cost_->Evaluate(parameters, residuals, jacobians);
   }
