@@ -234,11 +234,12 @@ ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_f
   return wrapper;
 }
 
-void ParallelResidualEvaluator::Reserve(int residuals) {
-  wrappers_.reserve(wrappers_.size() + residuals);
-  block_offsets_.reserve(block_offsets_.size() + residuals);
-  // At most one wrapper per residual: its point, the residual, its Jacobian row.
-  storage_.reserve(storage_.size() + static_cast<size_t>(residuals) * (2 * size_ + 1));
+void ParallelResidualEvaluator::Reserve(int wrappers, int residuals) {
+  wrappers_.reserve(wrappers_.size() + wrappers);
+  block_offsets_.reserve(block_offsets_.size() + wrappers);
+  // Per wrapper its point; per residual its value and Jacobian row.
+  storage_.reserve(storage_.size() + static_cast<size_t>(wrappers) * size_ +
+                   static_cast<size_t>(residuals) * (1 + size_));
 }
 
 bool ParallelResidualEvaluator::AtLastPoint() const {

@@ -72,11 +72,11 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
                             const std::vector<double*>& parameter_blocks);
   // The same for a cost function of the first watched block alone.
   ceres::CostFunction* Wrap(ceres::CostFunction* cost_function);
-  // Makes room for `residuals` more residuals over the whole point (the
-  // dwells, one each, in wrappers of one or of a batch of them), so that
-  // wrapping them copies no stored values. Only capacity: wrappers of any
-  // shape may follow.
-  void Reserve(int residuals);
+  // Makes room for `wrappers` more wrappers of one parameter block each,
+  // holding `residuals` residuals over the whole point between them (the
+  // dwells, in batches), so that wrapping them copies no stored values. Only
+  // capacity: wrappers of any shape may follow.
+  void Reserve(int wrappers, int residuals);
 
   void PrepareForEvaluation(bool evaluate_jacobians, bool new_evaluation_point) override;
 

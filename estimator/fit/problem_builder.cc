@@ -98,6 +98,12 @@ int ProblemBuilder::AddSweep(const Sweep& sweep, const ParameterLayout& layout,
   return static_cast<int>(sweep.points.size());
 }
 
+int ProblemBuilder::ResidualBlocks(const Sweep& sweep) const {
+  const size_t dwells = sweep.points.size();
+  return static_cast<int>(options_.batch_dwells ? (dwells + kDwellsPerBatch - 1) / kDwellsPerBatch
+                                                : dwells);
+}
+
 int ProblemBuilder::AddSweep(const Sweep& sweep, double* parameters, ceres::Problem* problem,
                              ParallelResidualEvaluator* evaluator) const {
   return AddSweep(sweep, SingleBlockLayout(parameters), problem, evaluator);

@@ -85,6 +85,10 @@ class ProblemBuilder {
   int AddPenalties(const Sweep& sweep, double* parameters, ceres::Problem* problem,
                    ParallelResidualEvaluator* evaluator = nullptr) const;
 
+  // The residual blocks AddSweep adds for `sweep`: one per dwell, or with
+  // `batch_dwells` one per kDwellsPerBatch dwells begun.
+  int ResidualBlocks(const Sweep& sweep) const;
+
   // The cost function of one dwell on one 6-double block (owned by the
   // caller; Ceres takes it).
   ceres::CostFunction* MakeResidual(const DwellPoint& point) const;

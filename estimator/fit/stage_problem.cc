@@ -63,11 +63,15 @@ StageProblem::StageProblem(const FitDescription& fit, const StageSetup& setup)
   CHECK_EQ(setup.scale.size(), fixed_.size());
   for (const FitBlock& block : fit.blocks) problem_.AddParameterBlock(block.values, block.size);
   if (setup.threaded_evaluation) {
-    size_t points = 0;
+    int blocks = 0;
+    int points = 0;
     for (const FitDataset& dataset : fit.datasets) {
-      for (const Sweep* sweep : dataset.sweeps) points += sweep->points.size();
+      for (const Sweep* sweep : dataset.sweeps) {
+        blocks += builder_.ResidualBlocks(*sweep);
+        points += static_cast<int>(sweep->points.size());
+      }
     }
-    evaluator_.Reserve(static_cast<int>(points));
+    evaluator_.Reserve(blocks, points);
   }
   try {
     for (const FitDataset& dataset : fit.datasets) {

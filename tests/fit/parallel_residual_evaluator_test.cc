@@ -479,7 +479,7 @@ TEST(ParallelResidualEvaluator, WrappersOfMixedShapesReplayTheirOwnValues) {
   double a[1] = {kStart[0]};
   double bc[2] = {kStart[1], kStart[2]};
   ParallelResidualEvaluator evaluator({{a, 1}, {bc, 2}}, 3);
-  evaluator.Reserve(100);  // fewer than wrapped, and of another shape
+  evaluator.Reserve(100, 100);  // fewer than wrapped, and of another shape
   std::vector<std::unique_ptr<ceres::CostFunction>> wrappers;
   std::vector<std::unique_ptr<ceres::CostFunction>> references;
   auto wrap = [&](int i) {
