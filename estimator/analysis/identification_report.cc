@@ -32,6 +32,10 @@ IdentificationReport MakeIdentificationReport(const std::string& config_path,
 
 namespace {
 
+// About the length of one predictions.csv row (four round-trip numbers and
+// the labels), to reserve the text at once.
+constexpr size_t kPredictionRowBytes = 96;
+
 const char* Role(const SweepPrediction& prediction) {
   return prediction.fitted ? "fitted" : "validation";
 }
@@ -229,23 +233,34 @@ std::string ReportToYaml(const IdentificationReport& report) {
 }
 
 std::string ReportToPredictionsCsv(const IdentificationReport& report) {
-  std::ostringstream csv;
-  csv << "sweep,direction,role,freq_hz,a_base,a,a_model,branch,model_status\n";
+  // Appended to one reserved string (no stream, no temporary per number):
+  // the beam's validation sweeps are tens of thousands of rows.
+  size_t rows = 0;
+  for (const SweepPrediction& prediction : report.predictions) {
+    rows += prediction.sweep->points.size();
+  }
+  std::string csv = "sweep,direction,role,freq_hz,a_base,a,a_model,branch,model_status\n";
+  csv.reserve(csv.size() + rows * kPredictionRowBytes);
   for (const SweepPrediction& prediction : report.predictions) {
     const Sweep& sweep = *prediction.sweep;
+    const std::string prefix =
+        sweep.id + ',' + SweepDirectionName(sweep.direction) + ',' + Role(prediction) + ',';
     for (size_t i = 0; i < sweep.points.size(); ++i) {
       const DwellPoint& point = sweep.points[i];
       const StableRoot& model = prediction.model[i];
       const char* status = model.status == RootStatus::kOnBranch    ? "on_branch"
                            : model.status == RootStatus::kBranchEnd ? "branch_end"
                                                                     : "failed";
-      csv << sweep.id << ',' << SweepDirectionName(sweep.direction) << ',' << Role(prediction)
-          << ',' << FormatRoundTrip(RadPerSecondToHz(point.drive_frequency_rad_s)) << ','
-          << FormatRoundTrip(point.a_base) << ',' << FormatRoundTrip(point.amplitude) << ','
-          << FormatRoundTrip(model.a) << ',' << BranchName(point.branch) << ',' << status << '\n';
+      csv += prefix;
+      for (double value : {RadPerSecondToHz(point.drive_frequency_rad_s), point.a_base,
+                           point.amplitude, model.a}) {
+        AppendRoundTrip(value, &csv);
+        csv += ',';
+      }
+      csv.append(BranchName(point.branch)).append(1, ',').append(status).append(1, '\n');
     }
   }
-  return csv.str();
+  return csv;
 }
 
 namespace {
