@@ -6,9 +6,10 @@
 
 #include "dwellfit/config/dwell_plan_reader.h"
 #include "dwellfit/config/identify_config.h"
-#include "dwellfit/estimator/studies/chapter_tables.h"
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/output_files.h"
+#include "dwellfit/estimator/studies/chapter_tables.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -21,6 +22,7 @@ DEFINE_string(measured, "datasets/clamped-beam-27C/beam.yaml",
 DEFINE_string(output, "docs/chapter-tables.md", "Markdown file to write");
 
 int main(int argc, char** argv) {
+  dwellfit::KeepFreedMemoryForReuse();
   FLAGS_logtostderr = true;
   google::InitGoogleLogging(argv[0]);
   gflags::SetUsageMessage(

@@ -9,6 +9,7 @@
 
 #include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/studies/convergence_family.h"
 #include "gflags/gflags.h"
@@ -19,6 +20,7 @@ DEFINE_string(base, "datasets/thesis-numerical/beam.yaml",
 DEFINE_string(output, "docs/convergence-family.md", "Markdown file to write");
 
 int main(int argc, char** argv) {
+  dwellfit::KeepFreedMemoryForReuse();
   FLAGS_logtostderr = true;
   google::InitGoogleLogging(argv[0]);
   gflags::SetUsageMessage(

@@ -15,6 +15,7 @@
 #include "dwellfit/config/dwell_plan_reader.h"
 #include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/studies/coverage_study.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
@@ -33,6 +34,7 @@ DEFINE_string(set, "",
               "'initial_guess=auto,fixed=[]'");
 
 int main(int argc, char** argv) {
+  dwellfit::KeepFreedMemoryForReuse();
   google::InitGoogleLogging(argv[0]);
   gflags::SetUsageMessage(
       "Coverage of the 95 % parameter intervals over noisy simulated replicas.\n"

@@ -18,6 +18,7 @@
 #include "dwellfit/config/dwell_plan_reader.h"
 #include "dwellfit/config/result_parameters.h"
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/curves/sweep_curves.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
@@ -107,6 +108,7 @@ std::vector<dwellfit::CurveSpec> Specs(const dwellfit::DwellPlan* plan) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  dwellfit::KeepFreedMemoryForReuse();
   google::InitGoogleLogging(argv[0]);
   gflags::SetUsageMessage(
       "The model's response curves as CSV.\nUsage: curves (--result result.yaml | --plan "

@@ -7,6 +7,7 @@
 
 #include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/identify_run.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
@@ -71,6 +72,7 @@ std::vector<dwellfit::ConfigOverride> OverridesFromFlags() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  dwellfit::KeepFreedMemoryForReuse();
   FLAGS_logtostderr = true;
   google::InitGoogleLogging(argv[0]);
   gflags::SetUsageMessage(

@@ -7,6 +7,7 @@
 #include "dwellfit/config/dwell_plan_reader.h"
 #include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/studies/method_comparison.h"
 #include "gflags/gflags.h"
@@ -24,6 +25,7 @@ DEFINE_double(phase_bias_deg, 2.0, "Phase error shown with the phase-lag fit [de
 DEFINE_bool(wall_time, false, "Add wall-clock times (not reproducible) to the tables");
 
 int main(int argc, char** argv) {
+  dwellfit::KeepFreedMemoryForReuse();
   FLAGS_logtostderr = true;
   google::InitGoogleLogging(argv[0]);
   gflags::SetUsageMessage(

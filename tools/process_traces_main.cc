@@ -19,6 +19,7 @@
 
 #include "dwellfit/config/rig_config_reader.h"
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/data/sweep_csv_writer.h"
 #include "dwellfit/estimator/traces/harmonic_balance.h"
 #include "dwellfit/estimator/traces/trace_processing.h"
@@ -56,6 +57,7 @@ void Commit(const std::string& staged, const std::string& path) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  dwellfit::KeepFreedMemoryForReuse();
   google::InitGoogleLogging(argv[0]);
   gflags::SetUsageMessage(
       "Dwell points (and optionally harmonic-balance estimates) from sine-dwell time traces.\n"

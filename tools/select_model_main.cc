@@ -12,6 +12,7 @@
 
 #include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/studies/model_selection.h"
 #include "gflags/gflags.h"
@@ -26,6 +27,7 @@ DEFINE_string(output_dir, "",
               "Directory for the two files (default: the config's output_dir/model_selection)");
 
 int main(int argc, char** argv) {
+  dwellfit::KeepFreedMemoryForReuse();
   FLAGS_logtostderr = true;
   google::InitGoogleLogging(argv[0]);
   gflags::SetUsageMessage(

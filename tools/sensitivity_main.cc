@@ -16,6 +16,7 @@
 #include "dwellfit/config/config_override.h"
 #include "dwellfit/config/dwell_plan_reader.h"
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/studies/sensitivity_study.h"
 #include "gflags/gflags.h"
@@ -79,6 +80,7 @@ dwellfit::SensitivityStudy Run() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  dwellfit::KeepFreedMemoryForReuse();
   google::InitGoogleLogging(argv[0]);
   gflags::SetUsageMessage(
       "Many fits of one config varying noise, replicas, starts, penalties, fixed values, fixed "

@@ -8,9 +8,10 @@
 #include <iostream>
 
 #include "dwellfit/config/dwell_plan_reader.h"
-#include "dwellfit/estimator/simulation/dwell_simulator.h"
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/data/sweep_csv_writer.h"
+#include "dwellfit/estimator/simulation/dwell_simulator.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -18,6 +19,7 @@ DEFINE_string(plan, "", "YAML dwell plan: truth parameters, sweeps, noise (requi
 DEFINE_string(out, "", "CSV file to write (sweep,direction,freq_hz,a_base,a) (required).");
 
 int main(int argc, char** argv) {
+  dwellfit::KeepFreedMemoryForReuse();
   google::InitGoogleLogging(argv[0]);
   gflags::SetUsageMessage(
       "Simulates sine-dwell sweeps on the model from a plan.\n"

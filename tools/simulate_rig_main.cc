@@ -18,6 +18,7 @@
 #include "dwellfit/config/dwell_plan_reader.h"
 #include "dwellfit/config/rig_config_reader.h"
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/rig/rig_simulator.h"
 #include "gflags/gflags.h"
@@ -39,6 +40,7 @@ void DrawProgress(int done, int total) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  dwellfit::KeepFreedMemoryForReuse();
   google::InitGoogleLogging(argv[0]);
   gflags::SetUsageMessage(
       "Simulates a sine-dwell test on the virtual rig and writes time traces.\n"
