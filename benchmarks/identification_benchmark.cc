@@ -7,22 +7,32 @@
 // residual blocks evaluated on 1 and on 2 threads (the argument); their
 // results do not depend on it.
 #include <atomic>
+#include <cstdlib>
+#include <filesystem>
 #include <memory>
+#include <ostream>
+#include <streambuf>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "benchmark/benchmark.h"
 #include "dwellfit/config/identify_config.h"
+#include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/fit/identification.h"
 #include "dwellfit/estimator/fit/mapped_cost_function.h"
 #include "dwellfit/estimator/fit/problem_builder.h"
 #include "dwellfit/estimator/fit/staged_solve.h"
+#include "dwellfit/estimator/run/identify_run.h"
 #include "dwellfit/estimator/run/resolved_run.h"
 #include "dwellfit/estimator/simulation/dwell_simulator.h"
 
 namespace dwellfit {
 namespace {
+
+// The allocator policy every dwellfit tool sets first (memory_policy.h), so
+// that the fits here run as they do in `identify`.
+const bool kToolAllocatorPolicy = KeepFreedMemoryForReuse();
 
 // A committed dataset config, resolved once (data labelled and selected,
 // start found) as `identify` resolves it.
@@ -157,6 +167,45 @@ BENCHMARK(BM_ClampedBeamFitBusy)
     ->ArgNames({"threads", "busy"})
     ->Args({1, 1})
     ->Args({0, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(5)
+    ->UseRealTime();
+
+// The whole `identify` run on the committed clamped-beam config, in process
+// (RunIdentify: reading the CSV, the fit above, the covariance, the report,
+// predictions.csv, curves.csv and figures.gp written into a temporary
+// directory; no figures rendered, the printed report discarded), with
+// solver.num_threads = state.range(0). Against BM_ClampedBeamFit at the same
+// setting: what the run costs beyond its fit (process start-up aside).
+void BM_ClampedBeamIdentifyRun(benchmark::State& state) {
+  char directory_template[] = "/tmp/dwellfit-benchmark-XXXXXX";
+  const char* directory = mkdtemp(directory_template);
+  if (directory == nullptr) {
+    state.SkipWithError("cannot create a temporary output directory");
+    return;
+  }
+  const IdentifyConfig config =
+      LoadIdentifyConfig(std::string(DWELLFIT_SOURCE_DIR) + "/datasets/clamped-beam-27C/beam.yaml",
+                         {{"output_dir", directory, "benchmark"},
+                          {"solver.num_threads", std::to_string(state.range(0)), "benchmark"}});
+  struct NullBuffer : std::streambuf {
+    int overflow(int c) override { return c; }
+  } null_buffer;
+  std::ostream discard(&null_buffer);
+  IdentifyRunOptions options;
+  options.render_figures = false;
+  for (auto _ : state) {
+    const auto outcome = RunIdentify(config, discard, options);
+    state.counters["iterations"] = outcome->report.result.iterations;
+    state.counters["final_cost"] = outcome->report.result.final_cost;
+  }
+  std::error_code ignored;
+  std::filesystem::remove_all(directory, ignored);
+}
+BENCHMARK(BM_ClampedBeamIdentifyRun)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(0)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(5)
     ->UseRealTime();

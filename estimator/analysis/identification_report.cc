@@ -21,12 +21,7 @@ IdentificationReport MakeIdentificationReport(const std::string& config_path,
   report.result = result;
   report.omega_ref_rad_s =
       omega_ref_rad_s > 0.0 ? omega_ref_rad_s : result.parameters[kNaturalFrequency];
-  for (const Sweep* sweep : fitted) {
-    report.predictions.push_back(PredictSweep(result.parameters, *sweep, /*fitted=*/true));
-  }
-  for (const Sweep* sweep : validation) {
-    report.predictions.push_back(PredictSweep(result.parameters, *sweep, /*fitted=*/false));
-  }
+  report.predictions = PredictSweeps(result.parameters, fitted, validation);
   return report;
 }
 

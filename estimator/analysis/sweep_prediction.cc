@@ -13,8 +13,7 @@ PredictedJump PredictJump(const ParameterVector& p, const Sweep& sweep, JumpKind
                           double guess_control) {
   PredictedJump predicted;
   predicted.kind = kind;
-  const JumpKind fold_kind =
-      kind == JumpKind::kJumpUp ? JumpKind::kJumpUp : JumpKind::kJumpDown;
+  const JumpKind fold_kind = kind == JumpKind::kJumpUp ? JumpKind::kJumpUp : JumpKind::kJumpDown;
   const DwellPoint& first = sweep.points.front();
   FoldPoint fold;
   if (sweep.kind == SweepKind::kFrequency) {
@@ -73,6 +72,19 @@ SweepPrediction PredictSweep(const ParameterVector& parameters, const Sweep& swe
     prediction.relative_rms_error = std::sqrt(sum_squared_relative / n);
   }
   return prediction;
+}
+
+std::vector<SweepPrediction> PredictSweeps(const ParameterVector& parameters,
+                                           const std::vector<const Sweep*>& fitted,
+                                           const std::vector<const Sweep*>& validation) {
+  std::vector<SweepPrediction> predictions;
+  for (const Sweep* sweep : fitted) {
+    predictions.push_back(PredictSweep(parameters, *sweep, /*fitted=*/true));
+  }
+  for (const Sweep* sweep : validation) {
+    predictions.push_back(PredictSweep(parameters, *sweep, /*fitted=*/false));
+  }
+  return predictions;
 }
 
 }  // namespace dwellfit

@@ -7,9 +7,12 @@
 #include "dwellfit/estimator/analysis/parameter_uncertainty.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/data/jump_detection.h"
+#include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/run/run_figures.h"
 #include "glog/logging.h"
+#include "tbb/task_arena.h"
+#include "tbb/task_group.h"
 #include "yaml-cpp/yaml.h"
 
 namespace dwellfit {
@@ -47,13 +50,14 @@ void CheckUsable(const IdentifyConfig& config, const MultiStartResult& multi_sta
 // did not converge keeps that status: its covariance says little.)
 void MarkUnidentifiable(IdentificationReport* report) {
   IdentificationResult& result = report->result;
-  const bool any_free = std::count(report->options.fixed.begin(), report->options.fixed.end(),
-                                   false) > 0;
+  const bool any_free =
+      std::count(report->options.fixed.begin(), report->options.fixed.end(), false) > 0;
   if (!any_free || report->uncertainty.available || result.status != FitStatus::kConverged) return;
   result.status = FitStatus::kUnidentifiable;
   result.converged = false;
-  result.message = "the data cannot tell the free parameters apart: " +
-                   report->uncertainty.message + "; " + result.message;
+  result.message =
+      "the data cannot tell the free parameters apart: " + report->uncertainty.message + "; " +
+      result.message;
 }
 
 // The configuration in effect as YAML, without the keys that cannot change
@@ -67,6 +71,34 @@ std::string ConfigAffectingTheResult(const IdentifyConfig& config) {
   YAML::Emitter out;
   out << node;
   return out.c_str();
+}
+
+// What the run computes from the estimate once the fit has ended, side by
+// side on the run's threads (solver.num_threads), each part in its own
+// variable so that none depends on which thread runs it or when: the
+// covariance into report->uncertainty, the predictions of every sweep into
+// report->predictions and `predictions_csv`, and the response curves into
+// `curves`. `report` comes without predictions and uncertainty.
+void ComputeAfterFit(const ResolvedRun& run, const IdentificationResult& result,
+                     IdentificationReport* report, std::string* predictions_csv,
+                     RunCurves* curves) {
+  std::vector<const Sweep*> sweeps = run.fitted;
+  sweeps.insert(sweeps.end(), run.validation.begin(), run.validation.end());
+  ParameterUncertainty uncertainty;
+  // Three parts: more threads would idle.
+  tbb::task_arena arena(std::min(ResolveThreadCount(run.options.solver.num_threads), 3));
+  arena.execute([&] {
+    tbb::task_group group;
+    group.run([&] {
+      uncertainty = EstimateUncertainty(run.fitted, report->options, result.parameters,
+                                        report->omega_ref_rad_s, &result);
+    });
+    group.run([&] { *curves = TraceRunCurves(result.parameters, sweeps); });
+    report->predictions = PredictSweeps(result.parameters, run.fitted, run.validation);
+    *predictions_csv = ReportToPredictionsCsv(*report);
+    group.wait();
+  });
+  report->uncertainty = std::move(uncertainty);
 }
 
 }  // namespace
@@ -114,21 +146,20 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
   // The report states the start the best fit came from.
   IdentificationOptions options = run.options;
   options.initial = multi_start.starts[multi_start.best_start];
-  outcome->report =
-      MakeIdentificationReport(config.config_path, options, result,
-                               config.omega_ref_rad_s.value_or(0.0), run.fitted, run.validation);
+  outcome->report = MakeIdentificationReport(config.config_path, options, result,
+                                             config.omega_ref_rad_s.value_or(0.0), {}, {});
   outcome->report.initial_guess_steps = run.initial_guess_steps;
   outcome->report.multi_start = multi_start;
-  outcome->report.uncertainty =
-      EstimateUncertainty(run.fitted, options, result.parameters, outcome->report.omega_ref_rad_s,
-                          &result);
+  std::string predictions_csv;
+  RunCurves curves;
+  ComputeAfterFit(run, result, &outcome->report, &predictions_csv, &curves);
   outcome->report.config_in_effect = ConfigAffectingTheResult(config);
   MarkUnidentifiable(&outcome->report);
   const IdentificationReport& report = outcome->report;
   PrintReport(report, out);
   std::vector<NamedFile> files = {{"result.yaml", ReportToYaml(report)},
-                                  {"predictions.csv", ReportToPredictionsCsv(report)}};
-  AppendCurvesAndFigures(report, &files, out, run_options.render_figures);
+                                  {"predictions.csv", std::move(predictions_csv)}};
+  AppendCurvesAndFigures(report, curves, &files, out, run_options.render_figures);
   WriteFilesAtomically(config.output_dir, files);
   out << "\nwrote into " << config.output_dir << ":";
   for (const NamedFile& file : files) out << " " << file.first;

@@ -58,25 +58,34 @@ std::vector<std::string> EstimateLines(const IdentificationReport& report) {
   return lines;
 }
 
-void AppendCurvesAndFigures(const IdentificationReport& report, std::vector<NamedFile>* files,
-                            std::ostream& out, bool render) {
-  std::vector<const Sweep*> sweeps;
-  for (const SweepPrediction& prediction : report.predictions) sweeps.push_back(prediction.sweep);
-  std::vector<ResponseCurve> curves;
+RunCurves TraceRunCurves(const ParameterVector& parameters,
+                         const std::vector<const Sweep*>& sweeps) {
+  RunCurves traced;
   try {
-    curves = TraceCurves(report.result.parameters, CurveSpecsForSweeps(sweeps));
+    traced.curves = TraceCurves(parameters, CurveSpecsForSweeps(sweeps));
   } catch (const InputError& error) {
-    // Parameters where the model has no curve (a fit that stopped with no
-    // damping, say): the run's status says what happened; the files it can
-    // write are still written.
-    out << "warning: no curves or figures: " << error.what() << "\n";
+    // The run's status says what happened; the files it can write are
+    // still written.
+    traced.curves.clear();
+    traced.warning = std::string("no curves or figures: ") + error.what();
+    return traced;
+  }
+  traced.csv = CurvesToCsv(traced.curves);
+  return traced;
+}
+
+void AppendCurvesAndFigures(const IdentificationReport& report, const RunCurves& traced,
+                            std::vector<NamedFile>* files, std::ostream& out, bool render) {
+  if (!traced.warning.empty()) {
+    out << "warning: " << traced.warning << "\n";
     return;
   }
+  const std::vector<ResponseCurve>& curves = traced.curves;
   FigureSet figures;
   figures.corner_lines = EstimateLines(report);
   for (const ResponseCurve& curve : curves)
     figures.sweeps.push_back(MakeFigureSweep(report, curve));
-  files->emplace_back("curves.csv", CurvesToCsv(curves));
+  files->emplace_back("curves.csv", traced.csv);
   files->emplace_back(kFigureScriptName, GnuplotFigureScript(figures));
   if (!render) return;
   std::vector<NamedFile> inputs;

@@ -5,19 +5,34 @@
 #define DWELLFIT_ESTIMATOR_RUN_RUN_FIGURES_H_
 
 #include <ostream>
+#include <string>
 #include <vector>
 
 #include "dwellfit/estimator/analysis/identification_report.h"
 #include "dwellfit/estimator/curves/figures.h"
+#include "dwellfit/estimator/curves/response_curve.h"
 
 namespace dwellfit {
 
+// The model's response curve of every sweep of `sweeps` (one per sweep id,
+// in order) at `parameters`, and their curves.csv text. Where the model has
+// no curve (a fit that stopped with no damping, say), `warning` says why and
+// there are neither curves nor text.
+struct RunCurves {
+  std::vector<ResponseCurve> curves;
+  std::string csv;
+  std::string warning;
+};
+RunCurves TraceRunCurves(const ParameterVector& parameters,
+                         const std::vector<const Sweep*>& sweeps);
+
 // Appends curves.csv and figures.gp to `files` (which must hold
 // predictions.csv, read by the script), and with `render` the images gnuplot
-// draws from them; a missing or failing gnuplot is a warning on `out` and in
-// the log, never an error.
-void AppendCurvesAndFigures(const IdentificationReport& report, std::vector<NamedFile>* files,
-                            std::ostream& out, bool render = true);
+// draws from them; `curves` are TraceRunCurves of the report's estimate and
+// sweeps. No curves, or a missing or failing gnuplot, is a warning on `out`
+// (and in the log), never an error.
+void AppendCurvesAndFigures(const IdentificationReport& report, const RunCurves& curves,
+                            std::vector<NamedFile>* files, std::ostream& out, bool render = true);
 
 // The estimates as the figures' corner shows them: "eta_e = 100 ± 0.02",
 // omega in Hz, "(fixed)" for fixed parameters.
