@@ -92,24 +92,25 @@ double ParseNumber(const Location& where, const char* column, const char* text) 
   if (begin == end) {
     throw InputError(where.file, where.line, column, "value is empty; expected a number");
   }
-  const std::string shown = "value '" + EscapeForMessage(text) + "'";
+  // Only an error message shows the value (built then, not for every number).
+  auto shown = [text] { return "value '" + EscapeForMessage(text) + "'"; };
   if (*begin == '+' && end - begin > 1 && begin[1] != '-') ++begin;  // from_chars rejects '+'
   double value = 0.0;
   const auto [stop, error] = std::from_chars(begin, end, value);
   if (error == std::errc::result_out_of_range) {
-    throw InputError(where.file, where.line, column, shown + " is out of the range of a double");
+    throw InputError(where.file, where.line, column, shown() + " is out of the range of a double");
   }
   if (error != std::errc() || stop != end) {
     const bool comma = std::strchr(text, ',') != nullptr;
     throw InputError(where.file, where.line, column,
-                     shown + " is not a number" +
+                     shown() + " is not a number" +
                          (comma ? "; write numbers with a decimal point, not a comma (40.5, "
                                   "not 40,5)"
                                 : ""));
   }
   if (!std::isfinite(value)) {
     throw InputError(where.file, where.line, column,
-                     shown +
+                     shown() +
                          " is not finite (NaN or infinity); give a measured number or drop "
                          "the row");
   }
