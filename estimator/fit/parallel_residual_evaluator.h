@@ -79,6 +79,9 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   void Reserve(int wrappers, int residuals);
 
   void PrepareForEvaluation(bool evaluate_jacobians, bool new_evaluation_point) override;
+  // The next evaluation evaluates every wrapper anew, even at the point the
+  // wrappers hold values for.
+  void Invalidate() { computed_ = false; }
 
   // The gradient of (1/2) sum |r|^2 over every wrapped block at `point` (a
   // point as above), in the blocks' own coordinates (no manifold, no

@@ -32,7 +32,8 @@ bool ProblemBuilderOptions::IsValid(std::string* error) const {
 
 ProblemBuilder::ProblemBuilder(const ProblemBuilderOptions& options) : options_(options) {}
 
-ceres::CostFunction* ProblemBuilder::MakeResidual(const DwellPoint& point) const {
+ceres::CostFunction* ProblemBuilder::MakeResidual(
+    const DwellPoint& point, std::vector<VerticalErrorResidual*>* warm_started) const {
   if (options_.residual == ResidualKind::kAlgebraic) {
     return AlgebraicResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
                                      options_.dwell_weight);
@@ -55,9 +56,12 @@ ceres::CostFunction* ProblemBuilder::MakeResidual(const DwellPoint& point) const
                                     options_.residual_options.error, weight,
                                     options_.residual_options.amplitude_floor);
   }
-  return VerticalErrorResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
-                                       point.branch, options_.residual_options.error, weight,
-                                       options_.residual_options.amplitude_floor);
+  VerticalErrorResidual* functor = nullptr;
+  ceres::CostFunction* cost = VerticalErrorResidual::Create(
+      point.drive_frequency_rad_s, point.a_base, point.amplitude, point.branch,
+      options_.residual_options.error, weight, options_.residual_options.amplitude_floor, &functor);
+  if (warm_started != nullptr) warm_started->push_back(functor);
+  return cost;
 }
 
 void ProblemBuilder::Add(ceres::CostFunction* cost, const ParameterLayout& layout,
@@ -69,7 +73,8 @@ void ProblemBuilder::Add(ceres::CostFunction* cost, const ParameterLayout& layou
 }
 
 int ProblemBuilder::AddSweep(const Sweep& sweep, const ParameterLayout& layout,
-                             ceres::Problem* problem, ParallelResidualEvaluator* evaluator) const {
+                             ceres::Problem* problem, ParallelResidualEvaluator* evaluator,
+                             std::vector<VerticalErrorResidual*>* warm_started) const {
   if (options_.residual == ResidualKind::kPhaseLag) {
     for (const DwellPoint& point : sweep.points) {
       if (point.phase_rad && std::isfinite(*point.phase_rad)) continue;
@@ -83,14 +88,14 @@ int ProblemBuilder::AddSweep(const Sweep& sweep, const ParameterLayout& layout,
   }
   if (!options_.batch_dwells) {
     for (const DwellPoint& point : sweep.points) {
-      Add(MakeResidual(point), layout, problem, evaluator);
+      Add(MakeResidual(point, warm_started), layout, problem, evaluator);
     }
   } else {
     const size_t count = sweep.points.size();
     for (size_t first = 0; first < count; first += kDwellsPerBatch) {
       std::vector<ceres::CostFunction*> batch;
       for (size_t i = first; i < std::min(count, first + kDwellsPerBatch); ++i) {
-        batch.push_back(MakeResidual(sweep.points[i]));
+        batch.push_back(MakeResidual(sweep.points[i], warm_started));
       }
       Add(new BatchedCostFunction(std::move(batch)), layout, problem, evaluator);
     }

@@ -21,12 +21,14 @@
 #define DWELLFIT_ESTIMATOR_FIT_PROBLEM_BUILDER_H_
 
 #include <string>
+#include <vector>
 
 #include "ceres/problem.h"
 #include "dwellfit/estimator/data/sweep.h"
 #include "dwellfit/estimator/fit/fit_description.h"
 #include "dwellfit/estimator/fit/identification_options.h"
 #include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
+#include "dwellfit/residuals/functors/vertical_error_residual.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 
 namespace dwellfit {
@@ -66,10 +68,13 @@ class ProblemBuilder {
   // one residual block per dwell, in order, or with `batch_dwells` up to
   // kDwellsPerBatch consecutive dwells per residual block. With an
   // `evaluator` (the problem's evaluation callback, watching the layout's
-  // blocks) the blocks are evaluated through it, on its threads. Returns the
-  // number of dwells added.
+  // blocks) the blocks are evaluated through it, on its threads. With
+  // `warm_started`, the vertical error's functors (whose root solves start
+  // where the last ended) are appended to it. Returns the number of dwells
+  // added.
   int AddSweep(const Sweep& sweep, const ParameterLayout& layout, ceres::Problem* problem,
-               ParallelResidualEvaluator* evaluator = nullptr) const;
+               ParallelResidualEvaluator* evaluator = nullptr,
+               std::vector<VerticalErrorResidual*>* warm_started = nullptr) const;
   // The same on one 6-double block `parameters` (SingleBlockLayout).
   int AddSweep(const Sweep& sweep, double* parameters, ceres::Problem* problem,
                ParallelResidualEvaluator* evaluator = nullptr) const;
@@ -90,8 +95,10 @@ class ProblemBuilder {
   int ResidualBlocks(const Sweep& sweep) const;
 
   // The cost function of one dwell on one 6-double block (owned by the
-  // caller; Ceres takes it).
-  ceres::CostFunction* MakeResidual(const DwellPoint& point) const;
+  // caller; Ceres takes it); a vertical error's functor is appended to
+  // `warm_started`, when given.
+  ceres::CostFunction* MakeResidual(
+      const DwellPoint& point, std::vector<VerticalErrorResidual*>* warm_started = nullptr) const;
 
   const ProblemBuilderOptions& options() const { return options_; }
 

@@ -52,6 +52,8 @@ ProblemBuilderOptions Batched(ProblemBuilderOptions options) {
 StageProblem::StageProblem(const FitDescription& fit, const StageSetup& setup)
     : fit_(fit),
       setup_(setup),
+      held_(setup.held),
+      held_constant_(fit.blocks.size(), false),
       builder_(Batched(setup.residuals)),
       eta_e_entries_(fit.EntriesHolding(kEtaE)),
       damping_entries_(fit.EntriesHolding(kMu1)),
@@ -62,22 +64,22 @@ StageProblem::StageProblem(const FitDescription& fit, const StageSetup& setup)
   for (size_t i = 0; i < mu2.size(); ++i) damping_entries_[i] = damping_entries_[i] || mu2[i];
   CHECK_EQ(setup.scale.size(), fixed_.size());
   for (const FitBlock& block : fit.blocks) problem_.AddParameterBlock(block.values, block.size);
-  if (setup.threaded_evaluation) {
-    int blocks = 0;
-    int points = 0;
-    for (const FitDataset& dataset : fit.datasets) {
-      for (const Sweep* sweep : dataset.sweeps) {
-        blocks += builder_.ResidualBlocks(*sweep);
-        points += static_cast<int>(sweep->points.size());
-      }
+  int blocks = 0;
+  int points = 0;
+  for (const FitDataset& dataset : fit.datasets) {
+    for (const Sweep* sweep : dataset.sweeps) {
+      blocks += builder_.ResidualBlocks(*sweep);
+      points += static_cast<int>(sweep->points.size());
     }
-    evaluator_.Reserve(blocks, points);
   }
+  if (setup.threaded_evaluation) evaluator_.Reserve(blocks, points);
+  if (setup.residuals.residual == ResidualKind::kVertical) warm_started_.reserve(points);
   try {
     for (const FitDataset& dataset : fit.datasets) {
       layouts_.push_back(LayoutOf(fit, dataset.parameters));
       for (const Sweep* sweep : dataset.sweeps) {
-        dwells_ += builder_.AddSweep(*sweep, layouts_.back(), &problem_, Evaluator());
+        dwells_ +=
+            builder_.AddSweep(*sweep, layouts_.back(), &problem_, Evaluator(), &warm_started_);
       }
     }
   } catch (...) {  // a sweep the residual cannot take: the earlier ones' blocks are owned
@@ -152,7 +154,17 @@ bool StageProblem::IsBounded(int entry) const {
 }
 
 bool StageProblem::IsHeld(int entry) const {
-  return fixed_[entry] || (!setup_.held.empty() && setup_.held[entry]);
+  return fixed_[entry] || (!held_.empty() && held_[entry]);
+}
+
+void StageProblem::EvaluateAfresh() {
+  for (VerticalErrorResidual* functor : warm_started_) functor->ForgetRoot();
+  evaluator_.Invalidate();
+}
+
+void StageProblem::Hold(const std::vector<bool>& held) {
+  CHECK(held.empty() || held.size() == fixed_.size());
+  held_ = held;
 }
 
 void StageProblem::Configure() {
@@ -168,10 +180,16 @@ void StageProblem::Configure() {
       scale[i] = setup_.scale[offset + i];
       any_free = any_free || !held[i];
     }
+    // Configured before (a solve again after Hold): a block held constant
+    // then may move now, and one with none free now drops its manifold.
     if (!any_free) {
+      if (problem_.HasManifold(block.values)) problem_.SetManifold(block.values, nullptr);
       problem_.SetParameterBlockConstant(block.values);
+      held_constant_[b] = true;
       continue;
     }
+    if (held_constant_[b]) problem_.SetParameterBlockVariable(block.values);
+    held_constant_[b] = false;
     problem_.SetManifold(block.values, new ScaledSubsetManifold(scale, held));
   }
 }

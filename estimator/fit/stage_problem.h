@@ -26,6 +26,7 @@
 #include "dwellfit/estimator/fit/fit_description.h"
 #include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
 #include "dwellfit/estimator/fit/problem_builder.h"
+#include "dwellfit/residuals/functors/vertical_error_residual.h"
 
 namespace dwellfit {
 
@@ -55,8 +56,21 @@ class StageProblem {
   void AddPenalties(const PenaltyOptions& penalties);
   // Calls FitDescription::add_residuals, when set.
   void AddCallerResiduals();
-  // Bounds, fixed and held entries, scaling. Call once, after the residuals.
+  // Bounds, fixed and held entries, scaling. Call after the residuals; again
+  // after Hold, to solve once more on the same residual blocks.
   void Configure();
+  // Per ambient entry: held at its value in addition to the fixed entries
+  // (empty: none), in place of StageSetup::held from the next Configure on.
+  void Hold(const std::vector<bool>& held);
+  // The next evaluation (DataCost, a solve's first) gives every value a
+  // problem just assembled would give at that point: each residual block is
+  // evaluated anew, the vertical error's root solves from the measured
+  // amplitudes (VerticalErrorResidual::ForgetRoot). Without it the values a
+  // problem already evaluated gives can differ in the last bits from a new
+  // one's, as its root solves start where the last ones ended. So one
+  // problem can rate several points, and then be solved, with the values of
+  // a problem assembled for each.
+  void EvaluateAfresh();
 
   // The cost of the dwells alone at the blocks' current values (infinity
   // where some dwell cannot be evaluated).
@@ -116,6 +130,9 @@ class StageProblem {
 
   const FitDescription& fit_;
   const StageSetup setup_;
+  std::vector<bool> held_;  // per ambient entry (empty: none); see Hold
+  // Per block: set constant by Configure (every entry fixed or held).
+  std::vector<bool> held_constant_;
   const ProblemBuilder builder_;
   std::vector<ParameterLayout> layouts_;  // per dataset
   std::vector<bool> eta_e_entries_;       // per ambient entry
@@ -131,6 +148,9 @@ class StageProblem {
   std::vector<ceres::ResidualBlockId> dwell_blocks_;
   std::vector<ceres::ResidualBlockId> caller_blocks_;
   std::vector<ceres::ResidualBlockId> penalty_blocks_;
+  // The dwells' vertical-error functors (owned by their cost functions),
+  // whose root solves start where their last ended.
+  std::vector<VerticalErrorResidual*> warm_started_;
   int dwells_ = 0;
 };
 

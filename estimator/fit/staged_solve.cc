@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -126,6 +127,10 @@ ceres::Solver::Summary SolveOnce(ResidualKind kind, const SolverSettings& settin
 // feasible side (the cost falls as they leave their bound: d cost / d p < 0
 // at p = 0). Returns whether any was released.
 bool ReleaseHeld(StageProblem* problem, std::vector<bool>* held, std::vector<bool>* released) {
+  bool releasable = false;  // without such an entry the gradient is not needed
+  for (size_t i = 0; i < held->size(); ++i)
+    releasable = releasable || ((*held)[i] && !(*released)[i]);
+  if (!releasable) return false;
   std::vector<double> gradient;
   if (!problem->CostGradient(&gradient)) return false;
   bool released_any = false;
@@ -218,15 +223,22 @@ StageSetup MakeSetup(const SolveContext& context, ResidualKind kind) {
 
 // One stage: the residual `kind` (with `penalties` on a vertical stage) from
 // the blocks' values, which it updates. False when a solve failed
-// (`*failure` says why).
+// (`*failure` says why). `rated`, when given, is a problem of the dwells
+// alone made with MakeSetup(context, kind) (the one ChooseStart rated the
+// start on): the stage solves on it instead of assembling its own.
 //
 // Active set: a bounded entry that rests on its bound is held there
 // (BoundRestWatcher) and the stage solves again without it; when that solve
 // ends, a held entry whose cost gradient points into the feasible side is
 // released, once, and the stage solves again. A solve that ends on a
-// convergence test with nothing to release ends the stage.
+// convergence test with nothing to release ends the stage. Every solve of a
+// stage runs on the same problem (the held entries reconfigured, StageProblem::
+// Hold): the same residual blocks each time, so the same values as a problem
+// assembled anew, and the values at the point where the last solve ended are
+// not evaluated again.
 bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptions& penalties,
-              StageSummary* stage, std::string* failure) {
+              StageSummary* stage, std::string* failure,
+              std::unique_ptr<StageProblem> rated = nullptr) {
   StageSetup setup = MakeSetup(context, kind);
   // The algebraic stage takes the enforced jumps' fold conditions
   // (ProblemBuilder::AddPenalties), unweighted by the data's cost; the
@@ -240,13 +252,19 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
   setup.held.assign(entries, false);
   std::vector<bool> released(entries, false);
   stage->residual = kind;
+  std::unique_ptr<StageProblem> assembled =
+      rated != nullptr ? std::move(rated) : std::make_unique<StageProblem>(context.fit, setup);
+  StageProblem& problem = *assembled;
   PenaltyOptions weighted = penalties;
+  if (with_penalties) weighted = WeighPenalties(penalties, &problem, stage);
+  if (with_penalties || fold_conditions) problem.AddPenalties(weighted);
+  problem.AddCallerResiduals();
+  stage->residual_blocks = problem.dwells();
   for (int round = 0;; ++round) {
-    StageProblem problem(context.fit, setup);
-    if (round == 0 && with_penalties) weighted = WeighPenalties(penalties, &problem, stage);
-    if (with_penalties || fold_conditions) problem.AddPenalties(weighted);
-    problem.AddCallerResiduals();
-    stage->residual_blocks = problem.dwells();
+    problem.Hold(setup.held);
+    // Each later solve starts from the values a problem assembled for it
+    // would give.
+    if (round > 0) problem.EvaluateAfresh();
     std::optional<int> resting;
     const std::vector<double> start = context.fit.Values();
     const ceres::Solver::Summary summary =
@@ -363,12 +381,14 @@ bool IsBranchLabelled(ResidualKind kind) {
   return kind == ResidualKind::kVertical || kind == ResidualKind::kAllRoots;
 }
 
-// Rates `values` (written into the blocks) as the start of a `kind` stage.
-StartRating RateStart(const SolveContext& context, ResidualKind kind,
+// Rates `values` (written into the blocks) as the start of a stage whose
+// problem of the dwells alone is `problem`, as a problem assembled for them
+// would (StageProblem::EvaluateAfresh).
+StartRating RateStart(const SolveContext& context, StageProblem* problem,
                       const std::vector<double>& values, const PenaltyOptions& penalties) {
   context.fit.SetValues(values);
-  StageProblem problem(context.fit, MakeSetup(context, kind));
-  return {problem.MissingFolds(penalties.bifurcation_range), problem.DataCost()};
+  problem->EvaluateAfresh();
+  return {problem->MissingFolds(penalties.bifurcation_range), problem->DataCost()};
 }
 
 // "the dwells' vertical cost is 8.77", after the missing folds, if any.
@@ -426,20 +446,28 @@ std::string StartNote(ResidualKind kind, bool after_start_stage, bool previous_c
 // fold stage (the algebraic residual with the enforced jumps' fold
 // conditions, FoldConditionResidual) runs from it first, once per solve,
 // and the better of its start and end is taken. Leaves the blocks at the
-// chosen start; false when the fold stage failed.
+// chosen start, and in `*rated` the problem the points were rated on, for
+// the stage to solve on (RunStage); false when the fold stage failed.
 bool ChooseStart(const SolveContext& context, ResidualKind kind,
                  const std::vector<double>* previous_start, bool after_start_stage,
                  bool* fold_stage_ran, const PenaltyOptions& penalties, FitSummary* summary,
-                 std::string* note, std::string* failure) {
+                 std::string* note, std::string* failure, std::unique_ptr<StageProblem>* rated) {
   std::vector<double> best = context.fit.Values();
-  StartRating rating = RateStart(context, kind, best, penalties);
-  if (previous_start != nullptr) {
-    const StartRating earlier = RateStart(context, kind, *previous_start, penalties);
-    const bool earlier_better = earlier.BetterThan(rating);
-    *note = StartNote(kind, after_start_stage, earlier_better, earlier, rating);
+  *rated = std::make_unique<StageProblem>(context.fit, MakeSetup(context, kind));
+  StageProblem* problem = rated->get();
+  // The previous start first: the stage usually starts where the previous
+  // one ended, and the problem then holds the values there that a problem
+  // assembled for the stage would compute first.
+  std::optional<StartRating> earlier;
+  if (previous_start != nullptr) earlier = RateStart(context, problem, *previous_start, penalties);
+  StartRating rating = RateStart(context, problem, best, penalties);
+  std::vector<double> last_rated = best;
+  if (earlier) {
+    const bool earlier_better = earlier->BetterThan(rating);
+    *note = StartNote(kind, after_start_stage, earlier_better, *earlier, rating);
     if (earlier_better) {
       best = *previous_start;
-      rating = earlier;
+      rating = *earlier;
     }
   }
   if (kind == ResidualKind::kVertical && !rating.missing_folds.empty() && !*fold_stage_ran) {
@@ -454,7 +482,8 @@ bool ChooseStart(const SolveContext& context, ResidualKind kind,
     }
     *fold_stage_ran = true;
     const std::vector<double> after = context.fit.Values();
-    const StartRating folded = RateStart(context, kind, after, penalties);
+    const StartRating folded = RateStart(context, problem, after, penalties);
+    last_rated = after;
     if (folded.BetterThan(rating)) {
       *note = note->empty() ? "started where the fold stage ended"
                             : *note +
@@ -464,6 +493,7 @@ bool ChooseStart(const SolveContext& context, ResidualKind kind,
     }
   }
   context.fit.SetValues(best);
+  if (best != last_rated) problem->EvaluateAfresh();
   return true;
 }
 
@@ -540,10 +570,11 @@ FitSummary SolveStaged(const FitDescription& fit, const StagedSolveOptions& opti
       after_start_stage = RunStartStage(context, kind, &summary);
     }
     const bool choose = kind == ResidualKind::kVertical || (s == 0 && after_start_stage);
+    std::unique_ptr<StageProblem> rated;
     if (choose &&
         !ChooseStart(context, kind, after_start_stage || s > 0 ? &previous_start : nullptr,
                      s == 0 && after_start_stage, &fold_stage_ran, options.penalties, &summary,
-                     &note, &error)) {
+                     &note, &error, &rated)) {
       summary.status = FitStatus::kFailure;
       summary.evaluation_failed = true;
       summary.message = error;
@@ -568,7 +599,8 @@ FitSummary SolveStaged(const FitDescription& fit, const StagedSolveOptions& opti
       summary.stages.emplace_back();
       summary.stages.back().note = note;
       note.clear();
-      if (!RunStage(context, kind, penalties, &summary.stages.back(), &error)) {
+      // The first run solves on the problem its start was rated on.
+      if (!RunStage(context, kind, penalties, &summary.stages.back(), &error, std::move(rated))) {
         summary.status = FitStatus::kFailure;
         summary.evaluation_failed = true;
         summary.message = error;

@@ -29,9 +29,10 @@
 // starts from this dwell's root at its last evaluation (from a_i at the
 // first), which is near the new root while a solver steps. The start only
 // saves iterations: whether the root found is on the dwell's branch is decided
-// by a certificate (stable_root.h), and the value agrees with a cold start to
-// the last bits. A kOnly dwell always starts from a_i, since it takes the
-// stable root nearest a_i where there are two.
+// by a certificate (stable_root.h), and the value agrees with a cold start's
+// to within the last bits, not always in them (ForgetRoot restarts cold). A
+// kOnly dwell always starts from a_i, since it takes the stable root nearest
+// a_i where there are two.
 #ifndef DWELLFIT_RESIDUALS_FUNCTORS_VERTICAL_ERROR_RESIDUAL_H_
 #define DWELLFIT_RESIDUALS_FUNCTORS_VERTICAL_ERROR_RESIDUAL_H_
 
@@ -96,12 +97,22 @@ class VerticalErrorResidual {
     return AmplitudeError(a_measured_, a_model, error_, weight_, amplitude_floor_, residual);
   }
 
+  // The next evaluation starts its Newton iteration from a_i, as the first
+  // does. The root found may differ from a warm start's in the last bits, so
+  // a caller that evaluates a functor again where a fresh one would evaluate
+  // (StageProblem::EvaluateAfresh) forgets the root first.
+  void ForgetRoot() { last_root_.store(0.0, std::memory_order_relaxed); }
+
+  // The cost function of a functor made with these arguments; `*functor`,
+  // when asked, is that functor (owned by the cost function).
   static ceres::CostFunction* Create(double drive_frequency_rad_s, double a_base, double a_measured,
                                      Branch branch, ErrorMeasure error, double weight,
-                                     double amplitude_floor = 0.0) {
-    return new ceres::AutoDiffCostFunction<VerticalErrorResidual, 1, kNumParameters>(
-        new VerticalErrorResidual(drive_frequency_rad_s, a_base, a_measured, branch, error, weight,
-                                  amplitude_floor));
+                                     double amplitude_floor = 0.0,
+                                     VerticalErrorResidual** functor = nullptr) {
+    auto* made = new VerticalErrorResidual(drive_frequency_rad_s, a_base, a_measured, branch, error,
+                                           weight, amplitude_floor);
+    if (functor != nullptr) *functor = made;
+    return new ceres::AutoDiffCostFunction<VerticalErrorResidual, 1, kNumParameters>(made);
   }
 
  private:

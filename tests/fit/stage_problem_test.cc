@@ -1,15 +1,18 @@
 // StageProblem, the one assembly of a ceres::Problem from a description:
 // bounds on the entries holding eta_e, mu1, mu2 (shared or not), fixed and
-// held entries, scaling per block, and the cost gradient with the caller's
-// residual blocks.
+// held entries, scaling per block, the cost gradient with the caller's
+// residual blocks, and one problem rating several points and solving again
+// with other entries held as problems assembled for each would.
 #include "dwellfit/estimator/fit/stage_problem.h"
 
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "ceres/normal_prior.h"
 #include "ceres/sized_cost_function.h"
+#include "ceres/solver.h"
 #include "gtest/gtest.h"
 #include "tests/fit_test_support.h"
 
@@ -128,6 +131,103 @@ TEST(StageProblem, CostGradientIncludesTheCallersResidualBlocks) {
     EXPECT_NEAR(gradient[kMu1], (0.2 - 0.3) / (sigma * sigma), 1e-6) << threaded;
     EXPECT_NEAR(gradient[kEtaE], 0.0, 1e-9) << threaded;
   }
+}
+
+// One problem rates several points as problems assembled for each would:
+// after EvaluateAfresh the dwells' cost and the missing folds at a point are
+// those of a new problem there, to the bit, whatever points the problem was
+// evaluated at before (the vertical error's root solves start anew).
+TEST(StageProblem, RatingAPointAfreshGivesANewProblemsValues) {
+  const std::vector<Sweep> sweeps = SimulateDataset(kThesisTruth, 0.01, 7);
+  ParameterVector p = ThesisStart(kThesisTruth);
+  const FitDescription fit = SingleBlockFit(Pointers(sweeps), {}, &p);
+  BifurcationRangeOptions range;
+  range.enabled = true;
+  // So damped that no fold exists, and near the truth.
+  ParameterVector damped = ThesisStart(kThesisTruth);
+  damped[kMu1] *= 20.0;
+  ParameterVector near = kThesisTruth;
+  for (int i = 0; i < kNumParameters - 1; ++i) near[i] *= 1.0 + 0.003 * (i + 1);
+  std::vector<std::vector<std::string>> fresh_missing;
+  for (bool threaded : {true, false}) {
+    StageSetup setup = SetupFor(fit, ResidualKind::kVertical);
+    setup.threaded_evaluation = threaded;
+    // A new problem at each point.
+    std::vector<double> fresh_cost;
+    fresh_missing.clear();
+    for (const ParameterVector& point : {damped, near}) {
+      p = point;
+      StageProblem fresh(fit, setup);
+      fresh_missing.push_back(fresh.MissingFolds(range));
+      fresh_cost.push_back(fresh.DataCost());
+    }
+    // One problem at both, and at the first again.
+    StageProblem reused(fit, setup);
+    const std::vector<ParameterVector> points = {damped, near, damped, near};
+    for (size_t i = 0; i < points.size(); ++i) {
+      p = points[i];
+      reused.EvaluateAfresh();
+      EXPECT_EQ(reused.MissingFolds(range), fresh_missing[i % 2]) << threaded << i;
+      EXPECT_EQ(reused.DataCost(), fresh_cost[i % 2]) << threaded << i;
+    }
+  }
+  // The damped point lacks the frequency sweep's jump-down fold, the near
+  // point lacks none.
+  ASSERT_EQ(fresh_missing.size(), 2u);
+  EXPECT_EQ(fresh_missing[0].size(), 1u);
+  EXPECT_TRUE(fresh_missing[1].empty());
+}
+
+// Solving again on one problem with other entries held (Hold, then
+// EvaluateAfresh) gives the solve of a problem assembled with them held, to
+// the bit; a block held constant before moves again when released.
+TEST(StageProblem, SolvingAgainWithOtherHeldEntriesMatchesANewProblem) {
+  const std::vector<Sweep> sweeps = SimulateDataset(kThesisTruth, 0.01, 7);
+  ParameterVector p = ThesisStart(kThesisTruth);
+  const FitDescription fit = SingleBlockFit(Pointers(sweeps), {}, &p);
+  const StageSetup setup = SetupFor(fit, ResidualKind::kVertical);
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_QR;
+  options.max_num_iterations = 8;
+  options.logging_type = ceres::SILENT;
+  std::vector<bool> held(kNumParameters, false);
+  held[kMu2] = true;
+  held[kNaturalFrequency] = true;
+
+  StageProblem reused(fit, setup);
+  reused.Configure();
+  ceres::Solver::Summary first;
+  ceres::Solve(options, reused.problem(), &first);
+  const ParameterVector after_first = p;
+  reused.Hold(held);
+  reused.EvaluateAfresh();
+  reused.Configure();
+  EXPECT_EQ(reused.problem()->ParameterBlockTangentSize(p.data()), 4);
+  ceres::Solver::Summary second;
+  ceres::Solve(options, reused.problem(), &second);
+  const ParameterVector reused_end = p;
+
+  p = after_first;
+  StageSetup held_setup = setup;
+  held_setup.held = held;
+  StageProblem fresh(fit, held_setup);
+  fresh.Configure();
+  ceres::Solver::Summary fresh_summary;
+  ceres::Solve(options, fresh.problem(), &fresh_summary);
+  EXPECT_EQ(second.iterations.size(), fresh_summary.iterations.size());
+  EXPECT_EQ(second.initial_cost, fresh_summary.initial_cost);
+  EXPECT_EQ(second.final_cost, fresh_summary.final_cost);
+  for (int i = 0; i < kNumParameters; ++i) EXPECT_EQ(reused_end[i], p[i]) << i;
+  EXPECT_EQ(p[kMu2], after_first[kMu2]);
+
+  // Every entry held: the block is constant; released, it moves again.
+  reused.Hold(std::vector<bool>(kNumParameters, true));
+  reused.Configure();
+  EXPECT_TRUE(reused.problem()->IsParameterBlockConstant(p.data()));
+  reused.Hold({});
+  reused.Configure();
+  EXPECT_FALSE(reused.problem()->IsParameterBlockConstant(p.data()));
+  EXPECT_EQ(reused.problem()->ParameterBlockTangentSize(p.data()), kNumParameters);
 }
 
 // Counts its destructions; r = p[mu1] - target otherwise.
