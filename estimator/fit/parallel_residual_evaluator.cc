@@ -200,6 +200,11 @@ ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, 
     size_ += block.size;
   }
   CHECK_GE(num_threads, 1);
+  iterate_.resize(size_);
+  for (size_t b = 0; b < blocks_.size(); ++b) {
+    std::copy(blocks_[b].values, blocks_[b].values + blocks_[b].size,
+              iterate_.begin() + offsets_[b]);
+  }
 }
 
 ParallelResidualEvaluator::ParallelResidualEvaluator(const double* parameters, int size,
@@ -250,8 +255,24 @@ bool ParallelResidualEvaluator::AtLastPoint() const {
   return true;
 }
 
-void ParallelResidualEvaluator::PrepareForEvaluation(bool /*evaluate_jacobians*/,
+const double* ParallelResidualEvaluator::IterateEntry(const double* value) const {
+  for (size_t b = 0; b < blocks_.size(); ++b) {
+    const double* begin = blocks_[b].values;
+    if (value >= begin && value < begin + blocks_[b].size) {
+      return iterate_.data() + offsets_[b] + (value - begin);
+    }
+  }
+  return nullptr;
+}
+
+void ParallelResidualEvaluator::PrepareForEvaluation(bool evaluate_jacobians,
                                                      bool /*new_evaluation_point*/) {
+  if (evaluate_jacobians) {
+    for (size_t b = 0; b < blocks_.size(); ++b) {
+      std::copy(blocks_[b].values, blocks_[b].values + blocks_[b].size,
+                iterate_.begin() + offsets_[b]);
+    }
+  }
   // Ceres has copied the point into the caller's blocks. The same point
   // again (the Jacobian at an accepted step, a line search's trial step and
   // the trust-region candidate): the values, Jacobians included, are there.

@@ -83,6 +83,14 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   // wrappers hold values for.
   void Invalidate() { computed_ = false; }
 
+  // Where the solver's current iterate holds the entry the caller keeps at
+  // `value` (an entry of a watched block; nullptr for any other pointer):
+  // the point of the last evaluation with Jacobians, which Ceres' trust-region
+  // minimizer makes at every accepted step. With non-monotonic steps Ceres
+  // writes only the best point so far into the caller's blocks, so during an
+  // excursion above that cost they lag behind the iterate.
+  const double* IterateEntry(const double* value) const;
+
   // The gradient of (1/2) sum |r|^2 over every wrapped block at `point` (a
   // point as above), in the blocks' own coordinates (no manifold, no
   // bounds), evaluated on the threads and summed in block order. False if a
@@ -118,6 +126,7 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   std::vector<int> block_offsets_;
   bool computed_ = false;           // last_point_ holds a point evaluated
   std::vector<double> last_point_;  // the point the wrappers hold values for
+  std::vector<double> iterate_;     // the last point evaluated with Jacobians
   std::int64_t replayed_ = 0;
   std::int64_t evaluated_directly_ = 0;
   // PrecomputeAll on the threads or in the caller alone, whichever is

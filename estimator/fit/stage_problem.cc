@@ -265,11 +265,22 @@ std::vector<BoundRestWatcher::Entry> StageProblem::WatchedBounds() const {
     const int offset = fit_.Offset(static_cast<int>(b));
     for (int i = 0; i < fit_.blocks[b].size; ++i) {
       if (IsBounded(offset + i) && !IsHeld(offset + i)) {
-        watched.push_back({fit_.blocks[b].values + i, 0.0, offset + i});
+        const double* value = fit_.blocks[b].values + i;
+        const double* iterate =
+            setup_.threaded_evaluation ? evaluator_.IterateEntry(value) : nullptr;
+        watched.push_back({value, 0.0, offset + i, iterate});
       }
     }
   }
   return watched;
+}
+
+void StageProblem::MoveToIterate() {
+  if (!setup_.threaded_evaluation) return;
+  for (const FitBlock& block : fit_.blocks) {
+    const double* iterate = evaluator_.IterateEntry(block.values);
+    std::copy(iterate, iterate + block.size, block.values);
+  }
 }
 
 bool StageProblem::EvaluatesFinite(const ceres::CostFunction& cost,

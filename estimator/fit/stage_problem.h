@@ -89,8 +89,13 @@ class StageProblem {
   // block cannot be evaluated.
   bool CostGradient(std::vector<double>* gradient);
   // The bounded entries that are neither fixed nor held, for a
-  // BoundRestWatcher (id: the ambient index). Valid after Configure.
+  // BoundRestWatcher (id: the ambient index), with where the solver's
+  // current iterate holds them (ParallelResidualEvaluator::IterateEntry;
+  // none without threaded evaluation). Valid after Configure.
   std::vector<BoundRestWatcher::Entry> WatchedBounds() const;
+  // Sets the described blocks to the solver's last iterate (see
+  // WatchedBounds). Nothing without threaded evaluation.
+  void MoveToIterate();
 
   ceres::Problem* problem() { return &problem_; }
   int dwells() const { return dwells_; }

@@ -177,5 +177,49 @@ TEST(BoundRestWatcher, IgnoresAShortRestOnTheBound) {
   EXPECT_EQ(*shorter.resting, kX);
 }
 
+// A successful step's summary, as the solver hands it to its callbacks.
+ceres::IterationSummary SuccessfulStep(int iteration) {
+  ceres::IterationSummary summary;
+  summary.iteration = iteration;
+  summary.step_is_successful = true;
+  return summary;
+}
+
+// With non-monotonic steps the caller's block keeps the best point while the
+// iterate moves: an entry resting on its bound in the iterate alone stops the
+// solve after kSteps steps, and says so; resting in both, it does not.
+TEST(BoundRestWatcher, ReadsTheIterateBesideTheBestPoint) {
+  double best = 2.5;
+  double iterate = 0.0;
+  BoundRestWatcher watcher({{&best, 0.0, kX, &iterate}}, kSteps);
+  for (int i = 1; i < kSteps; ++i) {
+    EXPECT_EQ(watcher(SuccessfulStep(i)), ceres::SOLVER_CONTINUE) << i;
+  }
+  ceres::IterationSummary rejected = SuccessfulStep(kSteps);
+  rejected.step_is_successful = false;
+  EXPECT_EQ(watcher(rejected), ceres::SOLVER_CONTINUE);  // not a step at the bound
+  EXPECT_EQ(watcher(SuccessfulStep(kSteps + 1)), ceres::SOLVER_TERMINATE_SUCCESSFULLY);
+  ASSERT_TRUE(watcher.resting().has_value());
+  EXPECT_EQ(*watcher.resting(), kX);
+  EXPECT_TRUE(watcher.resting_at_iterate());
+
+  // Both on the bound: the best point rests there, nothing to move to.
+  best = 0.0;
+  BoundRestWatcher both({{&best, 0.0, kX, &iterate}}, kSteps);
+  for (int i = 1; i < kSteps; ++i) EXPECT_EQ(both(SuccessfulStep(i)), ceres::SOLVER_CONTINUE);
+  EXPECT_EQ(both(SuccessfulStep(kSteps)), ceres::SOLVER_TERMINATE_SUCCESSFULLY);
+  EXPECT_FALSE(both.resting_at_iterate());
+
+  // The iterate leaves the bound: the count starts again.
+  best = 2.5;
+  BoundRestWatcher left({{&best, 0.0, kX, &iterate}}, kSteps);
+  for (int i = 1; i < kSteps; ++i) EXPECT_EQ(left(SuccessfulStep(i)), ceres::SOLVER_CONTINUE);
+  iterate = 0.5;
+  EXPECT_EQ(left(SuccessfulStep(kSteps)), ceres::SOLVER_CONTINUE);
+  iterate = 0.0;
+  EXPECT_EQ(left(SuccessfulStep(kSteps + 1)), ceres::SOLVER_CONTINUE);
+  EXPECT_FALSE(left.resting().has_value());
+}
+
 }  // namespace
 }  // namespace dwellfit

@@ -237,6 +237,79 @@ TEST(ParallelResidualEvaluator, SolveReplaysEveryEvaluation) {
   }
 }
 
+// (1/2) sum r^2 of the decaying cosine over `data` at `p`.
+double CosineCost(const std::vector<Sample>& data, const double* p) {
+  double cost = 0.0;
+  for (const Sample& sample : data) {
+    double r = 0.0;
+    const DecayingCosine cosine(sample);
+    cosine(p, &r);
+    cost += 0.5 * r * r;
+  }
+  return cost;
+}
+
+// After every accepted step, the cost at the evaluator's iterate and at the
+// caller's block, beside the cost Ceres reports for its iterate.
+class IterateRecorder : public ceres::IterationCallback {
+ public:
+  IterateRecorder(const std::vector<Sample>* data, const ParallelResidualEvaluator* evaluator,
+                  const double* parameters)
+      : data_(data), evaluator_(evaluator), parameters_(parameters) {}
+
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    if (!summary.step_is_successful) return ceres::SOLVER_CONTINUE;
+    steps.push_back({summary.cost, CosineCost(*data_, evaluator_->IterateEntry(parameters_)),
+                     CosineCost(*data_, parameters_), summary.step_is_nonmonotonic});
+    return ceres::SOLVER_CONTINUE;
+  }
+
+  struct Step {
+    double solver_cost, iterate_cost, block_cost;
+    bool nonmonotonic;
+  };
+  std::vector<Step> steps;
+
+ private:
+  const std::vector<Sample>* data_;
+  const ParallelResidualEvaluator* evaluator_;
+  const double* parameters_;
+};
+
+// The evaluator's iterate is the solver's: with non-monotonic steps its cost
+// is the cost Ceres reports at every accepted step, also where the cost rose
+// and Ceres keeps the best point so far in the caller's block instead.
+TEST(ParallelResidualEvaluator, IterateIsTheSolversIterate) {
+  const std::vector<Sample> data = SyntheticData(kNumSamples);
+  Parameters parameters = {4.0, -0.1, 1.0};  // growing, not decaying: the cost rises on the way
+  ParallelResidualEvaluator evaluator(parameters.data(), 3, 2);
+  ceres::Problem::Options problem_options;
+  problem_options.evaluation_callback = &evaluator;
+  ceres::Problem problem(problem_options);
+  for (const Sample& sample : data) {
+    problem.AddResidualBlock(evaluator.Wrap(NewDecayingCosine(sample)), nullptr, parameters.data());
+  }
+  ceres::Solver::Options options = FitOptions();
+  options.use_nonmonotonic_steps = true;
+  options.update_state_every_iteration = true;
+  IterateRecorder recorder(&data, &evaluator, parameters.data());
+  options.callbacks.push_back(&recorder);
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
+
+  int nonmonotonic = 0;
+  for (const IterateRecorder::Step& step : recorder.steps) {
+    EXPECT_NEAR(step.iterate_cost, step.solver_cost, 1e-12 * step.solver_cost);
+    if (!step.nonmonotonic) continue;
+    ++nonmonotonic;
+    EXPECT_LT(step.block_cost, step.iterate_cost);  // the best point, not the iterate
+  }
+  EXPECT_GT(nonmonotonic, 0) << "the premise: some accepted step raised the cost";
+  double outside = 0.0;
+  EXPECT_EQ(evaluator.IterateEntry(&outside), nullptr);
+}
+
 // The decaying cosine on two blocks: {a} and {b, c}.
 struct SplitDecayingCosine {
   explicit SplitDecayingCosine(const Sample& sample) : cosine(sample) {}
