@@ -316,13 +316,17 @@ ResidualOptions ReadResidual(const ConfigValue& value, const ConfigSource& sourc
 }
 
 SolverSettings ReadSolver(const ConfigValue& value, const ConfigSource& source) {
-  const StrictMap block(value, source,
-                        {"max_iterations", "function_tolerance", "gradient_tolerance",
-                         "parameter_tolerance", "num_threads", "nonmonotonic_steps"});
+  const StrictMap block(
+      value, source,
+      {"max_iterations", "function_tolerance", "start_function_tolerance", "gradient_tolerance",
+       "parameter_tolerance", "num_threads", "nonmonotonic_steps"});
   SolverSettings solver;
   if (const auto v = block.Optional("max_iterations")) solver.max_iterations = ReadInt(*v, source);
   if (const auto v = block.Optional("function_tolerance")) {
     solver.function_tolerance = ReadFiniteDouble(*v, source);
+  }
+  if (const auto v = block.Optional("start_function_tolerance")) {
+    solver.start_function_tolerance = ReadFiniteDouble(*v, source);
   }
   if (const auto v = block.Optional("gradient_tolerance")) {
     solver.gradient_tolerance = ReadFiniteDouble(*v, source);

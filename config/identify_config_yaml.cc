@@ -92,7 +92,8 @@ void EmitInitialGuess(YAML::Emitter& out, const IdentifyConfig& config) {
   out << YAML::Key << "initial_guess" << YAML::Value << YAML::BeginMap;
   for (int i = 0; i < kNumParameters; ++i) {
     if (!config.initial_guess[i]) {
-      out << YAML::Key << (i == kNaturalFrequency ? "omega_hz" : ParameterName(i)) << YAML::Value << "auto";
+      out << YAML::Key << (i == kNaturalFrequency ? "omega_hz" : ParameterName(i)) << YAML::Value
+          << "auto";
     } else if (i == kNaturalFrequency) {
       out << YAML::Key << "omega_hz" << YAML::Value << ConvertedNumber(RadPerSecondToHz(initial[i]))
           << YAML::Comment(ExactNumber(initial[i]) + " rad/s");
@@ -124,6 +125,8 @@ void EmitFitSettings(YAML::Emitter& out, const IdentificationOptions& identifica
   out << YAML::Key << "solver" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "max_iterations" << YAML::Value << solver.max_iterations;
   out << YAML::Key << "function_tolerance" << YAML::Value << ExactNumber(solver.function_tolerance);
+  out << YAML::Key << "start_function_tolerance" << YAML::Value
+      << ExactNumber(solver.start_function_tolerance);
   out << YAML::Key << "gradient_tolerance" << YAML::Value << ExactNumber(solver.gradient_tolerance);
   out << YAML::Key << "parameter_tolerance" << YAML::Value
       << ExactNumber(solver.parameter_tolerance);
@@ -157,7 +160,8 @@ void EmitChoices(YAML::Emitter& out, const char* key, const std::vector<Paramete
     if (!choice.value) {
       out << "free";
     } else {
-      out << (omega ? ConvertedNumber(RadPerSecondToHz(*choice.value)) : ExactNumber(*choice.value));
+      out << (omega ? ConvertedNumber(RadPerSecondToHz(*choice.value))
+                    : ExactNumber(*choice.value));
     }
   }
   out << YAML::EndSeq;

@@ -72,6 +72,7 @@ bool SolverSettings::IsValid(std::string* error) const {
   }
   const std::pair<const char*, double> tolerances[] = {
       {"function_tolerance", function_tolerance},
+      {"start_function_tolerance", start_function_tolerance},
       {"gradient_tolerance", gradient_tolerance},
       {"parameter_tolerance", parameter_tolerance}};
   for (const auto& [name, value] : tolerances) {

@@ -231,6 +231,8 @@ StageSetup MakeSetup(const SolveContext& context, ResidualKind kind) {
 // (`*failure` says why). `rated`, when given, is a problem of the dwells
 // alone made with MakeSetup(context, kind) (the one ChooseStart rated the
 // start on): the stage solves on it instead of assembling its own.
+// `start_only`: the stage's end only starts a later stage, and its solves
+// end on SolverSettings::start_function_tolerance.
 //
 // Active set: a bounded entry that rests on its bound is held there
 // (BoundRestWatcher) and the stage solves again without it; when that solve
@@ -242,9 +244,11 @@ StageSetup MakeSetup(const SolveContext& context, ResidualKind kind) {
 // assembled anew, and the values at the point where the last solve ended are
 // not evaluated again.
 bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptions& penalties,
-              StageSummary* stage, std::string* failure,
+              bool start_only, StageSummary* stage, std::string* failure,
               std::unique_ptr<StageProblem> rated = nullptr) {
   StageSetup setup = MakeSetup(context, kind);
+  SolverSettings settings = context.options.solver;
+  if (start_only) settings.function_tolerance = settings.start_function_tolerance;
   // The algebraic stage takes the enforced jumps' fold conditions
   // (ProblemBuilder::AddPenalties), unweighted by the data's cost; the
   // all-roots stage takes the penalties too, its range through the roots.
@@ -272,8 +276,7 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
     if (round > 0) problem.EvaluateAfresh();
     std::optional<int> resting;
     const std::vector<double> start = context.fit.Values();
-    const ceres::Solver::Summary summary =
-        SolveOnce(kind, context.options.solver, &problem, &resting);
+    const ceres::Solver::Summary summary = SolveOnce(kind, settings, &problem, &resting);
     VLOG(2) << ResidualKindName(kind) << " stage, solve " << round + 1 << ": "
             << summary.BriefReport();
     RecordSolve(summary, round, with_penalties ? penalties : PenaltyOptions{}, &problem, stage);
@@ -419,7 +422,10 @@ bool RunStartStage(const SolveContext& context, ResidualKind first, FitSummary* 
                    "candidate start for the first (") +
                ResidualKindName(first) + ") stage";
   std::string failure;
-  if (RunStage(context, ResidualKind::kAlgebraic, PenaltyOptions{}, &stage, &failure)) return true;
+  if (RunStage(context, ResidualKind::kAlgebraic, PenaltyOptions{}, /*start_only=*/true, &stage,
+               &failure)) {
+    return true;
+  }
   stage.note += "; it failed (" + failure + "), so the first stage starts at the given start";
   context.fit.SetValues(given);
   return false;
@@ -482,7 +488,8 @@ bool ChooseStart(const SolveContext& context, ResidualKind kind,
     fold_stage.fold_stage = true;
     fold_stage.note =
         "fold stage: the vertical stage's start lacks " + JoinLines(rating.missing_folds);
-    if (!RunStage(context, ResidualKind::kAlgebraic, penalties, &fold_stage, failure)) {
+    if (!RunStage(context, ResidualKind::kAlgebraic, penalties, /*start_only=*/true, &fold_stage,
+                  failure)) {
       return false;
     }
     *fold_stage_ran = true;
@@ -600,12 +607,15 @@ FitSummary SolveStaged(const FitDescription& fit, const StagedSolveOptions& opti
       runs.insert(runs.begin(), options.penalties);
       runs.front().bifurcation_range.exponent = 2;
     }
+    // An algebraic stage before the last only starts the next one.
+    const bool start_only = kind == ResidualKind::kAlgebraic && s + 1 < options.stages.size();
     for (const PenaltyOptions& penalties : runs) {
       summary.stages.emplace_back();
       summary.stages.back().note = note;
       note.clear();
       // The first run solves on the problem its start was rated on.
-      if (!RunStage(context, kind, penalties, &summary.stages.back(), &error, std::move(rated))) {
+      if (!RunStage(context, kind, penalties, start_only, &summary.stages.back(), &error,
+                    std::move(rated))) {
         summary.status = FitStatus::kFailure;
         summary.evaluation_failed = true;
         summary.message = error;

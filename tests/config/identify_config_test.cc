@@ -151,6 +151,22 @@ TEST(ConfigToYaml, RoundTripsThroughLoadIdentifyConfig) {
   EXPECT_EQ(reloaded.output_dir, loaded.output_dir);
 }
 
+// The start stage's tolerance: read, shown in the configuration in effect,
+// and its default where the config is silent.
+TEST(LoadIdentifyConfig, StartFunctionToleranceIsReadAndShown) {
+  const ConfigDirectory dir;
+  std::string text = kValidConfig;
+  const std::string line = "  function_tolerance: 1e-12\n";
+  ASSERT_NE(text.find(line), std::string::npos);
+  const std::string path = dir.WriteConfig(text);
+  EXPECT_EQ(LoadIdentifyConfig(path).identification.solver.start_function_tolerance,
+            SolverSettings{}.start_function_tolerance);
+  text.replace(text.find(line), line.size(), line + "  start_function_tolerance: 1e-3\n");
+  const IdentifyConfig config = LoadIdentifyConfig(dir.WriteConfig(text));
+  EXPECT_EQ(config.identification.solver.start_function_tolerance, 1e-3);
+  EXPECT_THAT(ConfigToYaml(config), HasSubstr("start_function_tolerance: 0.001"));
+}
+
 TEST(ConfigToYaml, ShowsTheSourceFileAndOmegaInHz) {
   const ConfigDirectory dir;
   const std::string path = dir.WriteConfig(kValidConfig);
@@ -203,8 +219,9 @@ TEST(IdentifyConfigErrors, UnknownKeyInABlockNamesKeyLineAndAllowedKeys) {
   ExpectAt(error, path, 18, "solver.max_iteration");
   EXPECT_THAT(error.what(), HasSubstr("unknown key 'max_iteration' in 'solver'"));
   EXPECT_THAT(error.what(), HasSubstr("did you mean 'max_iterations'?"));
-  EXPECT_THAT(error.what(), HasSubstr("allowed: max_iterations, function_tolerance, "
-                                      "gradient_tolerance, parameter_tolerance, num_threads"));
+  EXPECT_THAT(error.what(),
+              HasSubstr("allowed: max_iterations, function_tolerance, start_function_tolerance, "
+                        "gradient_tolerance, parameter_tolerance, num_threads"));
 }
 
 TEST(IdentifyConfigErrors, UnknownTopLevelKeyListsTheTopLevelKeys) {

@@ -4,6 +4,7 @@
 // are fitted jointly.
 #include "dwellfit/estimator/fit/staged_solve.h"
 
+#include <array>
 #include <cmath>
 #include <functional>
 #include <string>
@@ -43,6 +44,8 @@ TEST_F(StagedSolve, InvalidOptionsGiveAFailedStatusNamingTheField) {
       {[](StagedSolveOptions* o) { o->solver.max_iterations = 0; }, "solver.max_iterations"},
       {[](StagedSolveOptions* o) { o->solver.function_tolerance = -1.0; },
        "solver.function_tolerance must be a non-negative number (>= 0), got -1"},
+      {[](StagedSolveOptions* o) { o->solver.start_function_tolerance = NAN; },
+       "solver.start_function_tolerance must be a non-negative number (>= 0), got nan"},
       {[](StagedSolveOptions* o) { o->solver.num_threads = -2; }, "solver.num_threads"},
       {[](StagedSolveOptions* o) { o->residual.amplitude_floor = -1e-3; },
        "residual.amplitude_floor must be a non-negative number (>= 0)"},
@@ -97,6 +100,44 @@ TEST_F(StagedSolve, InvalidIdentificationAndMultiStartOptionsNameTheField) {
   std::string error;
   EXPECT_FALSE(builder.IsValid(&error));
   EXPECT_THAT(error, HasSubstr("dwell_weight must be positive and finite (> 0), got 0"));
+}
+
+// An algebraic stage whose end only starts the vertical stage ends on the
+// looser start tolerance, in fewer iterations, and the vertical stage reaches
+// the same minimum; an algebraic stage that is the last keeps the fit's own
+// tolerance, whatever the start tolerance.
+TEST_F(StagedSolve, AStartOnlyAlgebraicStageEndsOnTheStartTolerance) {
+  const std::vector<Sweep> noisy = SimulateDataset(kThesisTruth, 0.01, 3);
+  const auto solve = [&](std::vector<ResidualKind> stages, double start_tolerance,
+                         ParameterVector* p) {
+    StagedSolveOptions options = ThesisOptions();
+    options.stages = std::move(stages);
+    options.solver.start_function_tolerance = start_tolerance;
+    *p = ThesisStart(kThesisTruth);
+    std::array<bool, kNumParameters> fixed{};
+    fixed[kNaturalFrequency] = true;
+    return SolveStaged(SingleBlockFit(Pointers(noisy), fixed, p), options);
+  };
+  const std::vector<ResidualKind> two = {ResidualKind::kAlgebraic, ResidualKind::kVertical};
+  ParameterVector tight_p, loose_p;
+  const FitSummary tight = solve(two, 1e-8, &tight_p);
+  const FitSummary loose = solve(two, 1e-2, &loose_p);
+  ASSERT_EQ(tight.status, FitStatus::kConverged) << tight.message;
+  ASSERT_EQ(loose.status, FitStatus::kConverged) << loose.message;
+  ASSERT_EQ(tight.stages.front().residual, ResidualKind::kAlgebraic);
+  EXPECT_LT(loose.stages.front().iterations, tight.stages.front().iterations);
+  EXPECT_GT(loose.stages.front().final_cost, tight.stages.front().final_cost);
+  EXPECT_NEAR(loose.final_cost, tight.final_cost, 1e-6 * tight.final_cost);
+  for (int i = 0; i < kNumParameters; ++i) {
+    EXPECT_NEAR(loose_p[i], tight_p[i], 1e-3 * std::abs(tight_p[i]) + 1e-12) << i;
+  }
+
+  ParameterVector alone_tight_p, alone_loose_p;
+  const FitSummary alone_tight = solve({ResidualKind::kAlgebraic}, 1e-8, &alone_tight_p);
+  const FitSummary alone_loose = solve({ResidualKind::kAlgebraic}, 1e-2, &alone_loose_p);
+  EXPECT_EQ(alone_loose.iterations, alone_tight.iterations);
+  EXPECT_EQ(alone_loose_p, alone_tight_p);
+  EXPECT_EQ(alone_tight.stages.front().iterations, tight.stages.front().iterations);
 }
 
 // Each broken description names its dataset, block or entry.
