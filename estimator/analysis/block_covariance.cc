@@ -8,14 +8,17 @@
 #include <utility>
 #include <vector>
 
+#include "Eigen/QR"
 #include "Eigen/SVD"
 #include "boost/math/distributions/normal.hpp"
 #include "boost/math/distributions/students_t.hpp"
 #include "ceres/covariance.h"
 #include "ceres/crs_matrix.h"
+#include "ceres/normal_prior.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/fit/scaled_subset_manifold.h"
 #include "dwellfit/estimator/fit/stage_problem.h"
+#include "glog/logging.h"
 
 namespace dwellfit {
 namespace {
@@ -63,22 +66,58 @@ std::vector<double*> FreeBlocks(const FitDescription& fit) {
   return blocks;
 }
 
-// F = (1/2) sum r^2 over `rows` and their Jacobian in the tangent
-// coordinates of `blocks` (one column per free entry, in order).
-bool EvaluateJacobian(StageProblem* problem, const std::vector<ceres::ResidualBlockId>& rows,
-                      const std::vector<double*>& blocks, double* cost, Eigen::MatrixXd* jacobian) {
+// The rows of residual blocks rows[begin, end) (in the tangent coordinates
+// of `blocks`) into stacked.bottomRows(), below the k rows kept for R, and
+// their cost (1/2) sum r^2 into *cost. False if they cannot be evaluated or
+// are not finite.
+bool EvaluateChunk(ceres::Problem* problem, const std::vector<ceres::ResidualBlockId>& rows,
+                   size_t begin, size_t end, const std::vector<double*>& blocks, int k,
+                   double* cost, Eigen::MatrixXd* stacked) {
   ceres::Problem::EvaluateOptions options;
-  options.residual_blocks = rows;
+  options.residual_blocks.assign(rows.begin() + begin, rows.begin() + end);
   options.parameter_blocks = blocks;
   ceres::CRSMatrix crs;
-  if (!problem->problem()->Evaluate(options, cost, nullptr, nullptr, &crs)) return false;
-  jacobian->setZero(crs.num_rows, crs.num_cols);
+  if (!problem->Evaluate(options, cost, nullptr, nullptr, &crs) || !std::isfinite(*cost)) {
+    return false;
+  }
+  CHECK_EQ(crs.num_cols, k) << "one Jacobian column per free entry";
+  stacked->setZero(k + crs.num_rows, k);
   for (int row = 0; row < crs.num_rows; ++row) {
-    for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) {
-      (*jacobian)(row, crs.cols[k]) = crs.values[k];
+    for (int i = crs.rows[row]; i < crs.rows[row + 1]; ++i) {
+      (*stacked)(k + row, crs.cols[i]) = crs.values[i];
     }
   }
-  return std::isfinite(*cost) && jacobian->allFinite();
+  return stacked->allFinite();
+}
+
+// F = (1/2) sum r^2 over `rows` and the upper-triangular factor `r` (k x k)
+// of the QR decomposition of their Jacobian J in the tangent coordinates of
+// `blocks` (one column per free entry, in order): R^T R = J^T J. J is
+// evaluated `chunk_rows` rows at a time (whole residual blocks) and each
+// chunk folded in by a Householder QR of [R; J_chunk], whose R' has R'^T R' =
+// R^T R + J_chunk^T J_chunk; the normal matrix is never formed.
+bool FactorJacobian(ceres::Problem* problem, const std::vector<ceres::ResidualBlockId>& rows,
+                    const std::vector<double*>& blocks, int k, int chunk_rows, double* cost,
+                    Eigen::MatrixXd* r) {
+  r->setZero(k, k);
+  *cost = 0.0;
+  Eigen::MatrixXd stacked;
+  Eigen::HouseholderQR<Eigen::MatrixXd> qr;
+  size_t begin = 0;
+  while (begin < rows.size()) {
+    size_t end = begin;
+    for (int chunk = 0; end < rows.size() && chunk < chunk_rows; ++end) {
+      chunk += problem->GetCostFunctionForResidualBlock(rows[end])->num_residuals();
+    }
+    double chunk_cost = 0.0;
+    if (!EvaluateChunk(problem, rows, begin, end, blocks, k, &chunk_cost, &stacked)) return false;
+    *cost += chunk_cost;
+    stacked.topRows(k) = *r;
+    qr.compute(stacked);
+    *r = qr.matrixQR().topRows(k).triangularView<Eigen::Upper>();
+    begin = end;
+  }
+  return std::isfinite(*cost);
 }
 
 // Student's t (s estimated) or the normal (s known) 0.975 quantile.
@@ -146,17 +185,16 @@ bool EstimateNoise(BlockCovariance* c) {
   return true;
 }
 
-// Normalises the columns of `jacobian` into c->columns (moved there: at a
-// million dwells a copy is 40 MB more at the covariance's peak) and sets
-// c->unit_scale; false for a column without effect.
-bool NormaliseColumns(const FitDescription& fit, Eigen::MatrixXd jacobian,
-                      const std::vector<double>& tangent_scale, BlockCovariance* c) {
+// Normalises the columns of `r` (R of J, so the same column norms) into R_n
+// and sets c->unit_scale and c->column_cosines (R_n^T R_n = J_n^T J_n);
+// false for a column without effect.
+bool NormaliseColumns(const FitDescription& fit, const std::vector<double>& tangent_scale,
+                      Eigen::MatrixXd* r, BlockCovariance* c) {
   const int k = c->num_free;
   c->unit_scale.resize(k);
-  c->columns = std::move(jacobian);
   for (int j = 0; j < k; ++j) {
     const int entry = c->free[j];
-    const double norm = c->columns.col(j).norm();
+    const double norm = r->col(j).norm();
     if (!(norm > 0.0)) {
       // E.g. mu1 with mu1 = mu2 = 0: G depends on the damping through k1^2,
       // k2^2 and k1 k2 only, so its first derivative vanishes there.
@@ -168,17 +206,21 @@ bool NormaliseColumns(const FitDescription& fit, Eigen::MatrixXd jacobian,
       c->message = fit.EntryName(entry) + advice;
       return false;
     }
-    c->columns.col(j) /= norm;
+    r->col(j) /= norm;
     c->unit_scale[j] = tangent_scale[entry] / norm;
   }
+  c->column_cosines = r->transpose() * *r;
   return true;
 }
 
-// The collinearity of the normalised columns; false above kMaxCollinearity,
-// with the null directions and a message naming the entries they involve.
-bool CheckCollinearity(const FitDescription& fit, BlockCovariance* c) {
+// The collinearity of the normalised columns, from R_n (k x k), which has
+// the singular values and right singular vectors of J_n; false above
+// kMaxCollinearity, with the null directions and a message naming the
+// entries they involve.
+bool CheckCollinearity(const FitDescription& fit, const Eigen::MatrixXd& r_normalised,
+                       BlockCovariance* c) {
   const int k = c->num_free;
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(c->columns, Eigen::ComputeThinV);
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(r_normalised, Eigen::ComputeFullV);
   const Eigen::VectorXd& singular = svd.singularValues();
   c->collinearity = singular[0] / singular[k - 1];
   if (c->collinearity <= kMaxCollinearity) return true;
@@ -199,51 +241,46 @@ bool CheckCollinearity(const FitDescription& fit, BlockCovariance* c) {
   return false;
 }
 
-// (J^T J)^-1 by ceres::Covariance with every free block stepping in its
-// normalised units, in physical units, into c->covariance (times `factor`).
-bool ComputeCovariance(const FitDescription& fit, double factor, StageProblem* problem,
-                       BlockCovariance* c) {
+// (J^T J)^-1 by ceres::Covariance, in physical units, into c->covariance
+// (times `factor`). Its problem holds a copy x of every described entry
+// (ambient order), stepping in the normalised units (ScaledSubsetManifold:
+// x = x0 + unit_scale_j t_j on free entry j, fixed entries held), and one
+// linear residual block r = M (x - x0) (ceres::NormalPrior), M (k x ambient)
+// with column R_n.col(j) / unit_scale_j for free entry j and zeros for fixed
+// ones. Its Jacobian in t is M's free columns times unit_scale: R_n, whose
+// R_n^T R_n is J_n^T J_n of the dwells' problem stepping in the same units.
+// So Ceres inverts the same matrix as on the whole problem, C_t =
+// (J_n^T J_n)^-1, and lifts it to the ambient entries as D C_t D^T, D the
+// manifold's PlusJacobian (unit_scale_j at (free[j], j)).
+bool ComputeCovariance(const FitDescription& fit, double factor,
+                       const Eigen::MatrixXd& r_normalised, BlockCovariance* c) {
+  const int n = fit.NumEntries();
+  const int k = c->num_free;
   const std::vector<bool> fixed = fit.FixedEntries();
-  std::vector<double> unit(fixed.size(), 1.0);
-  for (int j = 0; j < c->num_free; ++j) unit[c->free[j]] = c->unit_scale[j];
-  const std::vector<double*> blocks = FreeBlocks(fit);
-  std::vector<int> offsets;
-  int rows = 0;
-  for (double* values : blocks) {
-    const int b = fit.BlockOf(values);
-    const int offset = fit.Offset(b);
-    const auto first = fixed.begin() + offset;
-    problem->problem()->SetManifold(
-        values,
-        new ScaledSubsetManifold(
-            std::vector<double>(unit.begin() + offset, unit.begin() + offset + fit.blocks[b].size),
-            std::vector<bool>(first, first + fit.blocks[b].size)));
-    offsets.push_back(offset);
-    rows += fit.blocks[b].size;
+  std::vector<double> unit(n, 1.0);  // unused for fixed entries
+  ceres::Matrix m = ceres::Matrix::Zero(k, n);
+  for (int j = 0; j < k; ++j) {
+    unit[c->free[j]] = c->unit_scale[j];
+    m.col(c->free[j]) = r_normalised.col(j) / c->unit_scale[j];
   }
+  std::vector<double> x = c->values;
+  const ceres::Vector x0 = Eigen::Map<const ceres::Vector>(c->values.data(), n);
+  ceres::Problem problem;
+  problem.AddParameterBlock(x.data(), n, new ScaledSubsetManifold(unit, fixed));
+  problem.AddResidualBlock(new ceres::NormalPrior(m, x0), nullptr, x.data());
+
   ceres::Covariance::Options options;
   options.algorithm_type = ceres::DENSE_SVD;
   options.min_reciprocal_condition_number = 1.0 / (kMaxCollinearity * kMaxCollinearity);
   options.null_space_rank = 0;  // rank deficient: fail, never truncate
   ceres::Covariance covariance(options);
-  const std::vector<const double*> const_blocks(blocks.begin(), blocks.end());
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> inverse(rows, rows);
-  if (!covariance.Compute(const_blocks, problem->problem()) ||
-      !covariance.GetCovarianceMatrix(const_blocks, inverse.data()) || !inverse.allFinite()) {
+  const std::vector<const double*> blocks = {x.data()};
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> inverse(n, n);
+  if (!covariance.Compute(blocks, &problem) ||
+      !covariance.GetCovarianceMatrix(blocks, inverse.data()) || !inverse.allFinite()) {
     return false;
   }
-  int row = 0;
-  for (size_t a = 0; a < blocks.size(); ++a) {
-    const int size_a = fit.blocks[fit.BlockOf(blocks[a])].size;
-    int col = 0;
-    for (size_t b = 0; b < blocks.size(); ++b) {
-      const int size_b = fit.blocks[fit.BlockOf(blocks[b])].size;
-      c->covariance.block(offsets[a], offsets[b], size_a, size_b) =
-          factor * inverse.block(row, col, size_a, size_b);
-      col += size_b;
-    }
-    row += size_a;
-  }
+  c->covariance = factor * inverse;
   return true;
 }
 
@@ -268,9 +305,14 @@ void SetIntervals(BlockCovariance* c) {
 
 }  // namespace
 
-BlockCovariance EstimateBlockCovariance(const FitDescription& fit,
-                                        const ResidualOptions& residual) {
+BlockCovariance EstimateBlockCovariance(const FitDescription& fit, const ResidualOptions& residual,
+                                        const BlockCovarianceOptions& options) {
   BlockCovariance c;
+  if (!(options.chunk_rows >= 1)) {
+    return Unavailable(c, StringPrintf("BlockCovarianceOptions::chunk_rows is %d: it must be at "
+                                       "least 1",
+                                       options.chunk_rows));
+  }
   if (!Prepare(fit, residual, &c)) return Unavailable(c, c.message);
   if (c.some_standardised && !c.all_standardised) {
     c.warnings.push_back(
@@ -283,8 +325,9 @@ BlockCovariance EstimateBlockCovariance(const FitDescription& fit,
 
   // The dwells alone: their cost gives the noise.
   std::unique_ptr<StageProblem> problem = AssembleDataProblem(fit, residual, 1.0, false);
-  Eigen::MatrixXd jacobian;
-  if (!EvaluateJacobian(problem.get(), problem->dwell_blocks(), blocks, &c.data_cost, &jacobian)) {
+  Eigen::MatrixXd r;  // R of J = Q R, k x k
+  if (!FactorJacobian(problem->problem(), problem->dwell_blocks(), blocks, c.num_free,
+                      options.chunk_rows, &c.data_cost, &r)) {
     return Unavailable(c, "the model cannot be evaluated at the estimate on every fitted dwell");
   }
   c.evaluated = true;
@@ -298,6 +341,7 @@ BlockCovariance EstimateBlockCovariance(const FitDescription& fit,
                        "against the caller's residual blocks");
   }
   if (fit.add_residuals) {
+    problem.reset();  // one problem of the dwells at a time
     problem = AssembleDataProblem(fit, residual, 1.0 / c.noise_sigma, true);
     std::vector<ceres::ResidualBlockId> rows = problem->dwell_blocks();
     for (ceres::ResidualBlockId id : problem->caller_blocks()) {
@@ -306,16 +350,17 @@ BlockCovariance EstimateBlockCovariance(const FitDescription& fit,
           problem->problem()->GetCostFunctionForResidualBlock(id)->num_residuals();
     }
     double cost = 0.0;
-    if (!EvaluateJacobian(problem.get(), rows, blocks, &cost, &jacobian)) {
+    if (!FactorJacobian(problem->problem(), rows, blocks, c.num_free, options.chunk_rows, &cost,
+                        &r)) {
       return Unavailable(c, "the caller's residual blocks cannot be evaluated at the estimate");
     }
     factor = 1.0;
   }
-  if (!NormaliseColumns(fit, std::move(jacobian), tangent_scale, &c) ||
-      !CheckCollinearity(fit, &c)) {
+  problem.reset();
+  if (!NormaliseColumns(fit, tangent_scale, &r, &c) || !CheckCollinearity(fit, r, &c)) {
     return Unavailable(c, c.message);
   }
-  if (!ComputeCovariance(fit, factor, problem.get(), &c)) {
+  if (!ComputeCovariance(fit, factor, r, &c)) {
     return Unavailable(c, StringPrintf("the covariance could not be computed (collinearity %.3g)",
                                        c.collinearity));
   }

@@ -28,9 +28,22 @@
 // entries' effects on the residuals coincide (the collinearity diagnostic of
 // Belsley, Kuh and Welsch). Above kMaxCollinearity no covariance is given
 // (available = false) and the message names the entries the data cannot
-// tell apart. Below it, ceres::Covariance (DENSE_SVD) inverts J^T J on the
-// problem whose blocks step in those normalised units (ScaledSubsetManifold
-// per block), and returns C in physical units.
+// tell apart. Below it, ceres::Covariance (DENSE_SVD) inverts J^T J with the
+// entries stepping in those normalised units (ScaledSubsetManifold), and
+// returns C in physical units.
+//
+// Memory. J (n x k) is never held whole: it is evaluated a chunk of residual
+// blocks at a time (BlockCovarianceOptions::chunk_rows rows or a little more)
+// and each chunk folded into the upper-triangular k x k factor R of its QR
+// decomposition, J = Q R: with [R; J_chunk] = Q' R', R'^T R' = R^T R +
+// J_chunk^T J_chunk, so after the last chunk R^T R = J^T J, without forming
+// J^T J (which would square the condition number: collinearity 1e8 is a
+// condition number 1e16 there). R has J's column norms, singular values and
+// right singular vectors, so the collinearity check and the null space are
+// those of R with normalised columns, R_n. ceres::Covariance then runs on a
+// small problem: one copy of the entries and one linear residual block r =
+// M (x - x0) whose Jacobian in the normalised tangent coordinates is R_n,
+// so that its (R_n^T R_n)^-1 is the (J_n^T J_n)^-1 of the whole problem.
 //
 // Blocks of the caller's own that its residual blocks read are held at their
 // values: C is conditional on them.
@@ -53,10 +66,18 @@ namespace dwellfit {
 // amplitude sweep) give 8e15; the thesis case's two fitted sweeps give ~200.
 inline constexpr double kMaxCollinearity = 1e8;
 
+struct BlockCovarianceOptions {
+  // Rows of J evaluated and folded into R at a time: whole residual blocks
+  // are added until the chunk has at least this many rows (>= 1). Memory
+  // of order chunk_rows x k doubles; the result does not depend on it
+  // beyond rounding.
+  int chunk_rows = 4096;
+};
+
 struct BlockCovariance {
-  // False: no covariance; `message` says why (invalid description, nothing
-  // free, no degrees of freedom, the model cannot be evaluated, entries the
-  // data cannot tell apart). Standard errors and covariance are then 0.
+  // False: no covariance; `message` says why (invalid description or
+  // options, nothing free, no degrees of freedom, the model cannot be
+  // evaluated, entries the data cannot tell apart). Standard errors and covariance are then 0.
   bool available = false;
   std::string message;  // plain words, always set
   // Mixed point sigmas (some dwells standardised, some raw).
@@ -81,16 +102,21 @@ struct BlockCovariance {
   Eigen::MatrixXd covariance;  // ambient x ambient, physical units
   std::vector<int> free;       // ambient index of each free entry, in order
   // When the data cannot tell entries apart: orthonormal null directions
-  // (k x r) of the column-normalised J `columns` (rows x k), and the physical
-  // change per unit of each free entry's normalised coordinate.
+  // (k x r) of the column-normalised J, J_n (every column of unit length).
   Eigen::MatrixXd null_space;
-  Eigen::MatrixXd columns;
+  // Once J is evaluated and no column vanishes: the cosines of the angles
+  // between the columns of J_n, J_n^T J_n (k x k, symmetric, 1 on the
+  // diagonal up to rounding): entry (i, j) is +-1 when free entries i and j
+  // change the residuals along one direction. Computed as R_n^T R_n.
+  Eigen::MatrixXd column_cosines;
+  // The physical change per unit of each free entry's normalised coordinate.
   Eigen::VectorXd unit_scale;
 };
 
 // The covariance of every described entry at the blocks' current values,
 // the dwells measured as `residual` says. Never throws or aborts.
-BlockCovariance EstimateBlockCovariance(const FitDescription& fit, const ResidualOptions& residual);
+BlockCovariance EstimateBlockCovariance(const FitDescription& fit, const ResidualOptions& residual,
+                                        const BlockCovarianceOptions& options = {});
 
 }  // namespace dwellfit
 

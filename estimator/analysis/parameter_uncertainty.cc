@@ -49,13 +49,14 @@ std::string PairAdvice(int a, int b) {
 }
 
 // The plain-words account of what the sweeps cannot see. `null_space` (k x r)
-// holds orthonormal null directions of the column-normalised Jacobian
-// `columns`; `unit_scale` is the physical change of each tangent coordinate
-// per unit. A parameter is implicated when its row of `null_space` has a norm
-// of at least kNullDirectionShare (the row norms do not depend on which basis
-// of the null space the SVD returned).
+// holds orthonormal null directions of the column-normalised Jacobian J_n;
+// `column_cosines` (k x k) is J_n^T J_n, the cosines between its columns;
+// `unit_scale` is the physical change of each tangent coordinate per unit.
+// A parameter is implicated when its row of `null_space` has a norm of at
+// least kNullDirectionShare (the row norms do not depend on which basis of
+// the null space the SVD returned).
 std::string DescribeNullSpace(const Eigen::MatrixXd& null_space, const Eigen::VectorXd& unit_scale,
-                              const std::vector<int>& free, const Eigen::MatrixXd& columns) {
+                              const std::vector<int>& free, const Eigen::MatrixXd& column_cosines) {
   std::vector<int> involved;
   std::vector<int> tangent;
   for (int j = 0; j < null_space.rows(); ++j) {
@@ -75,7 +76,7 @@ std::string DescribeNullSpace(const Eigen::MatrixXd& null_space, const Eigen::Ve
   // Two parameters, one lost direction: their Jacobian columns are parallel
   // (|cosine| = 1), and moving both along the null direction leaves the fit
   // unchanged, so their estimates correlate at the sign of that direction.
-  const double cosine = std::abs(columns.col(tangent[0]).dot(columns.col(tangent[1])));
+  const double cosine = std::abs(column_cosines(tangent[0], tangent[1]));
   const double sign = null_space(tangent[0], 0) * null_space(tangent[1], 0) > 0.0 ? 1.0 : -1.0;
   text += StringPrintf(
       " (a change of one is undone by a change of the other: their correlation is %+.3f)",
@@ -559,7 +560,7 @@ ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted
     const std::string message =
         c.null_space.cols() == 0
             ? c.message
-            : DescribeNullSpace(c.null_space, c.unit_scale, c.free, c.columns) +
+            : DescribeNullSpace(c.null_space, c.unit_scale, c.free, c.column_cosines) +
                   StringPrintf(" (collinearity %.3g, limit %.3g)", c.collinearity,
                                kMaxCollinearity);
     return Unavailable(u, message);
