@@ -305,14 +305,17 @@ void SetIntervals(BlockCovariance* c) {
 
 }  // namespace
 
+bool BlockCovarianceOptions::IsValid(std::string* error) const {
+  if (chunk_rows >= 1) return true;
+  *error =
+      StringPrintf("BlockCovarianceOptions::chunk_rows is %d: it must be at least 1", chunk_rows);
+  return false;
+}
+
 BlockCovariance EstimateBlockCovariance(const FitDescription& fit, const ResidualOptions& residual,
                                         const BlockCovarianceOptions& options) {
   BlockCovariance c;
-  if (!(options.chunk_rows >= 1)) {
-    return Unavailable(c, StringPrintf("BlockCovarianceOptions::chunk_rows is %d: it must be at "
-                                       "least 1",
-                                       options.chunk_rows));
-  }
+  if (!options.IsValid(&c.message)) return Unavailable(c, c.message);
   if (!Prepare(fit, residual, &c)) return Unavailable(c, c.message);
   if (c.some_standardised && !c.all_standardised) {
     c.warnings.push_back(

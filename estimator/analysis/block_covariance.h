@@ -72,6 +72,8 @@ struct BlockCovarianceOptions {
   // of order chunk_rows x k doubles; the result does not depend on it
   // beyond rounding.
   int chunk_rows = 4096;
+  // False, with the reason in `error`, for a setting out of its range.
+  bool IsValid(std::string* error) const;
 };
 
 struct BlockCovariance {

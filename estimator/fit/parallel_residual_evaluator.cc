@@ -200,11 +200,7 @@ ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, 
     size_ += block.size;
   }
   CHECK_GE(num_threads, 1);
-  iterate_.resize(size_);
-  for (size_t b = 0; b < blocks_.size(); ++b) {
-    std::copy(blocks_[b].values, blocks_[b].values + blocks_[b].size,
-              iterate_.begin() + offsets_[b]);
-  }
+  CopyBlocksTo(&iterate_);  // sized once: IterateEntry hands out pointers into it
 }
 
 ParallelResidualEvaluator::ParallelResidualEvaluator(const double* parameters, int size,
@@ -247,6 +243,13 @@ void ParallelResidualEvaluator::Reserve(int wrappers, int residuals) {
                    static_cast<size_t>(residuals) * (1 + size_));
 }
 
+void ParallelResidualEvaluator::CopyBlocksTo(std::vector<double>* point) const {
+  point->resize(size_);
+  for (size_t b = 0; b < blocks_.size(); ++b) {
+    std::copy(blocks_[b].values, blocks_[b].values + blocks_[b].size, point->begin() + offsets_[b]);
+  }
+}
+
 bool ParallelResidualEvaluator::AtLastPoint() const {
   for (size_t b = 0; b < blocks_.size(); ++b) {
     const double* last = last_point_.data() + offsets_[b];
@@ -267,22 +270,15 @@ const double* ParallelResidualEvaluator::IterateEntry(const double* value) const
 
 void ParallelResidualEvaluator::PrepareForEvaluation(bool evaluate_jacobians,
                                                      bool /*new_evaluation_point*/) {
-  if (evaluate_jacobians) {
-    for (size_t b = 0; b < blocks_.size(); ++b) {
-      std::copy(blocks_[b].values, blocks_[b].values + blocks_[b].size,
-                iterate_.begin() + offsets_[b]);
-    }
-  }
   // Ceres has copied the point into the caller's blocks. The same point
   // again (the Jacobian at an accepted step, a line search's trial step and
   // the trust-region candidate): the values, Jacobians included, are there.
-  if (computed_ && AtLastPoint()) return;
-  last_point_.resize(size_);
-  for (size_t b = 0; b < blocks_.size(); ++b) {
-    std::copy(blocks_[b].values, blocks_[b].values + blocks_[b].size,
-              last_point_.begin() + offsets_[b]);
+  if (!computed_ || !AtLastPoint()) {
+    CopyBlocksTo(&last_point_);
+    PrecomputeAll();
   }
-  PrecomputeAll();
+  // last_point_ now holds the caller's blocks either way.
+  if (evaluate_jacobians) std::copy(last_point_.begin(), last_point_.end(), iterate_.begin());
 }
 
 void ParallelResidualEvaluator::PrecomputeAll() {

@@ -110,6 +110,8 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   void PrecomputeAll();
   // The watched blocks hold last_point_.
   bool AtLastPoint() const;
+  // The watched blocks' values, concatenated, into `point` (resized to a point).
+  void CopyBlocksTo(std::vector<double>* point) const;
 
   const std::vector<Block> blocks_;
   std::vector<int> offsets_;  // of each block in a point
