@@ -14,9 +14,9 @@
 #include "dwellfit/config/config_override.h"
 #include "dwellfit/config/model_selection_config.h"
 #include "dwellfit/config/sweep_selection.h"
+#include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/fit/identification_options.h"
 #include "dwellfit/estimator/fit/initial_guess.h"
-#include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/fit/multi_start.h"
 
 namespace dwellfit {
@@ -62,10 +62,21 @@ struct IdentifyConfig {
 IdentifyConfig LoadIdentifyConfig(const std::string& path,
                                   const std::vector<ConfigOverride>& overrides = {});
 
-// The config in effect as YAML text that LoadIdentifyConfig accepts again,
-// with comments naming the source file and the overrides (for printing and
-// for result.yaml provenance). Paths are absolute; omega is in Hz.
-std::string ConfigToYaml(const IdentifyConfig& config);
+// Which keys ConfigToYaml writes.
+enum class ConfigKeys {
+  // Every key, after a comment naming the source file and the overrides.
+  kAll,
+  // Only the keys that can change the result: without output_dir,
+  // solver.num_threads and multi_start.threads, and without the comment, so
+  // that one input gives one result.yaml wherever it is written and on any
+  // thread count.
+  kAffectingTheResult,
+};
+
+// The config in effect as YAML text that LoadIdentifyConfig accepts again
+// (for printing, and for result.yaml's provenance). Paths are absolute;
+// omega is in Hz.
+std::string ConfigToYaml(const IdentifyConfig& config, ConfigKeys keys = ConfigKeys::kAll);
 
 }  // namespace dwellfit
 

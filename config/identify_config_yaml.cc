@@ -105,7 +105,8 @@ void EmitInitialGuess(YAML::Emitter& out, const IdentifyConfig& config) {
 }
 
 // fixed, stages, residual and solver: how the fit runs.
-void EmitFitSettings(YAML::Emitter& out, const IdentificationOptions& identification) {
+void EmitFitSettings(YAML::Emitter& out, const IdentificationOptions& identification,
+                     ConfigKeys keys) {
   out << YAML::Key << "fixed" << YAML::Value << YAML::Flow << YAML::BeginSeq;
   for (int i = 0; i < kNumParameters; ++i) {
     if (identification.fixed[i]) out << ParameterName(i);
@@ -130,17 +131,22 @@ void EmitFitSettings(YAML::Emitter& out, const IdentificationOptions& identifica
   out << YAML::Key << "gradient_tolerance" << YAML::Value << ExactNumber(solver.gradient_tolerance);
   out << YAML::Key << "parameter_tolerance" << YAML::Value
       << ExactNumber(solver.parameter_tolerance);
-  out << YAML::Key << "num_threads" << YAML::Value << solver.num_threads;
+  if (keys == ConfigKeys::kAll) {
+    out << YAML::Key << "num_threads" << YAML::Value << solver.num_threads;
+  }
   out << YAML::Key << "nonmonotonic_steps" << YAML::Value << solver.nonmonotonic_steps;
   out << YAML::EndMap;
 }
 
-void EmitMultiStartAndJumpDetection(YAML::Emitter& out, const IdentifyConfig& config) {
+void EmitMultiStartAndJumpDetection(YAML::Emitter& out, const IdentifyConfig& config,
+                                    ConfigKeys keys) {
   out << YAML::Key << "multi_start" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "starts" << YAML::Value << config.multi_start.starts;
   out << YAML::Key << "spread" << YAML::Value << ExactNumber(config.multi_start.spread);
   out << YAML::Key << "seed" << YAML::Value << config.multi_start.seed;
-  out << YAML::Key << "threads" << YAML::Value << config.multi_start.threads;
+  if (keys == ConfigKeys::kAll) {
+    out << YAML::Key << "threads" << YAML::Value << config.multi_start.threads;
+  }
   out << YAML::EndMap;
 
   const JumpDetectionOptions& jump_detection = config.jump_detection;
@@ -182,13 +188,15 @@ void EmitModelSelection(YAML::Emitter& out, const ModelSelectionConfig& selectio
 
 }  // namespace
 
-std::string ConfigToYaml(const IdentifyConfig& config) {
+std::string ConfigToYaml(const IdentifyConfig& config, ConfigKeys keys) {
   YAML::Emitter out;
-  std::string header = "Configuration in effect, loaded from " + config.config_path;
-  for (const ConfigOverride& applied : config.overrides) {
-    header += "\noverride: " + DescribeOverride(applied);
+  if (keys == ConfigKeys::kAll) {
+    std::string header = "Configuration in effect, loaded from " + config.config_path;
+    for (const ConfigOverride& applied : config.overrides) {
+      header += "\noverride: " + DescribeOverride(applied);
+    }
+    out << YAML::Comment(header) << YAML::Newline;
   }
-  out << YAML::Comment(header) << YAML::Newline;
   out << YAML::BeginMap;
   out << YAML::Key << "data" << YAML::Value << YAML::Flow << YAML::BeginSeq;
   for (const std::string& file : config.data_files) out << file;
@@ -196,9 +204,9 @@ std::string ConfigToYaml(const IdentifyConfig& config) {
   EmitSelections(out, "fit", config.fit_sweeps);
   EmitSelections(out, "validate", config.validate_sweeps);
   EmitInitialGuess(out, config);
-  EmitFitSettings(out, config.identification);
+  EmitFitSettings(out, config.identification, keys);
   EmitPenalties(out, config.identification.penalties);
-  EmitMultiStartAndJumpDetection(out, config);
+  EmitMultiStartAndJumpDetection(out, config, keys);
   EmitJumpOverrides(out, config.jump_overrides);
   if (config.omega_ref_rad_s.has_value()) {
     out << YAML::Key << "effective_nonlinearity_reference_hz" << YAML::Value
@@ -206,7 +214,8 @@ std::string ConfigToYaml(const IdentifyConfig& config) {
         << YAML::Comment(ExactNumber(*config.omega_ref_rad_s) + " rad/s");
   }  // unset: the identified omega (the key's default)
   if (config.model_selection.has_value()) EmitModelSelection(out, *config.model_selection);
-  out << YAML::Key << "output_dir" << YAML::Value << config.output_dir;
+  if (keys == ConfigKeys::kAll)
+    out << YAML::Key << "output_dir" << YAML::Value << config.output_dir;
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

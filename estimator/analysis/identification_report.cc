@@ -196,6 +196,22 @@ void EmitSweep(const SweepPrediction& prediction, YAML::Emitter* out) {
   *out << YAML::EndMap;
 }
 
+// Appends `mapping` (YAML text of a block mapping) to the top-level block
+// mapping `yaml` as the value of `key`, every line indented two spaces, as
+// text: the configuration is already YAML, and parsing it again to emit it
+// cost as much as writing the rest of result.yaml.
+void AppendBlockMapping(const char* key, const std::string& mapping, std::string* yaml) {
+  yaml->append(key).append(":\n");
+  std::size_t begin = 0;
+  while (begin < mapping.size()) {
+    std::size_t end = mapping.find('\n', begin);
+    if (end == std::string::npos) end = mapping.size();
+    if (end > begin) yaml->append("  ").append(mapping, begin, end - begin);
+    yaml->push_back('\n');
+    begin = end + 1;
+  }
+}
+
 }  // namespace
 
 std::string ReportToYaml(const IdentificationReport& report) {
@@ -220,11 +236,12 @@ std::string ReportToYaml(const IdentificationReport& report) {
   out << YAML::Key << "sweeps" << YAML::Value << YAML::BeginSeq;
   for (const SweepPrediction& prediction : report.predictions) EmitSweep(prediction, &out);
   out << YAML::EndSeq;
-  if (!report.config_in_effect.empty()) {
-    out << YAML::Key << "config_in_effect" << YAML::Value << YAML::Load(report.config_in_effect);
-  }
   out << YAML::EndMap;
-  return std::string(out.c_str()) + "\n";
+  std::string yaml = std::string(out.c_str()) + "\n";
+  if (!report.config_in_effect.empty()) {
+    AppendBlockMapping("config_in_effect", report.config_in_effect, &yaml);
+  }
+  return yaml;
 }
 
 std::string ReportToPredictionsCsv(const IdentificationReport& report) {

@@ -18,9 +18,9 @@ namespace dwellfit {
 
 struct IdentificationReport {
   std::string config_path;
-  // The configuration in effect (overrides applied) as YAML, recorded in
-  // result.yaml when set (identify leaves out output_dir and the thread
-  // counts, which cannot change the result).
+  // The configuration in effect (overrides applied) as a YAML block mapping,
+  // recorded in result.yaml when set (identify leaves out output_dir and the
+  // thread counts, which cannot change the result).
   std::string config_in_effect;
   IdentificationOptions options;  // the start and the fixed parameters
   IdentificationResult result;

@@ -13,7 +13,6 @@
 #include "glog/logging.h"
 #include "tbb/task_arena.h"
 #include "tbb/task_group.h"
-#include "yaml-cpp/yaml.h"
 
 namespace dwellfit {
 
@@ -58,19 +57,6 @@ void MarkUnidentifiable(IdentificationReport* report) {
   result.message =
       "the data cannot tell the free parameters apart: " + report->uncertainty.message + "; " +
       result.message;
-}
-
-// The configuration in effect as YAML, without the keys that cannot change
-// the result (where the files go, how many threads), so that one input gives
-// one result file.
-std::string ConfigAffectingTheResult(const IdentifyConfig& config) {
-  YAML::Node node = YAML::Load(ConfigToYaml(config));
-  node.remove("output_dir");
-  if (node["solver"]) node["solver"].remove("num_threads");
-  if (node["multi_start"]) node["multi_start"].remove("threads");
-  YAML::Emitter out;
-  out << node;
-  return out.c_str();
 }
 
 // What the run computes from the estimate once the fit has ended, side by
@@ -153,7 +139,7 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
   std::string predictions_csv;
   RunCurves curves;
   ComputeAfterFit(run, result, &outcome->report, &predictions_csv, &curves);
-  outcome->report.config_in_effect = ConfigAffectingTheResult(config);
+  outcome->report.config_in_effect = ConfigToYaml(config, ConfigKeys::kAffectingTheResult);
   MarkUnidentifiable(&outcome->report);
   const IdentificationReport& report = outcome->report;
   PrintReport(report, out);

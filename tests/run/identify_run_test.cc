@@ -43,7 +43,7 @@ TEST(RunIdentify, WithoutRenderingWritesTheScriptButNoImage) {
   std::ostringstream printed;
   IdentifyRunOptions options;
   options.render_figures = false;
-  RunIdentify(config, printed, options);
+  const auto outcome = RunIdentify(config, printed, options);
   const YAML::Node manifest = YAML::LoadFile(out_dir + "/manifest.yaml");
   std::vector<std::string> names;
   for (const YAML::Node& file : manifest["files"]) names.push_back(file["name"].as<std::string>());
@@ -52,8 +52,20 @@ TEST(RunIdentify, WithoutRenderingWritesTheScriptButNoImage) {
   const YAML::Node result = YAML::LoadFile(out_dir + "/result.yaml");
   EXPECT_EQ(result["status"].as<std::string>(), "converged");
   EXPECT_FALSE(result["dwellfit_version"].as<std::string>().empty());
-  EXPECT_EQ(result["config_in_effect"]["fit"].size(), 2u);
-  EXPECT_FALSE(result["config_in_effect"]["output_dir"]);
+  // The configuration as it reads back: every key that can change the result
+  // with its value, none that cannot (where the files go, the thread counts).
+  const YAML::Node in_effect = result["config_in_effect"];
+  EXPECT_EQ(in_effect["fit"].size(), 2u);
+  EXPECT_EQ(in_effect["solver"]["function_tolerance"].as<double>(),
+            config.identification.solver.function_tolerance);
+  EXPECT_EQ(in_effect["initial_guess"]["mu1"].as<double>(), *config.initial_guess[kMu1]);
+  EXPECT_FALSE(in_effect["output_dir"]);
+  EXPECT_FALSE(in_effect["solver"]["num_threads"]);
+  EXPECT_FALSE(in_effect["multi_start"]["threads"]);
+  EXPECT_TRUE(in_effect["multi_start"]["starts"]);
+  // Written after the rest of the report: the keys before it read as before.
+  EXPECT_EQ(result["fitted_points"].as<int>(), outcome->report.result.residual_blocks);
+  EXPECT_GT(result["fitted_points"].as<int>(), 100);
 }
 
 // A vertical stage run alone begins with the algebraic start stage, and
