@@ -1,6 +1,8 @@
 #include "dwellfit/estimator/run/run_figures.h"
 
 #include <algorithm>
+#include <string>
+#include <utility>
 
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/string_printf.h"
@@ -74,7 +76,7 @@ RunCurves TraceRunCurves(const ParameterVector& parameters,
   return traced;
 }
 
-void AppendCurvesAndFigures(const IdentificationReport& report, const RunCurves& traced,
+void AppendCurvesAndFigures(const IdentificationReport& report, RunCurves traced,
                             std::vector<NamedFile>* files, std::ostream& out, bool render) {
   if (!traced.warning.empty()) {
     out << "warning: " << traced.warning << "\n";
@@ -85,7 +87,7 @@ void AppendCurvesAndFigures(const IdentificationReport& report, const RunCurves&
   figures.corner_lines = EstimateLines(report);
   for (const ResponseCurve& curve : curves)
     figures.sweeps.push_back(MakeFigureSweep(report, curve));
-  files->emplace_back("curves.csv", traced.csv);
+  files->emplace_back("curves.csv", std::move(traced.csv));
   files->emplace_back(kFigureScriptName, GnuplotFigureScript(figures));
   if (!render) return;
   std::vector<NamedFile> inputs;

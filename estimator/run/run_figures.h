@@ -29,9 +29,9 @@ RunCurves TraceRunCurves(const ParameterVector& parameters,
 // Appends curves.csv and figures.gp to `files` (which must hold
 // predictions.csv, read by the script), and with `render` the images gnuplot
 // draws from them; `curves` are TraceRunCurves of the report's estimate and
-// sweeps. No curves, or a missing or failing gnuplot, is a warning on `out`
-// (and in the log), never an error.
-void AppendCurvesAndFigures(const IdentificationReport& report, const RunCurves& curves,
+// sweeps; their CSV text moves into `files`. No curves, or a missing or
+// failing gnuplot, is a warning on `out` (and in the log), never an error.
+void AppendCurvesAndFigures(const IdentificationReport& report, RunCurves curves,
                             std::vector<NamedFile>* files, std::ostream& out, bool render = true);
 
 // The estimates as the figures' corner shows them: "eta_e = 100 ± 0.02",
