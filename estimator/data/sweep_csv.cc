@@ -463,20 +463,26 @@ LoadedSweeps LoadSweepsCsv(const std::string& path) {
 
   std::vector<SweepBuilder> builders;
   std::map<std::pair<std::string, SweepDirection>, size_t> index_of;
+  std::size_t current = 0;  // the previous row's sweep in `builders`
   RowFields fields;
   while (ReadRow(path, &*reader, &fields)) {
     const Location where{path, static_cast<int>(reader->get_file_line())};
     const RowValues row = ParseRow(where, fields, columns);
-    const auto key = std::make_pair(row.id, row.direction);
-    auto found = index_of.find(key);
-    if (found == index_of.end()) {
-      found = index_of.emplace(key, builders.size()).first;
-      builders.emplace_back();
-      builders.back().sweep.id = row.id;
-      builders.back().sweep.direction = row.direction;
-      builders.back().sweep.source_file = path;
+    // Rows come sweep by sweep: most belong to the previous row's sweep.
+    const bool same_sweep = current < builders.size() && builders[current].sweep.id == row.id &&
+                            builders[current].sweep.direction == row.direction;
+    if (!same_sweep) {
+      const auto [found, inserted] =
+          index_of.emplace(std::make_pair(row.id, row.direction), builders.size());
+      if (inserted) {
+        builders.emplace_back();
+        builders.back().sweep.id = row.id;
+        builders.back().sweep.direction = row.direction;
+        builders.back().sweep.source_file = path;
+      }
+      current = found->second;
     }
-    AddRow(where, row, &builders[found->second]);
+    AddRow(where, row, &builders[current]);
   }
   if (builders.empty()) {
     throw InputError(path, header_line, "",
