@@ -57,8 +57,10 @@ SweepPrediction PredictSweep(const ParameterVector& parameters, const Sweep& swe
   double sum_squared = 0.0;
   double sum_squared_relative = 0.0;
   for (const DwellPoint& point : sweep.points) {
-    const StableRoot root = ModelAmplitude(parameters, point.drive_frequency_rad_s, point.a_base,
-                                           point.branch, point.amplitude);
+    // From the measured amplitude, as the vertical error's root solve (most
+    // dwells lie near their branch: no turning points to find).
+    const StableRoot root = ModelAmplitudeNear(parameters, point.drive_frequency_rad_s,
+                                               point.a_base, point.branch, point.amplitude);
     prediction.model.push_back(root);
     if (root.status == RootStatus::kBranchEnd) ++prediction.points_off_branch;
     const double error = root.a - point.amplitude;

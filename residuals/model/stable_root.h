@@ -297,6 +297,17 @@ inline StableRoot ModelAmplitude(const ParameterVector& p, double omega_drive_ra
   return root;
 }
 
+// ModelAmplitude through SolveStableRootNear: the same amplitude, faster
+// where `a_guess` (a measured amplitude) lies near its branch; the returned
+// `branch` is the requested one (see SolveStableRootNear).
+inline StableRoot ModelAmplitudeNear(const ParameterVector& p, double omega_drive_rad_s,
+                                     double a_base, Branch branch, double a_guess) {
+  const auto k = ResponseCoefficients<double>::FromParameters(p.data(), omega_drive_rad_s);
+  StableRoot root = SolveStableRootNear(k, a_base, branch, a_guess);
+  if (root.status != RootStatus::kFailed) root.a = LiftRoot(k, a_base, root);
+  return root;
+}
+
 }  // namespace dwellfit
 
 #endif  // DWELLFIT_RESIDUALS_MODEL_STABLE_ROOT_H_
