@@ -7,9 +7,9 @@
 #       stay shared.
 #
 # Why: a run of identify on a small dataset takes a few milliseconds of
-# arithmetic, and the dynamic loader mapping and relocating 29 shared libraries
-# took some 2.5 ms more of every process (docs/performance.md). Linked this way
-# a tool loads 9. When an archive is missing the build says which and links
+# arithmetic, and the dynamic loader mapping and relocating 27 shared libraries
+# took some 2 ms more of every process (docs/performance.md). Linked this way
+# a tool loads 8. When an archive is missing the build says which and links
 # everything shared, as before.
 #
 # Off by default when dwellfit is built inside a host project (add_subdirectory):
