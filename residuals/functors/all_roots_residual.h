@@ -42,9 +42,7 @@ class AllRootsResidual {
       : drive_frequency_rad_s_(drive_frequency_rad_s),
         a_base_(a_base),
         a_measured_(a_measured),
-        error_(error),
-        weight_(weight),
-        amplitude_floor_(amplitude_floor) {}
+        amplitude_error_(a_measured, error, weight, amplitude_floor) {}
 
   template <typename T>
   bool operator()(const T* const parameters, T* residual) const {
@@ -53,7 +51,7 @@ class AllRootsResidual {
     if (!NearestStableRoot(ScalarCoefficients(k), a_base_, a_measured_, &root.a)) return false;
     root.status = RootStatus::kOnBranch;
     const T a_model = LiftRoot(k, a_base_, root);
-    return AmplitudeError(a_measured_, a_model, error_, weight_, amplitude_floor_, residual);
+    return amplitude_error_(a_model, residual);
   }
 
   static ceres::CostFunction* Create(double drive_frequency_rad_s, double a_base, double a_measured,
@@ -68,9 +66,7 @@ class AllRootsResidual {
   const double drive_frequency_rad_s_;
   const double a_base_;
   const double a_measured_;
-  const ErrorMeasure error_;
-  const double weight_;
-  const double amplitude_floor_;  // f, the data's amplitude unit
+  const AmplitudeError amplitude_error_;
 };
 
 }  // namespace dwellfit

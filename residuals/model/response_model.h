@@ -52,6 +52,14 @@ struct ResponseCoefficients {
   }
   // dG/da = 2 (P P' + Q Q'); its sign is the stability of a fixed point.
   T dG(const T& a) const { return 2.0 * (P(a) * dP(a) + Q(a) * dQ(a)); }
+  // G(a) - target and dG/da together, P and Q formed once: the same values,
+  // bit for bit, as G(a) - target and dG(a).
+  void GMinusAndSlope(const T& a, double target, T* value, T* slope) const {
+    const T p = P(a);
+    const T q = Q(a);
+    *value = p * p + q * q - target;
+    *slope = 2.0 * (p * dP(a) + q * dQ(a));
+  }
   // d2G/da2 = 2 (P'^2 + P P'' + Q'^2 + Q Q'') with P'' = 2 k2, Q'' = 6 k4 a.
   T d2G(const T& a) const {
     const T dp = dP(a);

@@ -72,7 +72,11 @@ double ExpandUntil(double hi, const Predicate& positive) {
 
 }  // namespace internal
 
-inline TurningPoints FindTurningPoints(const ResponseCoefficients<double>& k) {
+// The turning points of G on a > 0; `branch` names the one wanted (kLower:
+// a_lower_end alone, kUpper: a_upper_end alone, the other left 0; kOnly:
+// both). A turning point computed is the same value either way.
+inline TurningPoints FindTurningPoints(const ResponseCoefficients<double>& k,
+                                       Branch branch = Branch::kOnly) {
   TurningPoints tp;
   const double c4 = k.c4();
   const double c6 = k.c6();
@@ -103,8 +107,8 @@ inline TurningPoints FindTurningPoints(const ResponseCoefficients<double>& k) {
     return v > 0.0;
   });
   if (!std::isfinite(h_hi)) return tp;
-  tp.a_lower_end = BracketedNewton(h, 0.0, a_h_min, 0.5 * a_h_min);
-  tp.a_upper_end = BracketedNewton(h, a_h_min, h_hi, h_hi);
+  if (branch != Branch::kUpper) tp.a_lower_end = BracketedNewton(h, 0.0, a_h_min, 0.5 * a_h_min);
+  if (branch != Branch::kLower) tp.a_upper_end = BracketedNewton(h, a_h_min, h_hi, h_hi);
   tp.exist = std::isfinite(tp.a_lower_end) && std::isfinite(tp.a_upper_end);
   return tp;
 }
@@ -130,14 +134,13 @@ inline StableRoot SolveStableRoot(const ResponseCoefficients<double>& k, double 
   const double target = a_base * a_base;
   if (!(target > 0.0) || !std::isfinite(k.k1 + k.k2 + k.k3 + k.k4)) return root;
   auto residual = [&k, target](double a, double* value, double* slope) {
-    *value = k.G(a) - target;
-    *slope = k.dG(a);
+    k.GMinusAndSlope(a, target, value, slope);
   };
   auto upper_bracket_end = [&](double start) {
     return internal::ExpandUntil(start, [&](double a) { return k.G(a) > target; });
   };
   const double guess = a_guess > 0.0 ? a_guess : std::numeric_limits<double>::quiet_NaN();
-  const TurningPoints tp = FindTurningPoints(k);
+  const TurningPoints tp = FindTurningPoints(k, branch);
   if (!tp.exist) {
     const double hi = upper_bracket_end(guess > 0.0 ? guess : std::sqrt(a_base));
     if (!std::isfinite(hi)) return root;
@@ -145,12 +148,13 @@ inline StableRoot SolveStableRoot(const ResponseCoefficients<double>& k, double 
     root.status = std::isfinite(root.a) ? RootStatus::kOnBranch : RootStatus::kFailed;
     return root;
   }
-  const bool lower_exists = k.G(tp.a_lower_end) > target;
-  const bool upper_exists = k.G(tp.a_upper_end) < target;
+  // Whether each branch reaches a_base (asked only of a turning point found).
+  auto lower_exists = [&]() { return k.G(tp.a_lower_end) > target; };
+  auto upper_exists = [&]() { return k.G(tp.a_upper_end) < target; };
   auto lower = [&]() {
     StableRoot r;
     r.branch = Branch::kLower;
-    if (lower_exists) {
+    if (lower_exists()) {
       r.a = BracketedNewton(residual, 0.0, tp.a_lower_end, guess);
       r.status = RootStatus::kOnBranch;
     } else {
@@ -162,7 +166,7 @@ inline StableRoot SolveStableRoot(const ResponseCoefficients<double>& k, double 
   auto upper = [&]() {
     StableRoot r;
     r.branch = Branch::kUpper;
-    if (upper_exists) {
+    if (upper_exists()) {
       const double hi = upper_bracket_end(std::max(2.0 * tp.a_upper_end, guess));
       if (!std::isfinite(hi)) return r;
       r.a = BracketedNewton(residual, tp.a_upper_end, hi, guess);
@@ -181,12 +185,12 @@ inline StableRoot SolveStableRoot(const ResponseCoefficients<double>& k, double 
       root = upper();
       break;
     case Branch::kOnly:
-      if (lower_exists && upper_exists) {
+      if (lower_exists() && upper_exists()) {
         const StableRoot l = lower();
         const StableRoot u = upper();
         root = std::abs(l.a - a_guess) <= std::abs(u.a - a_guess) ? l : u;
       } else {
-        root = lower_exists ? lower() : upper();
+        root = lower_exists() ? lower() : upper();
       }
       break;
   }
@@ -242,9 +246,10 @@ inline StableRoot SolveStableRootNear(const ResponseCoefficients<double>& k, dou
     const double target = a_base * a_base;
     double a = a_guess;
     for (int i = 0; i < 30; ++i) {
-      const double slope = k.dG(a);
+      double value, slope;
+      k.GMinusAndSlope(a, target, &value, &slope);
       if (!(slope > 0.0)) break;
-      const double step = (k.G(a) - target) / slope;
+      const double step = value / slope;
       a -= step;
       if (!(a > 0.0) || !std::isfinite(a)) break;
       if (std::abs(step) <= 4.0 * std::numeric_limits<double>::epsilon() * a) {
@@ -271,7 +276,9 @@ template <typename T>
 T LiftRoot(const ResponseCoefficients<T>& k, double a_base, const StableRoot& root) {
   const T a0(root.a);
   if (root.status == RootStatus::kBranchEnd) return a0 - k.dG(a0) / k.d2G(a0);
-  return a0 - (k.G(a0) - a_base * a_base) / k.dG(a0);
+  T value, slope;
+  k.GMinusAndSlope(a0, a_base * a_base, &value, &slope);
+  return a0 - value / slope;
 }
 
 inline double ScalarPart(double x) { return x; }
