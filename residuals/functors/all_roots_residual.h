@@ -42,7 +42,9 @@ class AllRootsResidual {
       : drive_frequency_rad_s_(drive_frequency_rad_s),
         a_base_(a_base),
         a_measured_(a_measured),
-        amplitude_error_(a_measured, error, weight, amplitude_floor) {}
+        error_(error),
+        weight_(weight),
+        amplitude_floor_(amplitude_floor) {}
 
   template <typename T>
   bool operator()(const T* const parameters, T* residual) const {
@@ -51,7 +53,7 @@ class AllRootsResidual {
     if (!NearestStableRoot(ScalarCoefficients(k), a_base_, a_measured_, &root.a)) return false;
     root.status = RootStatus::kOnBranch;
     const T a_model = LiftRoot(k, a_base_, root);
-    return amplitude_error_(a_model, residual);
+    return AmplitudeError(a_measured_, a_model, error_, weight_, amplitude_floor_, residual);
   }
 
   static ceres::CostFunction* Create(double drive_frequency_rad_s, double a_base, double a_measured,
@@ -66,7 +68,9 @@ class AllRootsResidual {
   const double drive_frequency_rad_s_;
   const double a_base_;
   const double a_measured_;
-  const AmplitudeError amplitude_error_;
+  const ErrorMeasure error_;
+  const double weight_;
+  const double amplitude_floor_;  // f, the data's amplitude unit
 };
 
 }  // namespace dwellfit

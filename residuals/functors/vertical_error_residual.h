@@ -52,38 +52,21 @@ enum class ErrorMeasure {
   kRelative,  // ln(a_i + f) - ln(a_model + f), f the amplitude floor
 };
 
-// The weighted error of a model amplitude against one measured amplitude a_i,
-// as `error` measures it; the measured side (ln(a_i + f) for kRelative) is
-// formed once, not at every evaluation.
-class AmplitudeError {
- public:
-  AmplitudeError(double a_measured, ErrorMeasure error, double weight, double amplitude_floor)
-      : error_(error),
-        weight_(weight),
-        amplitude_floor_(amplitude_floor),
-        measured_term_(error == ErrorMeasure::kAbsolute ? a_measured
-                                                        : std::log(a_measured + amplitude_floor)) {}
-
-  // False where the error is undefined: the log of a model amplitude that is
-  // not positive, or a value that is not finite (a root that overflowed at an
-  // extreme trial step).
-  template <typename T>
-  bool operator()(const T& a_model, T* residual) const {
-    if (error_ == ErrorMeasure::kAbsolute) {
-      *residual = weight_ * (measured_term_ - a_model);
-    } else {
-      if (!(ScalarPart(a_model) > 0.0)) return false;
-      *residual = weight_ * (measured_term_ - log(a_model + amplitude_floor_));
-    }
-    return std::isfinite(ScalarPart(*residual));
+// The weighted error of a model amplitude against a measured one, as
+// `error` measures it. False where it is undefined: the log of a model
+// amplitude that is not positive, or a value that is not finite (a root that
+// overflowed at an extreme trial step).
+template <typename T>
+bool AmplitudeError(double a_measured, const T& a_model, ErrorMeasure error, double weight,
+                    double amplitude_floor, T* residual) {
+  if (error == ErrorMeasure::kAbsolute) {
+    *residual = weight * (a_measured - a_model);
+  } else {
+    if (!(ScalarPart(a_model) > 0.0)) return false;
+    *residual = weight * (std::log(a_measured + amplitude_floor) - log(a_model + amplitude_floor));
   }
-
- private:
-  ErrorMeasure error_;
-  double weight_;
-  double amplitude_floor_;  // f, the data's amplitude unit
-  double measured_term_;    // a_i (kAbsolute) or ln(a_i + f) (kRelative)
-};
+  return std::isfinite(ScalarPart(*residual));
+}
 
 class VerticalErrorResidual {
  public:
@@ -94,7 +77,9 @@ class VerticalErrorResidual {
         a_base_(a_base),
         a_measured_(a_measured),
         branch_(branch),
-        amplitude_error_(a_measured, error, weight, amplitude_floor) {}
+        error_(error),
+        weight_(weight),
+        amplitude_floor_(amplitude_floor) {}
 
   template <typename T>
   bool operator()(const T* const parameters, T* residual) const {
@@ -109,7 +94,7 @@ class VerticalErrorResidual {
       last_root_.store(root.a, std::memory_order_relaxed);
     }
     const T a_model = LiftRoot(k, a_base_, root);
-    return amplitude_error_(a_model, residual);
+    return AmplitudeError(a_measured_, a_model, error_, weight_, amplitude_floor_, residual);
   }
 
   // The next evaluation starts its Newton iteration from a_i, as the first
@@ -135,7 +120,9 @@ class VerticalErrorResidual {
   const double a_base_;
   const double a_measured_;
   const Branch branch_;
-  const AmplitudeError amplitude_error_;
+  const ErrorMeasure error_;
+  const double weight_;
+  const double amplitude_floor_;  // f, the data's amplitude unit
   // The root at the last evaluation (0: none yet): the next Newton start.
   // Atomic so that concurrent evaluations stay well defined.
   mutable std::atomic<double> last_root_{0.0};
