@@ -31,7 +31,7 @@ class AlgebraicResidual {
   template <typename T>
   bool operator()(const T* const parameters, T* residual) const {
     const auto k = ResponseCoefficients<T>::FromParameters(parameters, drive_frequency_rad_s_);
-    residual[0] = weight_ * (k.G(T(a_measured_)) - a_base_squared_) / a_base_squared_;
+    residual[0] = weight_ * (k.G(a_measured_) - a_base_squared_) / a_base_squared_;
     // Undefined evaluation: a trial step where G overflows (eta_e -> 0).
     return std::isfinite(ScalarPart(residual[0]));
   }

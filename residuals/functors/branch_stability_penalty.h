@@ -44,7 +44,7 @@ class BranchStabilityPenalty {
       residual[0] = T(0.0);
       return true;
     }
-    const T a0(upper_ ? tp.a_upper_end : tp.a_lower_end);
+    const double a0 = upper_ ? tp.a_upper_end : tp.a_lower_end;
     const T a_fold = a0 - k.dG(a0) / k.d2G(a0);
     const T excess = upper_ ? a_fold - a_measured_ : a_measured_ - a_fold;
     residual[0] = sqrt_weight_ * exp(0.5 * lambda_ * excess);

@@ -43,7 +43,7 @@ class FoldConditionResidual {
   template <typename T>
   bool operator()(const T* const p, T* residual) const {
     const auto k = ResponseCoefficients<T>::FromParameters(p, drive_frequency_rad_s_);
-    const T a(a_jump_);
+    const double a = a_jump_;
     residual[0] = weight_ * (k.G(a) - a_base_squared_) / a_base_squared_;
     residual[1] = weight_ * a * k.dG(a) / a_base_squared_;
     return std::isfinite(ScalarPart(residual[0])) && std::isfinite(ScalarPart(residual[1]));

@@ -36,7 +36,7 @@ class PhaseLagResidual {
   template <typename T>
   bool operator()(const T* const parameters, T* residual) const {
     const auto k = ResponseCoefficients<T>::FromParameters(parameters, drive_frequency_rad_s_);
-    const T a(a_measured_);
+    const double a = a_measured_;
     residual[0] = weight_ * (in_quadrature_ - k.P(a));
     residual[1] = weight_ * (in_phase_ - k.Q(a));
     // Undefined evaluation: a trial step where 1/eta_e overflows.

@@ -69,7 +69,7 @@ inline FoldPoint SolveAmplitudeFold(const double* p, double omega_drive_rad_s, J
 template <typename T>
 T LiftAmplitudeFold(const T* p, double omega_drive_rad_s, const FoldPoint& fold) {
   const auto k = ResponseCoefficients<T>::FromParameters(p, omega_drive_rad_s);
-  const T a0(fold.a);
+  const double a0 = fold.a;
   const T a = a0 - k.dG(a0) / k.d2G(a0);
   return sqrt(k.G(a));
 }

@@ -38,30 +38,51 @@ struct ResponseCoefficients {
     return k;
   }
 
-  T P(const T& a) const { return (k1 + k2 * a) * a; }
-  T Q(const T& a) const { return (k3 + k4 * a * a) * a; }
-  T dP(const T& a) const { return k1 + 2.0 * k2 * a; }
-  T dQ(const T& a) const { return k3 + 3.0 * k4 * a * a; }
+  // The amplitude `a` is a T, or a double where it is a constant (a root
+  // found in double and lifted to Jets): the same values, with no
+  // derivative part carried for it.
+  template <typename A>
+  T P(const A& a) const {
+    return (k1 + k2 * a) * a;
+  }
+  template <typename A>
+  T Q(const A& a) const {
+    return (k3 + k4 * a * a) * a;
+  }
+  template <typename A>
+  T dP(const A& a) const {
+    return k1 + 2.0 * k2 * a;
+  }
+  template <typename A>
+  T dQ(const A& a) const {
+    return k3 + 3.0 * k4 * a * a;
+  }
 
   // G(a) of (3.11), evaluated as P^2 + Q^2 (better conditioned than the
   // expanded sextic).
-  T G(const T& a) const {
+  template <typename A>
+  T G(const A& a) const {
     const T p = P(a);
     const T q = Q(a);
     return p * p + q * q;
   }
   // dG/da = 2 (P P' + Q Q'); its sign is the stability of a fixed point.
-  T dG(const T& a) const { return 2.0 * (P(a) * dP(a) + Q(a) * dQ(a)); }
+  template <typename A>
+  T dG(const A& a) const {
+    return 2.0 * (P(a) * dP(a) + Q(a) * dQ(a));
+  }
   // G(a) - target and dG/da together, P and Q formed once: the same values,
   // bit for bit, as G(a) - target and dG(a).
-  void GMinusAndSlope(const T& a, double target, T* value, T* slope) const {
+  template <typename A>
+  void GMinusAndSlope(const A& a, double target, T* value, T* slope) const {
     const T p = P(a);
     const T q = Q(a);
     *value = p * p + q * q - target;
     *slope = 2.0 * (p * dP(a) + q * dQ(a));
   }
   // d2G/da2 = 2 (P'^2 + P P'' + Q'^2 + Q Q'') with P'' = 2 k2, Q'' = 6 k4 a.
-  T d2G(const T& a) const {
+  template <typename A>
+  T d2G(const A& a) const {
     const T dp = dP(a);
     const T dq = dQ(a);
     return 2.0 * (dp * dp + P(a) * (2.0 * k2) + dq * dq + Q(a) * (6.0 * k4 * a));

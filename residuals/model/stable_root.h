@@ -274,7 +274,7 @@ inline StableRoot SolveStableRootNear(const ResponseCoefficients<double>& k, dou
 // end, F = dG/da (the turning point moves with the parameters).
 template <typename T>
 T LiftRoot(const ResponseCoefficients<T>& k, double a_base, const StableRoot& root) {
-  const T a0(root.a);
+  const double a0 = root.a;  // a constant: its Jet would carry a zero derivative
   if (root.status == RootStatus::kBranchEnd) return a0 - k.dG(a0) / k.d2G(a0);
   T value, slope;
   k.GMinusAndSlope(a0, a_base * a_base, &value, &slope);
