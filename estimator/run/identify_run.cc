@@ -66,14 +66,20 @@ void MarkUnidentifiable(IdentificationReport* report) {
 // than they save (the thesis case, 456 dwells: 2 ms of work in all, no faster
 // on two threads). The beam's 24,576 gain.
 constexpr std::size_t kMinDwellsForThreadsAfterFit = 2048;
+// From this many dwells on they run one after the other again, for memory:
+// the covariance (its Jacobian and R factor) and the predictions (one per
+// dwell, and their CSV text) each hold some 180 bytes per dwell at their
+// peak, and side by side their peaks add. On a million dwells the run's peak
+// was 631 MB side by side and 447 MB one after the other.
+constexpr std::size_t kMaxDwellsForThreadsAfterFit = 100000;
 
 // What the run computes from the estimate once the fit has ended, side by
 // side on the run's threads (solver.num_threads) when there are enough
-// dwells, each part in its own variable so that none depends on which thread
-// runs it or when: the covariance into report->uncertainty, the predictions
-// of every sweep into report->predictions and `predictions_csv`, and the
-// response curves into `curves`. `report` comes without predictions and
-// uncertainty.
+// dwells and not too many, each part in its own variable so that none
+// depends on which thread runs it or when: the covariance into
+// report->uncertainty, the predictions of every sweep into
+// report->predictions and `predictions_csv`, and the response curves into
+// `curves`. `report` comes without predictions and uncertainty.
 void ComputeAfterFit(const ResolvedRun& run, const IdentificationResult& result,
                      IdentificationReport* report, std::string* predictions_csv,
                      RunCurves* curves) {
@@ -93,7 +99,8 @@ void ComputeAfterFit(const ResolvedRun& run, const IdentificationResult& result,
   };
   // Three parts: more threads would idle.
   const int threads = std::min(ResolveThreadCount(run.options.solver.num_threads), 3);
-  if (threads == 1 || dwells < kMinDwellsForThreadsAfterFit) {
+  if (threads == 1 || dwells < kMinDwellsForThreadsAfterFit ||
+      dwells >= kMaxDwellsForThreadsAfterFit) {
     estimate_uncertainty();
     trace_curves();
     predict();
