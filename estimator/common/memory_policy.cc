@@ -25,4 +25,6 @@ bool KeepFreedMemoryForReuse() {
   return mmap_threshold && trim_threshold && top_pad;
 }
 
+void ReturnFreedMemory() { malloc_trim(0); }
+
 }  // namespace dwellfit

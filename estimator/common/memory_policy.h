@@ -10,8 +10,10 @@
 // fault per 4 KiB, some 10 microseconds each on a virtual machine. Kept in
 // the heap instead, a freed block is reused as it is.
 //
-// The peak resident memory does not grow (the same blocks are live at the
-// peak); what a run has freed is simply not returned before it ends.
+// What a run has freed is not returned before it ends. That can raise the
+// peak resident memory where a phase that frees much is followed by one whose
+// blocks do not fit in the freed space (blocks of 32 MiB and more are still
+// mapped afresh): a run calls ReturnFreedMemory between the two.
 #ifndef DWELLFIT_ESTIMATOR_COMMON_MEMORY_POLICY_H_
 #define DWELLFIT_ESTIMATOR_COMMON_MEMORY_POLICY_H_
 
@@ -22,6 +24,12 @@ namespace dwellfit {
 // once, first thing in a tool's main; a library embedding dwellfit keeps its
 // own allocator policy. Returns whether every setting was accepted.
 bool KeepFreedMemoryForReuse();
+
+// Returns the pages of the heap's free memory to the kernel (malloc_trim);
+// blocks later served from them fault their pages in again. On a
+// million-dwell identify run, called after the fit: 15 ms, and the run's
+// peak 435 -> 336 MB resident.
+void ReturnFreedMemory();
 
 }  // namespace dwellfit
 

@@ -32,6 +32,46 @@ bool ProblemBuilderOptions::IsValid(std::string* error) const {
 
 ProblemBuilder::ProblemBuilder(const ProblemBuilderOptions& options) : options_(options) {}
 
+double ProblemBuilder::AmplitudeWeight(const DwellPoint& point) const {
+  double weight = options_.dwell_weight;
+  if (options_.residual_options.use_point_sigma && point.sigma) {
+    // sigma is the standard deviation of a; in relative error it becomes
+    // that of ln a, sigma / a.
+    weight *= options_.residual_options.error == ErrorMeasure::kAbsolute
+                  ? 1.0 / *point.sigma
+                  : (point.amplitude + options_.residual_options.amplitude_floor) / *point.sigma;
+  }
+  return weight;
+}
+
+ceres::CostFunction* ProblemBuilder::MakeBatch(
+    const std::vector<DwellPoint>& points, size_t first, size_t end,
+    std::vector<VerticalErrorResidual*>* warm_started) const {
+  if (options_.residual == ResidualKind::kAlgebraic) {
+    auto* batch = new FunctorBatch<AlgebraicResidual>();
+    for (size_t i = first; i < end; ++i) {
+      const DwellPoint& point = points[i];
+      batch->Add(point.drive_frequency_rad_s, point.a_base, point.amplitude, options_.dwell_weight);
+    }
+    return batch;
+  }
+  if (options_.residual == ResidualKind::kVertical) {
+    auto* batch = new FunctorBatch<VerticalErrorResidual>();
+    for (size_t i = first; i < end; ++i) {
+      const DwellPoint& point = points[i];
+      VerticalErrorResidual* functor =
+          batch->Add(point.drive_frequency_rad_s, point.a_base, point.amplitude, point.branch,
+                     options_.residual_options.error, AmplitudeWeight(point),
+                     options_.residual_options.amplitude_floor);
+      if (warm_started != nullptr) warm_started->push_back(functor);
+    }
+    return batch;
+  }
+  std::vector<ceres::CostFunction*> members;
+  for (size_t i = first; i < end; ++i) members.push_back(MakeResidual(points[i], warm_started));
+  return new BatchedCostFunction(std::move(members));
+}
+
 ceres::CostFunction* ProblemBuilder::MakeResidual(
     const DwellPoint& point, std::vector<VerticalErrorResidual*>* warm_started) const {
   if (options_.residual == ResidualKind::kAlgebraic) {
@@ -43,14 +83,7 @@ ceres::CostFunction* ProblemBuilder::MakeResidual(
     return PhaseLagResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
                                     point.phase_rad.value_or(0.0), options_.dwell_weight);
   }
-  double weight = options_.dwell_weight;
-  if (options_.residual_options.use_point_sigma && point.sigma) {
-    // sigma is the standard deviation of a; in relative error it becomes
-    // that of ln a, sigma / a.
-    weight *= options_.residual_options.error == ErrorMeasure::kAbsolute
-                  ? 1.0 / *point.sigma
-                  : (point.amplitude + options_.residual_options.amplitude_floor) / *point.sigma;
-  }
+  const double weight = AmplitudeWeight(point);
   if (options_.residual == ResidualKind::kAllRoots) {
     return AllRootsResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
                                     options_.residual_options.error, weight,
@@ -93,11 +126,8 @@ int ProblemBuilder::AddSweep(const Sweep& sweep, const ParameterLayout& layout,
   } else {
     const size_t count = sweep.points.size();
     for (size_t first = 0; first < count; first += kDwellsPerBatch) {
-      std::vector<ceres::CostFunction*> batch;
-      for (size_t i = first; i < std::min(count, first + kDwellsPerBatch); ++i) {
-        batch.push_back(MakeResidual(sweep.points[i], warm_started));
-      }
-      Add(new BatchedCostFunction(std::move(batch)), layout, problem, evaluator);
+      const size_t end = std::min(count, first + kDwellsPerBatch);
+      Add(MakeBatch(sweep.points, first, end, warm_started), layout, problem, evaluator);
     }
   }
   return static_cast<int>(sweep.points.size());

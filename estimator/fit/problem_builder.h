@@ -43,7 +43,8 @@ struct ProblemBuilderOptions {
   // Soft constraints of eqs. (3.17) and (3.19); AddPenalties adds them.
   PenaltyOptions penalties;
   // AddSweep puts up to ProblemBuilder::kDwellsPerBatch consecutive dwells in
-  // one residual block (BatchedCostFunction) instead of one block per dwell:
+  // one residual block (FunctorBatch, BatchedCostFunction) instead of one
+  // block per dwell:
   // Ceres' work and memory per block are then paid once per batch. Every
   // stage problem (stage_problem.h) batches; a caller that wants a residual
   // block per dwell keeps the default.
@@ -103,6 +104,14 @@ class ProblemBuilder {
   const ProblemBuilderOptions& options() const { return options_; }
 
  private:
+  // The weight of a dwell's amplitude error: dwell_weight, and 1/sigma of the
+  // error measured where the dwell carries its sigma and it is used.
+  double AmplitudeWeight(const DwellPoint& point) const;
+  // The residual block of dwells [first, end) of `points` (batch_dwells):
+  // the algebraic and the vertical error as a FunctorBatch, any other
+  // residual as a BatchedCostFunction of MakeResidual's cost functions.
+  ceres::CostFunction* MakeBatch(const std::vector<DwellPoint>& points, size_t first, size_t end,
+                                 std::vector<VerticalErrorResidual*>* warm_started) const;
   // Adds `cost` (on one 6-double block) as a residual block on `layout`.
   void Add(ceres::CostFunction* cost, const ParameterLayout& layout, ceres::Problem* problem,
            ParallelResidualEvaluator* evaluator) const;

@@ -7,6 +7,7 @@
 
 #include "dwellfit/estimator/analysis/parameter_uncertainty.h"
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
 #include "dwellfit/estimator/run/output_files.h"
@@ -66,16 +67,20 @@ void MarkUnidentifiable(IdentificationReport* report) {
 // than they save (the thesis case, 456 dwells: 2 ms of work in all, no faster
 // on two threads). The beam's 24,576 gain.
 constexpr std::size_t kMinDwellsForThreadsAfterFit = 2048;
-// From this many dwells on they run one after the other again, for memory:
-// the covariance (its Jacobian and R factor) and the predictions (one per
-// dwell, and their CSV text) each hold some 180 bytes per dwell at their
-// peak, and side by side their peaks add. On a million dwells the run's peak
-// was 631 MB side by side and 447 MB one after the other.
-constexpr std::size_t kMaxDwellsForThreadsAfterFit = 100000;
+// From this many dwells on the run keeps its memory down. The fit's freed
+// memory goes back to the kernel before the parts after it allocate theirs
+// (ReturnFreedMemory): kept, it stays resident beside their largest blocks,
+// which are mapped afresh. The parts run one after the other again: the
+// covariance (its Jacobian and R factor) and the predictions (one per dwell,
+// and their CSV text) each hold some 180 bytes per dwell at their peak, and
+// side by side their peaks add. On a million dwells the run's peak was
+// 631 MB side by side, 447 MB one after the other, 336 MB with the memory
+// returned as well (and the fit's dwells in FunctorBatch blocks).
+constexpr std::size_t kLargeRunDwells = 100000;
 
 // What the run computes from the estimate once the fit has ended, side by
 // side on the run's threads (solver.num_threads) when there are enough
-// dwells and not too many, each part in its own variable so that none
+// dwells and not too many (kLargeRunDwells), each part in its own variable so that none
 // depends on which thread runs it or when: the covariance into
 // report->uncertainty, the predictions of every sweep into
 // report->predictions and `predictions_csv`, and the response curves into
@@ -99,8 +104,9 @@ void ComputeAfterFit(const ResolvedRun& run, const IdentificationResult& result,
   };
   // Three parts: more threads would idle.
   const int threads = std::min(ResolveThreadCount(run.options.solver.num_threads), 3);
-  if (threads == 1 || dwells < kMinDwellsForThreadsAfterFit ||
-      dwells >= kMaxDwellsForThreadsAfterFit) {
+  const bool large = dwells >= kLargeRunDwells;
+  if (large) ReturnFreedMemory();
+  if (threads == 1 || dwells < kMinDwellsForThreadsAfterFit || large) {
     estimate_uncertainty();
     trace_curves();
     predict();

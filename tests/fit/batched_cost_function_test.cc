@@ -4,6 +4,8 @@
 #include <vector>
 
 #include "ceres/autodiff_cost_function.h"
+#include "dwellfit/residuals/functors/vertical_error_residual.h"
+#include "dwellfit/residuals/model/response_model.h"
 #include "gtest/gtest.h"
 
 namespace dwellfit {
@@ -85,6 +87,74 @@ TEST(BatchedCostFunction, FailsWhenAnyMemberFails) {
   const double between[] = {1.0};  // the second member fails (x0 < 2)
   const double* at_between[] = {between, y};
   EXPECT_FALSE(batch.Evaluate(at_between, r, nullptr));
+}
+
+// Dwells around the thesis model's fold at 40-42 Hz (w = 2 pi 40 rad/s), on
+// both branches and past their ends, with weights and a floor that differ.
+struct DwellArgs {
+  double omega_rad_s, a_base, a, weight;
+  Branch branch;
+};
+std::vector<DwellArgs> FoldDwells() {
+  std::vector<DwellArgs> dwells;
+  const Branch branches[] = {Branch::kLower, Branch::kUpper, Branch::kOnly};
+  for (int i = 0; i < 9; ++i) {
+    dwells.push_back(
+        {kTwoPi * (39.5 + 0.3 * i), 0.01, 0.0004 * (1 + i % 4), 1.0 + 0.1 * i, branches[i % 3]});
+  }
+  return dwells;
+}
+
+// A FunctorBatch of vertical errors gives, bit for bit, the residuals and
+// Jacobian rows of one AutoDiffCostFunction per dwell, at two points (the
+// second evaluation warm-starts each dwell's root), and its members' addresses
+// stay those Add returned.
+TEST(FunctorBatch, GivesEachDwellsAutodiffCostFunctionsValuesBitForBit) {
+  const std::vector<DwellArgs> dwells = FoldDwells();
+  FunctorBatch<VerticalErrorResidual> batch;
+  std::vector<std::unique_ptr<ceres::CostFunction>> alone;
+  std::vector<const VerticalErrorResidual*> added;
+  for (const DwellArgs& d : dwells) {
+    added.push_back(
+        batch.Add(d.omega_rad_s, d.a_base, d.a, d.branch, ErrorMeasure::kRelative, d.weight, 1e-6));
+    alone.emplace_back(VerticalErrorResidual::Create(d.omega_rad_s, d.a_base, d.a, d.branch,
+                                                     ErrorMeasure::kRelative, d.weight, 1e-6));
+  }
+  ASSERT_EQ(batch.num_residuals(), static_cast<int>(dwells.size()));
+  ASSERT_EQ(batch.parameter_block_sizes(), std::vector<int32_t>{kNumParameters});
+  for (size_t i = 1; i < added.size(); ++i) EXPECT_NE(added[i], added[i - 1]);
+  const ParameterVector points[] = {{100.0, 0.2, 300.0, 1.0e4, 9.0e8, kTwoPi * 40.0},
+                                    {104.0, 0.19, 310.0, 1.1e4, 9.3e8, kTwoPi * 40.1}};
+  for (const ParameterVector& p : points) {
+    const double* blocks[] = {p.data()};
+    std::vector<double> r(dwells.size()), j(dwells.size() * kNumParameters);
+    double* jacobians[] = {j.data()};
+    ASSERT_TRUE(batch.Evaluate(blocks, r.data(), jacobians));
+    std::vector<double> value_only(dwells.size());
+    ASSERT_TRUE(batch.Evaluate(blocks, value_only.data(), nullptr));
+    for (size_t i = 0; i < dwells.size(); ++i) {
+      double r_alone, j_alone[kNumParameters];
+      double* jacobians_alone[] = {j_alone};
+      ASSERT_TRUE(alone[i]->Evaluate(blocks, &r_alone, jacobians_alone));
+      EXPECT_EQ(r[i], r_alone) << "dwell " << i;
+      EXPECT_EQ(value_only[i], r_alone) << "dwell " << i;
+      for (int k = 0; k < kNumParameters; ++k) {
+        EXPECT_EQ(j[i * kNumParameters + k], j_alone[k]) << "dwell " << i << " entry " << k;
+      }
+    }
+  }
+}
+
+TEST(FunctorBatch, FailsWhenAnyMemberFails) {
+  const ParameterVector p = {100.0, 0.2, 300.0, 1.0e4, 9.0e8, kTwoPi * 40.0};
+  const double* blocks[] = {p.data()};
+  double r[2];
+  FunctorBatch<VerticalErrorResidual> batch;
+  batch.Add(kTwoPi * 40.0, 0.01, 0.001, Branch::kOnly, ErrorMeasure::kRelative, 1.0, 0.0);
+  EXPECT_TRUE(batch.Evaluate(blocks, r, nullptr));
+  // A drive level of 0 has no root to solve for: this member fails.
+  batch.Add(kTwoPi * 41.0, 0.0, 0.001, Branch::kOnly, ErrorMeasure::kRelative, 1.0, 0.0);
+  EXPECT_FALSE(batch.Evaluate(blocks, r, nullptr));
 }
 
 }  // namespace
