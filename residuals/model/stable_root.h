@@ -148,13 +148,14 @@ inline StableRoot SolveStableRoot(const ResponseCoefficients<double>& k, double 
     root.status = std::isfinite(root.a) ? RootStatus::kOnBranch : RootStatus::kFailed;
     return root;
   }
-  // Whether each branch reaches a_base (asked only of a turning point found).
-  auto lower_exists = [&]() { return k.G(tp.a_lower_end) > target; };
-  auto upper_exists = [&]() { return k.G(tp.a_upper_end) < target; };
+  // Whether each branch reaches a_base, once each (the branch whose turning
+  // point was not found is never asked for).
+  const bool lower_exists = branch != Branch::kUpper && k.G(tp.a_lower_end) > target;
+  const bool upper_exists = branch != Branch::kLower && k.G(tp.a_upper_end) < target;
   auto lower = [&]() {
     StableRoot r;
     r.branch = Branch::kLower;
-    if (lower_exists()) {
+    if (lower_exists) {
       r.a = BracketedNewton(residual, 0.0, tp.a_lower_end, guess);
       r.status = RootStatus::kOnBranch;
     } else {
@@ -166,7 +167,7 @@ inline StableRoot SolveStableRoot(const ResponseCoefficients<double>& k, double 
   auto upper = [&]() {
     StableRoot r;
     r.branch = Branch::kUpper;
-    if (upper_exists()) {
+    if (upper_exists) {
       const double hi = upper_bracket_end(std::max(2.0 * tp.a_upper_end, guess));
       if (!std::isfinite(hi)) return r;
       r.a = BracketedNewton(residual, tp.a_upper_end, hi, guess);
@@ -185,12 +186,12 @@ inline StableRoot SolveStableRoot(const ResponseCoefficients<double>& k, double 
       root = upper();
       break;
     case Branch::kOnly:
-      if (lower_exists() && upper_exists()) {
+      if (lower_exists && upper_exists) {
         const StableRoot l = lower();
         const StableRoot u = upper();
         root = std::abs(l.a - a_guess) <= std::abs(u.a - a_guess) ? l : u;
       } else {
-        root = lower_exists() ? lower() : upper();
+        root = lower_exists ? lower() : upper();
       }
       break;
   }
