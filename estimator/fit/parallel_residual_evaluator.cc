@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <thread>
 #include <utility>
@@ -18,11 +19,19 @@ namespace {
 
 // Residuals (dwells) each thread gets at the least (fewer threads below that).
 constexpr int kMinRowsPerThread = 256;
-// Every this many evaluations the way not preferred runs, to be timed again.
-constexpr std::int64_t kProbeInterval = 16;
-// The weight of the newest evaluation in the recent time of its way.
-constexpr double kRecentWeight = 0.25;
 
+// Which way (threaded or in the caller alone) this process's evaluators last
+// found faster, for the next evaluator to start with (0: none has compared
+// them yet, 1: threaded, 2: alone), and whether a threaded evaluation has run
+// in this process (the first starts TBB's worker threads, and its time says
+// nothing about the ways). Only a preference: no value depends on it.
+std::atomic<int> last_faster_way{0};
+std::atomic<bool> workers_started{false};
+// The threads are chosen only where their evaluations are this much faster:
+// a threaded evaluation also costs time outside itself (the workers that
+// wake, and that look for more work before they sleep, take processor time
+// from the caller's serial work on a busy machine).
+constexpr double kThreadedMargin = 1.15;
 }  // namespace
 
 int ResolveThreadCount(int num_threads) {
@@ -207,6 +216,9 @@ ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, 
     size_ += block.size;
   }
   CHECK_GE(num_threads, 1);
+  const int hint = last_faster_way.load(std::memory_order_relaxed);
+  started_from_hint_ = hint != 0;
+  prefer_threaded_ = hint != 2;
   CopyBlocksTo(&iterate_);  // sized once: IterateEntry hands out pointers into it
 }
 
@@ -299,13 +311,7 @@ void ParallelResidualEvaluator::PrecomputeAll() {
     for (int i = 0; i < count; ++i) wrappers_[i]->Precompute(copy);
     return;
   }
-  // The threads only where they pay on this machine now: each evaluation
-  // runs the way (threaded or in the caller alone) whose recent evaluations
-  // took less time, and every kProbeInterval-th tries the other way, so a
-  // machine that becomes busy or idle is followed. Which way runs changes no
-  // value.
-  const bool threaded_faster = threaded_seconds_ <= alone_seconds_;
-  const bool threaded = (++evaluations_ % kProbeInterval == 0) ? !threaded_faster : threaded_faster;
+  const bool threaded = ChooseThreaded();
   const auto start = std::chrono::steady_clock::now();
   if (!threaded) {
     for (int i = 0; i < count; ++i) wrappers_[i]->Precompute(copy);
@@ -322,10 +328,55 @@ void ParallelResidualEvaluator::PrecomputeAll() {
           tbb::simple_partitioner());
     });
   }
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  double& recent = threaded ? threaded_seconds_ : alone_seconds_;
-  recent = recent == 0.0 ? seconds : (1.0 - kRecentWeight) * recent + kRecentWeight * seconds;
+  RecordTime(threaded,
+             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+}
+
+double ParallelResidualEvaluator::RecentTimes::Typical() const {
+  if (count == 0) return 0.0;
+  if (count < static_cast<int>(seconds.size())) {
+    return *std::min_element(seconds.begin(), seconds.begin() + count);
+  }
+  std::array<double, 3> sorted = seconds;
+  std::sort(sorted.begin(), sorted.end());
+  return sorted[1];
+}
+
+// The threads only where they pay on this machine now. An evaluator starts
+// with the way this process's evaluators last found faster and tries the
+// other after kProbeInterval evaluations; the process's first evaluator
+// times both ways at once. Then each evaluation runs the way whose last three
+// took less time (their median: one evaluation the machine held up does not
+// tip the choice), and now and then the other, to follow a machine that
+// becomes busy or idle. A trial that leaves the choice as it was doubles the
+// wait before the next, so a machine that stays as it is pays for few.
+bool ParallelResidualEvaluator::ChooseThreaded() {
+  const RecentTimes& preferred = prefer_threaded_ ? threaded_times_ : alone_times_;
+  const RecentTimes& other = prefer_threaded_ ? alone_times_ : threaded_times_;
+  if (preferred.count == 0) return prefer_threaded_;
+  if (other.count == 0 && !started_from_hint_) return !prefer_threaded_;
+  if (++since_probe_ >= probe_interval_) {
+    since_probe_ = 0;
+    return !prefer_threaded_;
+  }
+  return prefer_threaded_;
+}
+
+void ParallelResidualEvaluator::RecordTime(bool threaded, double seconds) {
+  if (threaded && !workers_started.exchange(true, std::memory_order_relaxed)) return;
+  (threaded ? threaded_times_ : alone_times_).Add(seconds);
+  if (threaded_times_.count == 0 || alone_times_.count == 0) return;
+  const bool was_trial = threaded != prefer_threaded_;
+  const bool threaded_faster =
+      kThreadedMargin * threaded_times_.Typical() <= alone_times_.Typical();
+  if (threaded_faster != prefer_threaded_) {
+    prefer_threaded_ = threaded_faster;
+    probe_interval_ = kProbeInterval;
+    since_probe_ = 0;
+  } else if (was_trial) {
+    probe_interval_ = std::min(2 * probe_interval_, kMaxProbeInterval);
+  }
+  last_faster_way.store(prefer_threaded_ ? 1 : 2, std::memory_order_relaxed);
 }
 
 bool ParallelResidualEvaluator::CostGradient(const double* point, std::vector<double>* gradient) {

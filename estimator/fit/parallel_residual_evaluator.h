@@ -17,8 +17,10 @@
 // depend on the number of threads. Below 256 residuals per thread the
 // caller evaluates alone (handing work over costs microseconds), and above
 // it each evaluation runs on the threads or in the caller alone, whichever
-// has recently been faster (each tried again every 16 evaluations): on a
-// machine whose other cores are busy, more threads do not cost time.
+// has recently been faster by the median of its last three evaluations (the
+// threads by a margin), the other way tried again now and then, less often
+// while it keeps losing (ChooseThreaded): on a machine whose other cores are
+// busy, more threads do not cost time.
 //
 // A wrapped cost function (Wrap) keeps its own definition: for a dwell it is
 // the autodiff VerticalErrorResidual with its Newton root solve. Ceres then
@@ -36,6 +38,7 @@
 #ifndef DWELLFIT_ESTIMATOR_FIT_PARALLEL_RESIDUAL_EVALUATOR_H_
 #define DWELLFIT_ESTIMATOR_FIT_PARALLEL_RESIDUAL_EVALUATOR_H_
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -132,11 +135,30 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   std::int64_t replayed_ = 0;
   std::int64_t evaluated_directly_ = 0;
   // PrecomputeAll on the threads or in the caller alone, whichever is
-  // faster: the recent wall time of each way [s] (0: not timed yet), and the
-  // evaluations so far.
-  double threaded_seconds_ = 0.0;
-  double alone_seconds_ = 0.0;
-  std::int64_t evaluations_ = 0;
+  // faster (ChooseThreaded): the wall times of each way's last evaluations
+  // [s], the evaluations since the other way was last tried, and how many
+  // to wait before trying it again.
+  struct RecentTimes {
+    std::array<double, 3> seconds{};
+    int count = 0;  // timed so far, at most seconds.size() kept
+    void Add(double value) { seconds[count++ % seconds.size()] = value; }
+    // The median of the last three, the least of fewer (0: none yet).
+    double Typical() const;
+  };
+  bool ChooseThreaded();
+  // Records how long an evaluation took and which way it ran.
+  void RecordTime(bool threaded, double seconds);
+  RecentTimes threaded_times_;
+  RecentTimes alone_times_;
+  // The way not preferred runs again, to be timed, after kProbeInterval
+  // evaluations; after each such trial that leaves the preference as it
+  // was, twice as many, up to kMaxProbeInterval.
+  static constexpr int kProbeInterval = 16;
+  static constexpr int kMaxProbeInterval = 64;
+  bool prefer_threaded_ = true;
+  bool started_from_hint_ = false;  // prefer_threaded_ came from an earlier evaluator
+  int since_probe_ = 0;
+  int probe_interval_ = kProbeInterval;
 };
 
 }  // namespace dwellfit
