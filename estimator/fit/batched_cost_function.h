@@ -15,6 +15,8 @@
 #ifndef DWELLFIT_ESTIMATOR_FIT_BATCHED_COST_FUNCTION_H_
 #define DWELLFIT_ESTIMATOR_FIT_BATCHED_COST_FUNCTION_H_
 
+#include <algorithm>
+#include <array>
 #include <deque>
 #include <memory>
 #include <utility>
@@ -24,6 +26,7 @@
 #include "ceres/internal/autodiff.h"
 #include "ceres/internal/parameter_dims.h"
 #include "ceres/internal/variadic_evaluate.h"
+#include "ceres/jet.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 
 namespace dwellfit {
@@ -48,9 +51,11 @@ class BatchedCostFunction : public ceres::CostFunction {
 // ceres::AutoDiffCostFunction<Functor, 1, kNumParameters> each, with the
 // functors held side by side instead of a cost function object (and its
 // vector of block sizes) per dwell: on a million dwells some 100 MB less at a
-// fit's peak. Each member is evaluated by the code AutoDiffCostFunction runs
-// (Ceres' VariadicEvaluate without Jacobians, AutoDifferentiate with them),
-// so its residual and Jacobian row are the same numbers.
+// fit's peak. Each member is evaluated as AutoDiffCostFunction evaluates it
+// (Ceres' VariadicEvaluate without Jacobians; with them, on the parameters as
+// Jets seeded by Ceres' Make1stOrderPerturbations, as AutoDifferentiate does,
+// but seeded once per batch rather than once per member), so its residual and
+// Jacobian row are the same numbers.
 template <typename Functor>
 class FunctorBatch : public ceres::CostFunction {
  public:
@@ -68,17 +73,31 @@ class FunctorBatch : public ceres::CostFunction {
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
     using Dims = ceres::internal::StaticParameterDims<kNumParameters>;
-    for (size_t m = 0; m < functors_.size(); ++m) {
-      bool evaluated;
-      if (jacobians == nullptr) {
-        evaluated =
-            ceres::internal::VariadicEvaluate<Dims>(functors_[m], parameters, residuals + m);
-      } else {
-        double* row[] = {jacobians[0] == nullptr ? nullptr : jacobians[0] + m * kNumParameters};
-        evaluated = ceres::internal::AutoDifferentiate<1, Dims>(functors_[m], parameters, 1,
-                                                                residuals + m, row);
+    if (jacobians == nullptr) {
+      for (size_t m = 0; m < functors_.size(); ++m) {
+        if (!ceres::internal::VariadicEvaluate<Dims>(functors_[m], parameters, residuals + m)) {
+          return false;
+        }
       }
-      if (!evaluated) return false;
+      return true;
+    }
+    // The parameters as Jets, seeded as AutoDifferentiate seeds them, once for
+    // every member (each reads them as const); then each member's residual
+    // and Jacobian row as AutoDifferentiate takes them.
+    using JetT = ceres::Jet<double, kNumParameters>;
+    std::array<JetT, kNumParameters> point;
+    ceres::internal::Make1stOrderPerturbations<Dims::Parameters>::Apply(parameters, point.data());
+    const JetT* blocks[] = {point.data()};
+    for (size_t m = 0; m < functors_.size(); ++m) {
+      JetT residual;
+      residual.a = ceres::kImpossibleValue;
+      residual.v.setConstant(ceres::kImpossibleValue);
+      if (!ceres::internal::VariadicEvaluate<Dims>(functors_[m], blocks, &residual)) return false;
+      residuals[m] = residual.a;
+      if (jacobians[0] != nullptr) {
+        std::copy(residual.v.data(), residual.v.data() + kNumParameters,
+                  jacobians[0] + m * kNumParameters);
+      }
     }
     return true;
   }

@@ -53,7 +53,8 @@ class AllRootsResidual {
     if (!NearestStableRoot(ScalarCoefficients(k), a_base_, a_measured_, &root.a)) return false;
     root.status = RootStatus::kOnBranch;
     const T a_model = LiftRoot(k, a_base_, root);
-    return AmplitudeError(a_measured_, a_model, error_, weight_, amplitude_floor_, residual);
+    return AmplitudeError(MeasuredTerm(a_measured_, error_, amplitude_floor_), a_model, error_,
+                          weight_, amplitude_floor_, residual);
   }
 
   static ceres::CostFunction* Create(double drive_frequency_rad_s, double a_base, double a_measured,

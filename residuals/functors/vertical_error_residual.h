@@ -52,18 +52,27 @@ enum class ErrorMeasure {
   kRelative,  // ln(a_i + f) - ln(a_model + f), f the amplitude floor
 };
 
+// The measured side of the error as `error` measures it: a_i, or
+// ln(a_i + f) for the relative error (a constant of the dwell, formed once).
+inline double MeasuredTerm(double a_measured, ErrorMeasure error, double amplitude_floor) {
+  return error == ErrorMeasure::kAbsolute ? a_measured : std::log(a_measured + amplitude_floor);
+}
+
 // The weighted error of a model amplitude against a measured one, as
-// `error` measures it. False where it is undefined: the log of a model
-// amplitude that is not positive, or a value that is not finite (a root that
-// overflowed at an extreme trial step).
+// `error` measures it, `measured_term` being MeasuredTerm of the measured
+// amplitude:
+//   absolute: w (a_i - a_model),  relative: w (ln(a_i + f) - ln(a_model + f)).
+// False where it is undefined: the log of a model amplitude that is not
+// positive, or a value that is not finite (a root that overflowed at an
+// extreme trial step).
 template <typename T>
-bool AmplitudeError(double a_measured, const T& a_model, ErrorMeasure error, double weight,
+bool AmplitudeError(double measured_term, const T& a_model, ErrorMeasure error, double weight,
                     double amplitude_floor, T* residual) {
   if (error == ErrorMeasure::kAbsolute) {
-    *residual = weight * (a_measured - a_model);
+    *residual = weight * (measured_term - a_model);
   } else {
     if (!(ScalarPart(a_model) > 0.0)) return false;
-    *residual = weight * (std::log(a_measured + amplitude_floor) - log(a_model + amplitude_floor));
+    *residual = weight * (measured_term - log(a_model + amplitude_floor));
   }
   return std::isfinite(ScalarPart(*residual));
 }
@@ -79,7 +88,8 @@ class VerticalErrorResidual {
         branch_(branch),
         error_(error),
         weight_(weight),
-        amplitude_floor_(amplitude_floor) {}
+        amplitude_floor_(amplitude_floor),
+        measured_term_(MeasuredTerm(a_measured, error, amplitude_floor)) {}
 
   template <typename T>
   bool operator()(const T* const parameters, T* residual) const {
@@ -94,7 +104,7 @@ class VerticalErrorResidual {
       last_root_.store(root.a, std::memory_order_relaxed);
     }
     const T a_model = LiftRoot(k, a_base_, root);
-    return AmplitudeError(a_measured_, a_model, error_, weight_, amplitude_floor_, residual);
+    return AmplitudeError(measured_term_, a_model, error_, weight_, amplitude_floor_, residual);
   }
 
   // The next evaluation starts its Newton iteration from a_i, as the first
@@ -123,6 +133,7 @@ class VerticalErrorResidual {
   const ErrorMeasure error_;
   const double weight_;
   const double amplitude_floor_;  // f, the data's amplitude unit
+  const double measured_term_;    // MeasuredTerm(a_measured_, error_, amplitude_floor_)
   // The root at the last evaluation (0: none yet): the next Newton start.
   // Atomic so that concurrent evaluations stay well defined.
   mutable std::atomic<double> last_root_{0.0};
