@@ -25,9 +25,9 @@
 #include "ceres/cost_function.h"
 #include "ceres/internal/autodiff.h"
 #include "ceres/internal/parameter_dims.h"
-#include "ceres/internal/variadic_evaluate.h"
 #include "ceres/jet.h"
 #include "dwellfit/residuals/model/model_parameters.h"
+#include "dwellfit/residuals/model/response_model.h"
 
 namespace dwellfit {
 
@@ -51,11 +51,12 @@ class BatchedCostFunction : public ceres::CostFunction {
 // ceres::AutoDiffCostFunction<Functor, 1, kNumParameters> each, with the
 // functors held side by side instead of a cost function object (and its
 // vector of block sizes) per dwell: on a million dwells some 100 MB less at a
-// fit's peak. Each member is evaluated as AutoDiffCostFunction evaluates it
-// (Ceres' VariadicEvaluate without Jacobians; with them, on the parameters as
-// Jets seeded by Ceres' Make1stOrderPerturbations, as AutoDifferentiate does,
-// but seeded once per batch rather than once per member), so its residual and
-// Jacobian row are the same numbers.
+// fit's peak. Functor's operator() is Functor::Evaluate on the parameters'
+// terms (ParameterTerms); a batch forms the terms once for all its members,
+// from the parameters with Jacobians as Jets seeded by Ceres'
+// Make1stOrderPerturbations (as AutoDifferentiate seeds them per call), and
+// takes each member's residual and Jacobian row as AutoDifferentiate takes
+// them, so they are the numbers AutoDiffCostFunction gives.
 template <typename Functor>
 class FunctorBatch : public ceres::CostFunction {
  public:
@@ -72,27 +73,26 @@ class FunctorBatch : public ceres::CostFunction {
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
-    using Dims = ceres::internal::StaticParameterDims<kNumParameters>;
     if (jacobians == nullptr) {
+      const ParameterTerms<double> terms(parameters[0]);
       for (size_t m = 0; m < functors_.size(); ++m) {
-        if (!ceres::internal::VariadicEvaluate<Dims>(functors_[m], parameters, residuals + m)) {
-          return false;
-        }
+        if (!functors_[m].Evaluate(terms, residuals + m)) return false;
       }
       return true;
     }
-    // The parameters as Jets, seeded as AutoDifferentiate seeds them, once for
-    // every member (each reads them as const); then each member's residual
-    // and Jacobian row as AutoDifferentiate takes them.
+    // The parameters as Jets, seeded as AutoDifferentiate seeds them, and
+    // their terms, once for every member; then each member's residual and
+    // Jacobian row as AutoDifferentiate takes them.
+    using Dims = ceres::internal::StaticParameterDims<kNumParameters>;
     using JetT = ceres::Jet<double, kNumParameters>;
     std::array<JetT, kNumParameters> point;
     ceres::internal::Make1stOrderPerturbations<Dims::Parameters>::Apply(parameters, point.data());
-    const JetT* blocks[] = {point.data()};
+    const ParameterTerms<JetT> terms(point.data());
     for (size_t m = 0; m < functors_.size(); ++m) {
       JetT residual;
       residual.a = ceres::kImpossibleValue;
       residual.v.setConstant(ceres::kImpossibleValue);
-      if (!ceres::internal::VariadicEvaluate<Dims>(functors_[m], blocks, &residual)) return false;
+      if (!functors_[m].Evaluate(terms, &residual)) return false;
       residuals[m] = residual.a;
       if (jacobians[0] != nullptr) {
         std::copy(residual.v.data(), residual.v.data() + kNumParameters,

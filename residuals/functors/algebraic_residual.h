@@ -30,7 +30,13 @@ class AlgebraicResidual {
 
   template <typename T>
   bool operator()(const T* const parameters, T* residual) const {
-    const auto k = ResponseCoefficients<T>::FromParameters(parameters, drive_frequency_rad_s_);
+    return Evaluate(ParameterTerms<T>(parameters), residual);
+  }
+  // The same residual from the parameters' terms, which a batch of dwells
+  // forms once for all of them.
+  template <typename T>
+  bool Evaluate(const ParameterTerms<T>& terms, T* residual) const {
+    const auto k = ResponseCoefficients<T>::FromTerms(terms, drive_frequency_rad_s_);
     residual[0] = weight_ * (k.G(a_measured_) - a_base_squared_) / a_base_squared_;
     // Undefined evaluation: a trial step where G overflows (eta_e -> 0).
     return std::isfinite(ScalarPart(residual[0]));

@@ -93,7 +93,13 @@ class VerticalErrorResidual {
 
   template <typename T>
   bool operator()(const T* const parameters, T* residual) const {
-    const auto k = ResponseCoefficients<T>::FromParameters(parameters, drive_frequency_rad_s_);
+    return Evaluate(ParameterTerms<T>(parameters), residual);
+  }
+  // The same residual from the parameters' terms, which a batch of dwells
+  // forms once for all of them.
+  template <typename T>
+  bool Evaluate(const ParameterTerms<T>& terms, T* residual) const {
+    const auto k = ResponseCoefficients<T>::FromTerms(terms, drive_frequency_rad_s_);
     // kOnly picks the stable root nearest its guess: that stays a_i.
     const double last_root = last_root_.load(std::memory_order_relaxed);
     const double start = branch_ != Branch::kOnly && last_root > 0.0 ? last_root : a_measured_;

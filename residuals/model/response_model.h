@@ -21,6 +21,31 @@ namespace dwellfit {
 
 inline constexpr double kPi = 3.14159265358979323846264338327950;
 
+// The parts of the coefficients (3.3) that depend on the parameters alone.
+// A batch of dwells evaluated at one point forms them once; each dwell then
+// combines them with its drive frequency (ResponseCoefficients::FromTerms) in
+// the operations, and the order, of FromParameters, so the coefficients are
+// the same numbers either way.
+template <typename T>
+struct ParameterTerms {
+  // `p` is the parameter block (ParameterIndex layout).
+  explicit ParameterTerms(const T* p)
+      : eta_e(p[kEtaE]),
+        two_eta_e(2.0 * p[kEtaE]),
+        eight_eta_e(8.0 * p[kEtaE]),
+        mu1(p[kMu1]),
+        scaled_mu2((4.0 / (3.0 * kPi)) * p[kMu2]),
+        w_squared(p[kNaturalFrequency] * p[kNaturalFrequency]),
+        three_alpha(3.0 * p[kAlpha]),
+        two_delta(2.0 * p[kDelta]) {}
+
+  T eta_e, two_eta_e, eight_eta_e;
+  T mu1;
+  T scaled_mu2;  // 4 mu2 / (3 pi)
+  T w_squared;   // w^2 [rad^2/s^2]
+  T three_alpha, two_delta;
+};
+
 template <typename T>
 struct ResponseCoefficients {
   T k1, k2, k3, k4;
@@ -28,13 +53,15 @@ struct ResponseCoefficients {
   // `p` is the parameter block (ParameterIndex layout); `omega_drive` in rad/s.
   template <typename D>
   static ResponseCoefficients FromParameters(const T* p, const D& omega_drive) {
+    return FromTerms(ParameterTerms<T>(p), omega_drive);
+  }
+  template <typename D>
+  static ResponseCoefficients FromTerms(const ParameterTerms<T>& t, const D& omega_drive) {
     ResponseCoefficients k;
-    const T& eta_e = p[kEtaE];
-    const T& w = p[kNaturalFrequency];
-    k.k1 = omega_drive * p[kMu1] / eta_e;
-    k.k2 = (4.0 / (3.0 * kPi)) * p[kMu2] * omega_drive / eta_e;
-    k.k3 = -(omega_drive * omega_drive - w * w) / (2.0 * eta_e);
-    k.k4 = (3.0 * p[kAlpha] - 2.0 * p[kDelta] * omega_drive * omega_drive) / (8.0 * eta_e);
+    k.k1 = omega_drive * t.mu1 / t.eta_e;
+    k.k2 = t.scaled_mu2 * omega_drive / t.eta_e;
+    k.k3 = -(omega_drive * omega_drive - t.w_squared) / t.two_eta_e;
+    k.k4 = (t.three_alpha - t.two_delta * omega_drive * omega_drive) / t.eight_eta_e;
     return k;
   }
 

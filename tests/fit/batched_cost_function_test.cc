@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "ceres/autodiff_cost_function.h"
+#include "dwellfit/residuals/functors/algebraic_residual.h"
 #include "dwellfit/residuals/functors/vertical_error_residual.h"
 #include "dwellfit/residuals/model/response_model.h"
 #include "gtest/gtest.h"
@@ -141,6 +142,39 @@ TEST(FunctorBatch, GivesEachDwellsAutodiffCostFunctionsValuesBitForBit) {
       for (int k = 0; k < kNumParameters; ++k) {
         EXPECT_EQ(j[i * kNumParameters + k], j_alone[k]) << "dwell " << i << " entry " << k;
       }
+    }
+  }
+}
+
+// The same for the algebraic residuals of eq. (3.11).
+TEST(FunctorBatch, GivesEachAlgebraicResidualsAutodiffValuesBitForBit) {
+  const std::vector<DwellArgs> dwells = FoldDwells();
+  FunctorBatch<AlgebraicResidual> batch;
+  std::vector<std::unique_ptr<ceres::CostFunction>> alone;
+  for (const DwellArgs& d : dwells) {
+    batch.Add(d.omega_rad_s, d.a_base, d.a, d.weight);
+    alone.emplace_back(AlgebraicResidual::Create(d.omega_rad_s, d.a_base, d.a, d.weight));
+  }
+  const ParameterVector p = {104.0, 0.19, 310.0, 1.1e4, 9.3e8, kTwoPi * 40.1};
+  const double* blocks[] = {p.data()};
+  std::vector<double> r(dwells.size()), j(dwells.size() * kNumParameters);
+  double* jacobians[] = {j.data()};
+  ASSERT_TRUE(batch.Evaluate(blocks, r.data(), jacobians));
+  std::vector<double> value_only(dwells.size());
+  ASSERT_TRUE(batch.Evaluate(blocks, value_only.data(), nullptr));
+  for (size_t i = 0; i < dwells.size(); ++i) {
+    double r_alone, j_alone[kNumParameters];
+    double* jacobians_alone[] = {j_alone};
+    ASSERT_TRUE(alone[i]->Evaluate(blocks, &r_alone, jacobians_alone));
+    EXPECT_EQ(r[i], r_alone) << "dwell " << i;
+    // Without Jacobians in double, as the cost function evaluates then (a
+    // Jet divided by a double is multiplied by its reciprocal: the value may
+    // differ from the Jet's in the last bit).
+    double r_value_only;
+    ASSERT_TRUE(alone[i]->Evaluate(blocks, &r_value_only, nullptr));
+    EXPECT_EQ(value_only[i], r_value_only) << "dwell " << i;
+    for (int k = 0; k < kNumParameters; ++k) {
+      EXPECT_EQ(j[i * kNumParameters + k], j_alone[k]) << "dwell " << i << " entry " << k;
     }
   }
 }

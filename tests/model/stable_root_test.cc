@@ -1,9 +1,12 @@
 #include "dwellfit/residuals/model/stable_root.h"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <type_traits>
 
+#include "ceres/jet.h"
 #include "gtest/gtest.h"
 
 namespace dwellfit {
@@ -15,6 +18,43 @@ ParameterVector Truth() { return {100.0, 0.2, 300.0, 1e4, 9e8, HzToRadPerSecond(
 ResponseCoefficients<double> At(double hz) {
   const ParameterVector p = Truth();
   return ResponseCoefficients<double>::FromParameters(p.data(), HzToRadPerSecond(hz));
+}
+
+// The coefficients (3.3) formed from the parameters' terms (as a batch of
+// dwells forms them) are, bit for bit, those of the equations written out, in
+// double and with Jets carrying the derivatives.
+template <typename T>
+void ExpectCoefficientsOfEquations(const T* p, double omega) {
+  const ResponseCoefficients<T> k = ResponseCoefficients<T>::FromParameters(p, omega);
+  const ResponseCoefficients<T> shared =
+      ResponseCoefficients<T>::FromTerms(ParameterTerms<T>(p), omega);
+  const T& eta_e = p[kEtaE];
+  const T& w = p[kNaturalFrequency];
+  const T written[] = {omega * p[kMu1] / eta_e, (4.0 / (3.0 * kPi)) * p[kMu2] * omega / eta_e,
+                       -(omega * omega - w * w) / (2.0 * eta_e),
+                       (3.0 * p[kAlpha] - 2.0 * p[kDelta] * omega * omega) / (8.0 * eta_e)};
+  const T formed[] = {k.k1, k.k2, k.k3, k.k4};
+  const T formed_shared[] = {shared.k1, shared.k2, shared.k3, shared.k4};
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(ScalarPart(formed[i]), ScalarPart(written[i])) << "k" << i + 1;
+    EXPECT_EQ(ScalarPart(formed_shared[i]), ScalarPart(written[i])) << "k" << i + 1;
+    if constexpr (!std::is_same_v<T, double>) {
+      for (int j = 0; j < kNumParameters; ++j) {
+        EXPECT_EQ(formed[i].v[j], written[i].v[j]) << "k" << i + 1 << " d/dp" << j;
+        EXPECT_EQ(formed_shared[i].v[j], written[i].v[j]) << "k" << i + 1 << " d/dp" << j;
+      }
+    }
+  }
+}
+
+TEST(ResponseCoefficients, FromTheParametersTermsAreTheEquationsBitForBit) {
+  const ParameterVector p = {104.0, 0.19, 310.0, 1.1e4, 9.3e8, HzToRadPerSecond(40.1)};
+  std::array<ceres::Jet<double, kNumParameters>, kNumParameters> jets;
+  for (int j = 0; j < kNumParameters; ++j) jets[j] = ceres::Jet<double, kNumParameters>(p[j], j);
+  for (double hz : {38.0, 40.0, 41.37, 46.0}) {
+    ExpectCoefficientsOfEquations(p.data(), HzToRadPerSecond(hz));
+    ExpectCoefficientsOfEquations(jets.data(), HzToRadPerSecond(hz));
+  }
 }
 
 TEST(FindTurningPoints, AmplitudeSweepJumpLevelsAt41_5HzMatchTheChapter) {
