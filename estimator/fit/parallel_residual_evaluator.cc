@@ -20,18 +20,27 @@ namespace {
 // Residuals (dwells) each thread gets at the least (fewer threads below that).
 constexpr int kMinRowsPerThread = 256;
 
-// Which way (threaded or in the caller alone) this process's evaluators last
-// found faster, for the next evaluator to start with (0: none has compared
-// them yet, 1: threaded, 2: alone), and whether a threaded evaluation has run
-// in this process (the first starts TBB's worker threads, and its time says
-// nothing about the ways). Only a preference: no value depends on it.
-std::atomic<int> last_faster_way{0};
+// What this process's evaluators of one kind (ParallelResidualEvaluator's
+// `kind`) last found, for the next of that kind to go on from: which way
+// (threaded or in the caller alone) was faster (0: none has compared them
+// yet, 1: threaded, 2: alone), how many evaluations its trials of the other
+// way had come to wait, and how many had run since its last trial. Only a
+// preference: no value depends on it.
+struct KindHistory {
+  std::atomic<int> faster_way{0};
+  std::atomic<int> trial_interval{0};
+  std::atomic<int> since_trial{0};
+};
+KindHistory histories[ParallelResidualEvaluator::kKinds];
+// Whether a threaded evaluation has run in this process (the first starts
+// TBB's worker threads, and its time says nothing about the ways).
 std::atomic<bool> workers_started{false};
 // The threads are chosen only where their evaluations are this much faster:
 // a threaded evaluation also costs time outside itself (the workers that
 // wake, and that look for more work before they sleep, take processor time
 // from the caller's serial work on a busy machine).
 constexpr double kThreadedMargin = 1.15;
+
 }  // namespace
 
 int ResolveThreadCount(int num_threads) {
@@ -206,8 +215,9 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
   bool valid_ = false;
 };
 
-ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads)
-    : blocks_(std::move(blocks)), num_threads_(num_threads), arena_(num_threads) {
+ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads,
+                                                     int kind)
+    : blocks_(std::move(blocks)), num_threads_(num_threads), kind_(kind), arena_(num_threads) {
   CHECK(!blocks_.empty());
   for (const Block& block : blocks_) {
     CHECK(block.values != nullptr);
@@ -216,15 +226,18 @@ ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, 
     size_ += block.size;
   }
   CHECK_GE(num_threads, 1);
-  const int hint = last_faster_way.load(std::memory_order_relaxed);
-  started_from_hint_ = hint != 0;
-  prefer_threaded_ = hint != 2;
+  CHECK(kind >= 0 && kind < kKinds);
+  const KindHistory& history = histories[kind];
+  const int way = history.faster_way.load(std::memory_order_relaxed);
+  prefer_threaded_ = way != 2;
+  probe_interval_ = way == 0 ? 3 : history.trial_interval.load(std::memory_order_relaxed);
+  since_probe_ = way == 0 ? 0 : history.since_trial.load(std::memory_order_relaxed);
   CopyBlocksTo(&iterate_);  // sized once: IterateEntry hands out pointers into it
 }
 
 ParallelResidualEvaluator::ParallelResidualEvaluator(const double* parameters, int size,
-                                                     int num_threads)
-    : ParallelResidualEvaluator(std::vector<Block>{{parameters, size}}, num_threads) {}
+                                                     int num_threads, int kind)
+    : ParallelResidualEvaluator(std::vector<Block>{{parameters, size}}, num_threads, kind) {}
 
 ParallelResidualEvaluator::~ParallelResidualEvaluator() = default;
 
@@ -342,41 +355,56 @@ double ParallelResidualEvaluator::RecentTimes::Typical() const {
   return sorted[1];
 }
 
-// The threads only where they pay on this machine now. An evaluator starts
-// with the way this process's evaluators last found faster and tries the
-// other after kProbeInterval evaluations; the process's first evaluator
-// times both ways at once. Then each evaluation runs the way whose last three
-// took less time (their median: one evaluation the machine held up does not
-// tip the choice), and now and then the other, to follow a machine that
-// becomes busy or idle. A trial that leaves the choice as it was doubles the
-// wait before the next, so a machine that stays as it is pays for few.
+// The threads only where they pay on this machine now. An evaluator goes on
+// from where the last of its kind in this process left off: the way, the
+// wait between trials, the evaluations since the last trial (the first of a
+// kind starts on the threads and tries the caller alone after three
+// evaluations). Now and then one evaluation runs the
+// other way, a trial: its time against the median of the preferred way's
+// last three, just before it (the cost of an evaluation drifts as a solve
+// goes on, so older times are not compared). A trial that wins switches the
+// way, and the next three evaluations confirm it against the same median,
+// or switch back; one that loses doubles the wait before the next trial, up
+// to kMaxProbeInterval, so a machine that stays as it is pays for few.
+// Which way runs changes no value.
 bool ParallelResidualEvaluator::ChooseThreaded() {
-  const RecentTimes& preferred = prefer_threaded_ ? threaded_times_ : alone_times_;
-  const RecentTimes& other = prefer_threaded_ ? alone_times_ : threaded_times_;
-  if (preferred.count == 0) return prefer_threaded_;
-  if (other.count == 0 && !started_from_hint_) return !prefer_threaded_;
-  if (++since_probe_ >= probe_interval_) {
+  bool trial = false;
+  if (confirm_left_ == 0 && ++since_probe_ >= probe_interval_) {
     since_probe_ = 0;
-    return !prefer_threaded_;
+    trial = true;
   }
-  return prefer_threaded_;
+  histories[kind_].since_trial.store(since_probe_, std::memory_order_relaxed);
+  return trial ? !prefer_threaded_ : prefer_threaded_;
+}
+
+bool ParallelResidualEvaluator::Faster(bool threaded, double seconds, double other_seconds) {
+  return threaded ? kThreadedMargin * seconds <= other_seconds
+                  : seconds < kThreadedMargin * other_seconds;
 }
 
 void ParallelResidualEvaluator::RecordTime(bool threaded, double seconds) {
   if (threaded && !workers_started.exchange(true, std::memory_order_relaxed)) return;
-  (threaded ? threaded_times_ : alone_times_).Add(seconds);
-  if (threaded_times_.count == 0 || alone_times_.count == 0) return;
-  const bool was_trial = threaded != prefer_threaded_;
-  const bool threaded_faster =
-      kThreadedMargin * threaded_times_.Typical() <= alone_times_.Typical();
-  if (threaded_faster != prefer_threaded_) {
-    prefer_threaded_ = threaded_faster;
-    probe_interval_ = kProbeInterval;
+  RecentTimes& times = threaded ? threaded_times_ : alone_times_;
+  const RecentTimes& other = threaded ? alone_times_ : threaded_times_;
+  times.Add(seconds);
+  if (threaded != prefer_threaded_) {  // a trial
+    if (other.count > 0 && Faster(threaded, seconds, other.Typical())) {
+      prefer_threaded_ = threaded;
+      probe_interval_ = kProbeInterval;
+      since_probe_ = 0;
+      confirm_left_ = 3;
+    } else {
+      probe_interval_ = std::min(2 * probe_interval_, kMaxProbeInterval);
+    }
+  } else if (confirm_left_ > 0 && --confirm_left_ == 0 &&
+             !Faster(threaded, times.Typical(), other.Typical())) {
+    prefer_threaded_ = !threaded;  // the switch did not hold
+    probe_interval_ = 2 * kProbeInterval;
     since_probe_ = 0;
-  } else if (was_trial) {
-    probe_interval_ = std::min(2 * probe_interval_, kMaxProbeInterval);
   }
-  last_faster_way.store(prefer_threaded_ ? 1 : 2, std::memory_order_relaxed);
+  KindHistory& history = histories[kind_];
+  history.faster_way.store(prefer_threaded_ ? 1 : 2, std::memory_order_relaxed);
+  history.trial_interval.store(probe_interval_, std::memory_order_relaxed);
 }
 
 bool ParallelResidualEvaluator::CostGradient(const double* point, std::vector<double>* gradient) {

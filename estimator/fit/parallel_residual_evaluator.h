@@ -61,11 +61,16 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
     int size = 0;
   };
 
+  // Kinds of evaluators (`kind`, 0 <= kind < kKinds): the evaluators of one
+  // kind, whose evaluations cost alike (the dwells' residual kind), go on
+  // from what the last of them found about the threads (ChooseThreaded).
+  static constexpr int kKinds = 8;
+
   // `blocks`: every parameter block a wrapped cost function reads, distinct.
   // `num_threads` >= 1.
-  ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads);
+  ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads, int kind = 0);
   // One block of `size` doubles that every wrapped cost function reads.
-  ParallelResidualEvaluator(const double* parameters, int size, int num_threads);
+  ParallelResidualEvaluator(const double* parameters, int size, int num_threads, int kind = 0);
   ~ParallelResidualEvaluator() override;
 
   // Takes ownership of `cost_function`, whose parameter blocks are
@@ -120,6 +125,7 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   std::vector<int> offsets_;  // of each block in a point
   int size_ = 0;              // of a point
   const int num_threads_;
+  const int kind_;
   tbb::task_arena arena_;  // at most num_threads_ threads, the caller's included
   std::vector<ReplayingCostFunction*> wrappers_;  // owned by the problem
   int rows_ = 0;                                  // residuals over the wrappers
@@ -136,8 +142,7 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   std::int64_t evaluated_directly_ = 0;
   // PrecomputeAll on the threads or in the caller alone, whichever is
   // faster (ChooseThreaded): the wall times of each way's last evaluations
-  // [s], the evaluations since the other way was last tried, and how many
-  // to wait before trying it again.
+  // [s], and the trials of the way not preferred.
   struct RecentTimes {
     std::array<double, 3> seconds{};
     int count = 0;  // timed so far, at most seconds.size() kept
@@ -148,17 +153,20 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   bool ChooseThreaded();
   // Records how long an evaluation took and which way it ran.
   void RecordTime(bool threaded, double seconds);
+  // Whether `seconds` of the way `threaded` beats `other_seconds` of the
+  // other way: the threads must be kThreadedMargin times faster.
+  static bool Faster(bool threaded, double seconds, double other_seconds);
   RecentTimes threaded_times_;
   RecentTimes alone_times_;
-  // The way not preferred runs again, to be timed, after kProbeInterval
-  // evaluations; after each such trial that leaves the preference as it
-  // was, twice as many, up to kMaxProbeInterval.
+  // The way not preferred runs once, a trial, after kProbeInterval
+  // evaluations; after each trial it loses, twice as many, up to
+  // kMaxProbeInterval.
   static constexpr int kProbeInterval = 16;
   static constexpr int kMaxProbeInterval = 64;
   bool prefer_threaded_ = true;
-  bool started_from_hint_ = false;  // prefer_threaded_ came from an earlier evaluator
   int since_probe_ = 0;
   int probe_interval_ = kProbeInterval;
+  int confirm_left_ = 0;  // evaluations still to confirm a switch
 };
 
 }  // namespace dwellfit

@@ -58,7 +58,8 @@ StageProblem::StageProblem(const FitDescription& fit, const StageSetup& setup)
       eta_e_entries_(fit.EntriesHolding(kEtaE)),
       damping_entries_(fit.EntriesHolding(kMu1)),
       fixed_(fit.FixedEntries()),
-      evaluator_(EvaluatedBlocks(fit), setup.num_threads),
+      evaluator_(EvaluatedBlocks(fit), setup.num_threads,
+                 static_cast<int>(setup.residuals.residual)),
       problem_(ProblemOptions(&evaluator_, setup.threaded_evaluation)) {
   const std::vector<bool> mu2 = fit.EntriesHolding(kMu2);
   for (size_t i = 0; i < mu2.size(); ++i) damping_entries_[i] = damping_entries_[i] || mu2[i];
