@@ -39,7 +39,7 @@ std::atomic<bool> workers_started{false};
 // a threaded evaluation also costs time outside itself (the workers that
 // wake, and that look for more work before they sleep, take processor time
 // from the caller's serial work on a busy machine).
-constexpr double kThreadedMargin = 1.15;
+constexpr double kThreadedMargin = 1.3;
 
 }  // namespace
 
