@@ -16,11 +16,11 @@
 // thread runs it, and Ceres sums them in block order, so the solve does not
 // depend on the number of threads. Below 256 residuals per thread the
 // caller evaluates alone (handing work over costs microseconds), and above
-// it each evaluation runs on the threads or in the caller alone, whichever
-// has recently been faster by the median of its last three evaluations (the
-// threads by a margin), the other way tried again now and then, less often
-// while it keeps losing (ChooseThreaded): on a machine whose other cores are
-// busy, more threads do not cost time.
+// it each evaluation runs on the threads or in the caller alone: the other
+// way runs now and then as a trial, against the evaluations just before it,
+// the threads must win by a margin, and trials that lose come ever more
+// rarely (ChooseThreaded). On a machine whose other cores are busy the
+// evaluations run in the caller alone, as on one thread.
 //
 // A wrapped cost function (Wrap) keeps its own definition: for a dwell it is
 // the autodiff VerticalErrorResidual with its Newton root solve. Ceres then

@@ -106,6 +106,35 @@ std::vector<DwellArgs> FoldDwells() {
   return dwells;
 }
 
+// The batch's residuals and Jacobian rows at `p` are, bit for bit, those of
+// each member's own cost function in `alone`, with Jacobians and without (in
+// double then, as a cost function evaluates without them: a Jet divided by
+// a double is multiplied by its reciprocal, so the value may differ from the
+// Jet's in the last bit). Each member is evaluated with Jacobians first, as
+// its cost function is, so warm-started roots start from the same place.
+void ExpectBatchGivesEachAlone(const ceres::CostFunction& batch,
+                               const std::vector<std::unique_ptr<ceres::CostFunction>>& alone,
+                               const ParameterVector& p) {
+  const double* blocks[] = {p.data()};
+  std::vector<double> r(alone.size()), j(alone.size() * kNumParameters);
+  double* jacobians[] = {j.data()};
+  ASSERT_TRUE(batch.Evaluate(blocks, r.data(), jacobians));
+  std::vector<double> value_only(alone.size());
+  ASSERT_TRUE(batch.Evaluate(blocks, value_only.data(), nullptr));
+  for (size_t i = 0; i < alone.size(); ++i) {
+    double r_alone, j_alone[kNumParameters];
+    double* jacobians_alone[] = {j_alone};
+    ASSERT_TRUE(alone[i]->Evaluate(blocks, &r_alone, jacobians_alone));
+    EXPECT_EQ(r[i], r_alone) << "dwell " << i;
+    for (int k = 0; k < kNumParameters; ++k) {
+      EXPECT_EQ(j[i * kNumParameters + k], j_alone[k]) << "dwell " << i << " entry " << k;
+    }
+    double r_value_only;
+    ASSERT_TRUE(alone[i]->Evaluate(blocks, &r_value_only, nullptr));
+    EXPECT_EQ(value_only[i], r_value_only) << "dwell " << i;
+  }
+}
+
 // A FunctorBatch of vertical errors gives, bit for bit, the residuals and
 // Jacobian rows of one AutoDiffCostFunction per dwell, at two points (the
 // second evaluation warm-starts each dwell's root), and its members' addresses
@@ -126,24 +155,7 @@ TEST(FunctorBatch, GivesEachDwellsAutodiffCostFunctionsValuesBitForBit) {
   for (size_t i = 1; i < added.size(); ++i) EXPECT_NE(added[i], added[i - 1]);
   const ParameterVector points[] = {{100.0, 0.2, 300.0, 1.0e4, 9.0e8, kTwoPi * 40.0},
                                     {104.0, 0.19, 310.0, 1.1e4, 9.3e8, kTwoPi * 40.1}};
-  for (const ParameterVector& p : points) {
-    const double* blocks[] = {p.data()};
-    std::vector<double> r(dwells.size()), j(dwells.size() * kNumParameters);
-    double* jacobians[] = {j.data()};
-    ASSERT_TRUE(batch.Evaluate(blocks, r.data(), jacobians));
-    std::vector<double> value_only(dwells.size());
-    ASSERT_TRUE(batch.Evaluate(blocks, value_only.data(), nullptr));
-    for (size_t i = 0; i < dwells.size(); ++i) {
-      double r_alone, j_alone[kNumParameters];
-      double* jacobians_alone[] = {j_alone};
-      ASSERT_TRUE(alone[i]->Evaluate(blocks, &r_alone, jacobians_alone));
-      EXPECT_EQ(r[i], r_alone) << "dwell " << i;
-      EXPECT_EQ(value_only[i], r_alone) << "dwell " << i;
-      for (int k = 0; k < kNumParameters; ++k) {
-        EXPECT_EQ(j[i * kNumParameters + k], j_alone[k]) << "dwell " << i << " entry " << k;
-      }
-    }
-  }
+  for (const ParameterVector& p : points) ExpectBatchGivesEachAlone(batch, alone, p);
 }
 
 // The same for the algebraic residuals of eq. (3.11).
@@ -155,28 +167,7 @@ TEST(FunctorBatch, GivesEachAlgebraicResidualsAutodiffValuesBitForBit) {
     batch.Add(d.omega_rad_s, d.a_base, d.a, d.weight);
     alone.emplace_back(AlgebraicResidual::Create(d.omega_rad_s, d.a_base, d.a, d.weight));
   }
-  const ParameterVector p = {104.0, 0.19, 310.0, 1.1e4, 9.3e8, kTwoPi * 40.1};
-  const double* blocks[] = {p.data()};
-  std::vector<double> r(dwells.size()), j(dwells.size() * kNumParameters);
-  double* jacobians[] = {j.data()};
-  ASSERT_TRUE(batch.Evaluate(blocks, r.data(), jacobians));
-  std::vector<double> value_only(dwells.size());
-  ASSERT_TRUE(batch.Evaluate(blocks, value_only.data(), nullptr));
-  for (size_t i = 0; i < dwells.size(); ++i) {
-    double r_alone, j_alone[kNumParameters];
-    double* jacobians_alone[] = {j_alone};
-    ASSERT_TRUE(alone[i]->Evaluate(blocks, &r_alone, jacobians_alone));
-    EXPECT_EQ(r[i], r_alone) << "dwell " << i;
-    // Without Jacobians in double, as the cost function evaluates then (a
-    // Jet divided by a double is multiplied by its reciprocal: the value may
-    // differ from the Jet's in the last bit).
-    double r_value_only;
-    ASSERT_TRUE(alone[i]->Evaluate(blocks, &r_value_only, nullptr));
-    EXPECT_EQ(value_only[i], r_value_only) << "dwell " << i;
-    for (int k = 0; k < kNumParameters; ++k) {
-      EXPECT_EQ(j[i * kNumParameters + k], j_alone[k]) << "dwell " << i << " entry " << k;
-    }
-  }
+  ExpectBatchGivesEachAlone(batch, alone, {104.0, 0.19, 310.0, 1.1e4, 9.3e8, kTwoPi * 40.1});
 }
 
 TEST(FunctorBatch, FailsWhenAnyMemberFails) {
