@@ -20,26 +20,9 @@ namespace {
 // Residuals (dwells) each thread gets at the least (fewer threads below that).
 constexpr int kMinRowsPerThread = 256;
 
-// What this process's evaluators of one kind (ParallelResidualEvaluator's
-// `kind`) last found, for the next of that kind to go on from: which way
-// (threaded or in the caller alone) was faster (0: none has compared them
-// yet, 1: threaded, 2: alone), how many evaluations its trials of the other
-// way had come to wait, and how many had run since its last trial. Only a
-// preference: no value depends on it.
-struct KindHistory {
-  std::atomic<int> faster_way{0};
-  std::atomic<int> trial_interval{0};
-  std::atomic<int> since_trial{0};
-};
-KindHistory histories[ParallelResidualEvaluator::kKinds];
 // Whether a threaded evaluation has run in this process (the first starts
 // TBB's worker threads, and its time says nothing about the ways).
 std::atomic<bool> workers_started{false};
-// The threads are chosen only where their evaluations are this much faster:
-// a threaded evaluation also costs time outside itself (the workers that
-// wake, and that look for more work before they sleep, take processor time
-// from the caller's serial work on a busy machine).
-constexpr double kThreadedMargin = 1.3;
 
 }  // namespace
 
@@ -217,7 +200,10 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
 
 ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads,
                                                      int kind)
-    : blocks_(std::move(blocks)), num_threads_(num_threads), kind_(kind), arena_(num_threads) {
+    : blocks_(std::move(blocks)),
+      num_threads_(num_threads),
+      arena_(num_threads),
+      choice_(&ThreadChoiceHistory::ForKind(kind)) {
   CHECK(!blocks_.empty());
   for (const Block& block : blocks_) {
     CHECK(block.values != nullptr);
@@ -226,12 +212,6 @@ ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, 
     size_ += block.size;
   }
   CHECK_GE(num_threads, 1);
-  CHECK(kind >= 0 && kind < kKinds);
-  const KindHistory& history = histories[kind];
-  const int way = history.faster_way.load(std::memory_order_relaxed);
-  prefer_threaded_ = way != 2;
-  probe_interval_ = way == 0 ? 3 : history.trial_interval.load(std::memory_order_relaxed);
-  since_probe_ = way == 0 ? 0 : history.since_trial.load(std::memory_order_relaxed);
   CopyBlocksTo(&iterate_);  // sized once: IterateEntry hands out pointers into it
 }
 
@@ -324,7 +304,7 @@ void ParallelResidualEvaluator::PrecomputeAll() {
     for (int i = 0; i < count; ++i) wrappers_[i]->Precompute(copy);
     return;
   }
-  const bool threaded = ChooseThreaded();
+  const bool threaded = choice_.Next();
   const auto start = std::chrono::steady_clock::now();
   if (!threaded) {
     for (int i = 0; i < count; ++i) wrappers_[i]->Precompute(copy);
@@ -341,70 +321,12 @@ void ParallelResidualEvaluator::PrecomputeAll() {
           tbb::simple_partitioner());
     });
   }
-  RecordTime(threaded,
-             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-}
-
-double ParallelResidualEvaluator::RecentTimes::Typical() const {
-  if (count == 0) return 0.0;
-  if (count < static_cast<int>(seconds.size())) {
-    return *std::min_element(seconds.begin(), seconds.begin() + count);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // The process's first threaded evaluation starts TBB's workers: not timed.
+  if (!threaded || workers_started.exchange(true, std::memory_order_relaxed)) {
+    choice_.Record(threaded, seconds);
   }
-  std::array<double, 3> sorted = seconds;
-  std::sort(sorted.begin(), sorted.end());
-  return sorted[1];
-}
-
-// The threads only where they pay on this machine now. An evaluator goes on
-// from where the last of its kind in this process left off: the way, the
-// wait between trials, the evaluations since the last trial (the first of a
-// kind starts on the threads and tries the caller alone after three
-// evaluations). Now and then one evaluation runs the
-// other way, a trial: its time against the median of the preferred way's
-// last three, just before it (the cost of an evaluation drifts as a solve
-// goes on, so older times are not compared). A trial that wins switches the
-// way, and the next three evaluations confirm it against the same median,
-// or switch back; one that loses doubles the wait before the next trial, up
-// to kMaxProbeInterval, so a machine that stays as it is pays for few.
-// Which way runs changes no value.
-bool ParallelResidualEvaluator::ChooseThreaded() {
-  bool trial = false;
-  if (confirm_left_ == 0 && ++since_probe_ >= probe_interval_) {
-    since_probe_ = 0;
-    trial = true;
-  }
-  histories[kind_].since_trial.store(since_probe_, std::memory_order_relaxed);
-  return trial ? !prefer_threaded_ : prefer_threaded_;
-}
-
-bool ParallelResidualEvaluator::Faster(bool threaded, double seconds, double other_seconds) {
-  return threaded ? kThreadedMargin * seconds <= other_seconds
-                  : seconds < kThreadedMargin * other_seconds;
-}
-
-void ParallelResidualEvaluator::RecordTime(bool threaded, double seconds) {
-  if (threaded && !workers_started.exchange(true, std::memory_order_relaxed)) return;
-  RecentTimes& times = threaded ? threaded_times_ : alone_times_;
-  const RecentTimes& other = threaded ? alone_times_ : threaded_times_;
-  times.Add(seconds);
-  if (threaded != prefer_threaded_) {  // a trial
-    if (other.count > 0 && Faster(threaded, seconds, other.Typical())) {
-      prefer_threaded_ = threaded;
-      probe_interval_ = kProbeInterval;
-      since_probe_ = 0;
-      confirm_left_ = 3;
-    } else {
-      probe_interval_ = std::min(2 * probe_interval_, kMaxProbeInterval);
-    }
-  } else if (confirm_left_ > 0 && --confirm_left_ == 0 &&
-             !Faster(threaded, times.Typical(), other.Typical())) {
-    prefer_threaded_ = !threaded;  // the switch did not hold
-    probe_interval_ = 2 * kProbeInterval;
-    since_probe_ = 0;
-  }
-  KindHistory& history = histories[kind_];
-  history.faster_way.store(prefer_threaded_ ? 1 : 2, std::memory_order_relaxed);
-  history.trial_interval.store(probe_interval_, std::memory_order_relaxed);
 }
 
 bool ParallelResidualEvaluator::CostGradient(const double* point, std::vector<double>* gradient) {

@@ -16,11 +16,11 @@
 // thread runs it, and Ceres sums them in block order, so the solve does not
 // depend on the number of threads. Below 256 residuals per thread the
 // caller evaluates alone (handing work over costs microseconds), and above
-// it each evaluation runs on the threads or in the caller alone: the other
-// way runs now and then as a trial, against the evaluations just before it,
-// the threads must win by a margin, and trials that lose come ever more
-// rarely (ChooseThreaded). On a machine whose other cores are busy the
-// evaluations run in the caller alone, as on one thread.
+// it each evaluation runs on the threads or in the caller alone, as trials
+// of the other way, against the evaluations just before them, find faster
+// (ThreadChoice, which wants the threads clearly faster). On a machine whose
+// other cores are busy the evaluations run in the caller alone, as on one
+// thread.
 //
 // A wrapped cost function (Wrap) keeps its own definition: for a dwell it is
 // the autodiff VerticalErrorResidual with its Newton root solve. Ceres then
@@ -38,13 +38,13 @@
 #ifndef DWELLFIT_ESTIMATOR_FIT_PARALLEL_RESIDUAL_EVALUATOR_H_
 #define DWELLFIT_ESTIMATOR_FIT_PARALLEL_RESIDUAL_EVALUATOR_H_
 
-#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
 
 #include "ceres/cost_function.h"
 #include "ceres/evaluation_callback.h"
+#include "dwellfit/estimator/fit/thread_choice.h"
 #include "tbb/task_arena.h"
 
 namespace dwellfit {
@@ -61,13 +61,10 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
     int size = 0;
   };
 
-  // Kinds of evaluators (`kind`, 0 <= kind < kKinds): the evaluators of one
-  // kind, whose evaluations cost alike (the dwells' residual kind), go on
-  // from what the last of them found about the threads (ChooseThreaded).
-  static constexpr int kKinds = 8;
-
   // `blocks`: every parameter block a wrapped cost function reads, distinct.
-  // `num_threads` >= 1.
+  // `num_threads` >= 1. `kind` (0 <= kind < ThreadChoiceHistory::kKinds):
+  // evaluators whose evaluations cost alike (the dwells' residual kind) go
+  // on from what the last of them found about the threads (ThreadChoice).
   ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads, int kind = 0);
   // One block of `size` doubles that every wrapped cost function reads.
   ParallelResidualEvaluator(const double* parameters, int size, int num_threads, int kind = 0);
@@ -125,7 +122,6 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   std::vector<int> offsets_;  // of each block in a point
   int size_ = 0;              // of a point
   const int num_threads_;
-  const int kind_;
   tbb::task_arena arena_;  // at most num_threads_ threads, the caller's included
   std::vector<ReplayingCostFunction*> wrappers_;  // owned by the problem
   int rows_ = 0;                                  // residuals over the wrappers
@@ -140,33 +136,8 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   std::vector<double> iterate_;     // the last point evaluated with Jacobians
   std::int64_t replayed_ = 0;
   std::int64_t evaluated_directly_ = 0;
-  // PrecomputeAll on the threads or in the caller alone, whichever is
-  // faster (ChooseThreaded): the wall times of each way's last evaluations
-  // [s], and the trials of the way not preferred.
-  struct RecentTimes {
-    std::array<double, 3> seconds{};
-    int count = 0;  // timed so far, at most seconds.size() kept
-    void Add(double value) { seconds[count++ % seconds.size()] = value; }
-    // The median of the last three, the least of fewer (0: none yet).
-    double Typical() const;
-  };
-  bool ChooseThreaded();
-  // Records how long an evaluation took and which way it ran.
-  void RecordTime(bool threaded, double seconds);
-  // Whether `seconds` of the way `threaded` beats `other_seconds` of the
-  // other way: the threads must be kThreadedMargin times faster.
-  static bool Faster(bool threaded, double seconds, double other_seconds);
-  RecentTimes threaded_times_;
-  RecentTimes alone_times_;
-  // The way not preferred runs once, a trial, after kProbeInterval
-  // evaluations; after each trial it loses, twice as many, up to
-  // kMaxProbeInterval.
-  static constexpr int kProbeInterval = 16;
-  static constexpr int kMaxProbeInterval = 64;
-  bool prefer_threaded_ = true;
-  int since_probe_ = 0;
-  int probe_interval_ = kProbeInterval;
-  int confirm_left_ = 0;  // evaluations still to confirm a switch
+  // PrecomputeAll on the threads or in the caller alone.
+  ThreadChoice choice_;
 };
 
 }  // namespace dwellfit

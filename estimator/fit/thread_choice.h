@@ -1,0 +1,92 @@
+// ThreadChoice: whether the next evaluation of a ParallelResidualEvaluator
+// runs on its threads or in the caller alone, from the times of the last
+// evaluations of each way.
+//
+// A solve's evaluations drift in cost as it goes on (the clamped beam's
+// vertical stage from 0.9 ms down to 0.4, up to 0.8 and down to 0.3 ms), so
+// times taken at different moments compare the moments, not the ways. The
+// choice therefore changes only by trial: every so often one evaluation runs
+// the way not preferred, and its time is compared with the median of the
+// preferred way's last three evaluations, the ones just before it (the
+// median: one evaluation the machine held up does not decide). A trial that
+// wins switches the way, and the next three evaluations confirm it against
+// the same median, or the way switches back. A trial that loses doubles the
+// wait before the next (16, 32, then 64 evaluations), so a machine that stays
+// as it is pays for few. The threads must be kThreadedMargin times faster: a
+// threaded evaluation also costs time outside itself (the workers that wake,
+// and that look for more work before they sleep, take the processor from the
+// caller's serial work on a busy machine).
+//
+// What the choice has come to (the way, the wait between trials, the count
+// since the last) is kept in a ThreadChoiceHistory, which the next choice
+// of the same history goes on from: the evaluators of one residual kind
+// share one (ForKind), so a study of many fits pays for the trials once. A
+// history nobody has used yet starts on the threads and tries the caller
+// alone after three evaluations. Which way runs changes no value.
+#ifndef DWELLFIT_ESTIMATOR_FIT_THREAD_CHOICE_H_
+#define DWELLFIT_ESTIMATOR_FIT_THREAD_CHOICE_H_
+
+#include <array>
+#include <atomic>
+
+namespace dwellfit {
+
+struct ThreadChoiceHistory {
+  // Histories shared by this process's evaluators of one kind (0 <= kind <
+  // kKinds; the dwells' residual kind).
+  static constexpr int kKinds = 8;
+  static ThreadChoiceHistory& ForKind(int kind);
+
+  // The way last preferred (0: none yet, 1: threaded, 2: alone), the wait
+  // between trials and the evaluations since the last. Relaxed atomics:
+  // evaluators on other threads may read and write them at once; a mixed
+  // read only moves a trial.
+  std::atomic<int> preferred_way{0};
+  std::atomic<int> trial_interval{0};
+  std::atomic<int> since_trial{0};
+};
+
+class ThreadChoice {
+ public:
+  static constexpr double kThreadedMargin = 1.3;
+  static constexpr int kTrialInterval = 16;
+  static constexpr int kMaxTrialInterval = 64;
+  static constexpr int kFirstTrialAfter = 3;
+  static constexpr int kConfirmations = 3;
+
+  // Goes on from `history` (not owned; it must outlive this).
+  explicit ThreadChoice(ThreadChoiceHistory* history);
+
+  // Whether the next evaluation runs threaded.
+  bool Next();
+  // How long [s] the evaluation Next chose took.
+  void Record(bool threaded, double seconds);
+
+  bool prefers_threaded() const { return prefer_threaded_; }
+  int trial_interval() const { return trial_interval_; }
+
+ private:
+  // The wall times of one way's last evaluations.
+  struct RecentTimes {
+    std::array<double, 3> seconds{};
+    int count = 0;  // timed so far, at most seconds.size() kept
+    void Add(double value) { seconds[count++ % seconds.size()] = value; }
+    // The median of the last three, the least of fewer (0: none yet).
+    double Typical() const;
+  };
+  // Whether `seconds` of the way `threaded` beats `other_seconds` of the other.
+  static bool Faster(bool threaded, double seconds, double other_seconds);
+  void Publish();
+
+  ThreadChoiceHistory* const history_;
+  RecentTimes threaded_times_;
+  RecentTimes alone_times_;
+  bool prefer_threaded_ = true;
+  int trial_interval_ = kFirstTrialAfter;
+  int since_trial_ = 0;
+  int confirm_left_ = 0;  // evaluations still to confirm a switch
+};
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_ESTIMATOR_FIT_THREAD_CHOICE_H_

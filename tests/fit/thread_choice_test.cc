@@ -1,0 +1,123 @@
+#include "dwellfit/estimator/fit/thread_choice.h"
+
+#include <functional>
+
+#include "gtest/gtest.h"
+
+namespace dwellfit {
+namespace {
+
+// Runs `count` evaluations whose time [s] in each way is
+// `seconds(threaded, evaluation)`; returns how many ran threaded.
+int RunEvaluations(ThreadChoice* choice, int count, const std::function<double(bool, int)>& seconds,
+                   int first = 0) {
+  int threaded_count = 0;
+  for (int i = first; i < first + count; ++i) {
+    const bool threaded = choice->Next();
+    threaded_count += threaded ? 1 : 0;
+    choice->Record(threaded, seconds(threaded, i));
+  }
+  return threaded_count;
+}
+
+TEST(ThreadChoice, ANewHistoryStartsOnTheThreadsAndTriesTheCallerAloneAfterThree) {
+  ThreadChoiceHistory history;
+  ThreadChoice choice(&history);
+  EXPECT_TRUE(choice.Next());
+  choice.Record(true, 1e-3);
+  EXPECT_TRUE(choice.Next());
+  choice.Record(true, 1e-3);
+  EXPECT_FALSE(choice.Next());  // the trial
+}
+
+// Two idle cores: the threads take half the time. After the first trial the
+// evaluations stay threaded, and the caller alone is tried ever more rarely.
+TEST(ThreadChoice, ThreadsTwiceAsFastStayThreadedWithRarerTrials) {
+  ThreadChoiceHistory history;
+  ThreadChoice choice(&history);
+  const int threaded =
+      RunEvaluations(&choice, 200, [](bool t, int) { return t ? 0.5e-3 : 1.0e-3; });
+  EXPECT_TRUE(choice.prefers_threaded());
+  EXPECT_EQ(choice.trial_interval(), ThreadChoice::kMaxTrialInterval);
+  // Trials after 3, 16, 32, 64 and 64 evaluations.
+  EXPECT_EQ(200 - threaded, 5);
+}
+
+// A busy core: the threads are faster, but not by the margin. The caller
+// alone takes over at the first trial and the threads are tried ever more
+// rarely.
+TEST(ThreadChoice, ThreadsNotClearlyFasterGiveWayToTheCallerAlone) {
+  ThreadChoiceHistory history;
+  ThreadChoice choice(&history);
+  const int threaded =
+      RunEvaluations(&choice, 200, [](bool t, int) { return t ? 0.9e-3 : 1.0e-3; });
+  EXPECT_FALSE(choice.prefers_threaded());
+  EXPECT_EQ(choice.trial_interval(), ThreadChoice::kMaxTrialInterval);
+  // The two before the first trial, then trials after 16, 32, 64 and 64.
+  EXPECT_EQ(threaded, 6);
+}
+
+// The evaluations grow dearer as the solve goes on, the threads 0.9 times
+// the caller's time at every moment: a trial is measured against the
+// evaluations just before it, so the drift does not make the threads look
+// faster than older times of the caller.
+TEST(ThreadChoice, ADriftingCostIsNotTakenForFasterThreads) {
+  ThreadChoiceHistory history;
+  history.preferred_way = 2;  // the caller alone
+  history.trial_interval = ThreadChoice::kTrialInterval;
+  ThreadChoice choice(&history);
+  const auto drifting = [](bool t, int i) { return (t ? 0.9 : 1.0) * (0.4e-3 + 0.05e-3 * i); };
+  const int threaded = RunEvaluations(&choice, 120, drifting);
+  EXPECT_FALSE(choice.prefers_threaded());
+  EXPECT_EQ(threaded, 3);  // trials after 16, 32 and 64 evaluations
+}
+
+// One threaded evaluation the machine held up, just before a trial of the
+// caller alone, does not hand the evaluations to the caller: the trial is
+// measured against the median of the last three.
+TEST(ThreadChoice, OneHeldUpEvaluationDoesNotDecide) {
+  ThreadChoiceHistory history;
+  ThreadChoice choice(&history);
+  RunEvaluations(&choice, 10, [](bool t, int) { return t ? 0.5e-3 : 1.0e-3; });
+  ASSERT_TRUE(choice.prefers_threaded());
+  // The next trial comes after 16 evaluations: hold up the one before it.
+  RunEvaluations(
+      &choice, 16, [](bool t, int i) { return t ? (i == 24 ? 5e-3 : 0.5e-3) : 0.9e-3; }, 10);
+  EXPECT_TRUE(choice.prefers_threaded());
+}
+
+// A trial that wins by luck is undone when the next three evaluations on
+// the new way are slower than the old way was.
+TEST(ThreadChoice, ASwitchThatDoesNotHoldIsUndone) {
+  ThreadChoiceHistory history;
+  history.preferred_way = 2;
+  history.trial_interval = ThreadChoice::kTrialInterval;
+  ThreadChoice choice(&history);
+  RunEvaluations(&choice, 15, [](bool t, int) { return t ? 2e-3 : 1e-3; });
+  // The trial (evaluation 15) is lucky; the three after it are not.
+  RunEvaluations(
+      &choice, 1, [](bool t, int) { return t ? 0.5e-3 : 1e-3; }, 15);
+  EXPECT_TRUE(choice.prefers_threaded());
+  const int threaded = RunEvaluations(
+      &choice, 3, [](bool t, int) { return t ? 2e-3 : 1e-3; }, 16);
+  EXPECT_EQ(threaded, 3);
+  EXPECT_FALSE(choice.prefers_threaded());
+  EXPECT_EQ(choice.trial_interval(), 2 * ThreadChoice::kTrialInterval);
+}
+
+// The next choice of one history goes on from where the last left off.
+TEST(ThreadChoice, TheNextChoiceOfAHistoryGoesOnFromTheLast) {
+  ThreadChoiceHistory history;
+  {
+    ThreadChoice first(&history);
+    RunEvaluations(&first, 40, [](bool t, int) { return t ? 0.9e-3 : 1.0e-3; });
+    ASSERT_FALSE(first.prefers_threaded());
+  }
+  ThreadChoice next(&history);
+  EXPECT_FALSE(next.prefers_threaded());
+  EXPECT_EQ(next.trial_interval(), 2 * ThreadChoice::kTrialInterval);
+  EXPECT_FALSE(next.Next());
+}
+
+}  // namespace
+}  // namespace dwellfit
