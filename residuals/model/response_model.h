@@ -55,6 +55,8 @@ struct ResponseCoefficients {
   static ResponseCoefficients FromParameters(const T* p, const D& omega_drive) {
     return FromTerms(ParameterTerms<T>(p), omega_drive);
   }
+  // The coefficients (3.3), at the top of this file, from the parameters'
+  // terms.
   template <typename D>
   static ResponseCoefficients FromTerms(const ParameterTerms<T>& t, const D& omega_drive) {
     ResponseCoefficients k;
