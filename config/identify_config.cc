@@ -319,7 +319,7 @@ SolverSettings ReadSolver(const ConfigValue& value, const ConfigSource& source) 
   const StrictMap block(
       value, source,
       {"max_iterations", "function_tolerance", "start_function_tolerance", "gradient_tolerance",
-       "parameter_tolerance", "num_threads", "nonmonotonic_steps"});
+       "parameter_tolerance", "num_threads", "nonmonotonic_steps", "valley_polish"});
   SolverSettings solver;
   if (const auto v = block.Optional("max_iterations")) solver.max_iterations = ReadInt(*v, source);
   if (const auto v = block.Optional("function_tolerance")) {
@@ -333,6 +333,9 @@ SolverSettings ReadSolver(const ConfigValue& value, const ConfigSource& source) 
   }
   if (const auto v = block.Optional("parameter_tolerance")) {
     solver.parameter_tolerance = ReadFiniteDouble(*v, source);
+  }
+  if (const auto v = block.Optional("valley_polish")) {
+    solver.valley_polish = ReadBool(*v, source);
   }
   if (const auto v = block.Optional("nonmonotonic_steps")) {
     solver.nonmonotonic_steps = ReadBool(*v, source);

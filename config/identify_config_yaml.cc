@@ -135,6 +135,7 @@ void EmitFitSettings(YAML::Emitter& out, const IdentificationOptions& identifica
     out << YAML::Key << "num_threads" << YAML::Value << solver.num_threads;
   }
   out << YAML::Key << "nonmonotonic_steps" << YAML::Value << solver.nonmonotonic_steps;
+  out << YAML::Key << "valley_polish" << YAML::Value << solver.valley_polish;
   out << YAML::EndMap;
 }
 

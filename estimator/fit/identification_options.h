@@ -65,6 +65,11 @@ struct SolverSettings {
   // (ceres::Solver::Options::use_nonmonotonic_steps): faster along the
   // narrow valleys of measured data with penalties.
   bool nonmonotonic_steps = false;
+  // Finish a vertical or all-roots solve that creeps along a weakly
+  // determined direction with a quasi-Newton polish (valley_polish.h):
+  // the simulated sweep of 1e6 dwells in 13 BFGS iterations instead of 60
+  // Levenberg-Marquardt steps. false: Levenberg-Marquardt alone.
+  bool valley_polish = true;
   bool IsValid(std::string* error) const;
 };
 

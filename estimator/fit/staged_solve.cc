@@ -11,6 +11,7 @@
 #include "dwellfit/estimator/fit/bound_rest_watcher.h"
 #include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
 #include "dwellfit/estimator/fit/stage_problem.h"
+#include "dwellfit/estimator/fit/valley_polish.h"
 #include "glog/logging.h"
 
 namespace dwellfit {
@@ -86,6 +87,8 @@ bool PenaltiesEnabled(const PenaltyOptions& penalties) {
 constexpr int kStepsAtBoundBeforeHolding = 5;
 // Solves in one stage at the most (see RunStage).
 constexpr int kMaxSolvesPerStage = 12;
+// Valley polishes in one stage at the most (see RunStage).
+constexpr int kMaxPolishesPerStage = 2;
 
 // The stage-independent part of a staged solve.
 struct SolveContext {
@@ -97,8 +100,10 @@ struct SolveContext {
 
 // One solve of `problem`, with the active set's watcher; `*resting` is the
 // entry that stopped it by resting on its bound.
+// `creep`, when given, stops a solve that creeps (valley_polish.h).
 ceres::Solver::Summary SolveOnce(ResidualKind kind, const SolverSettings& settings,
-                                 StageProblem* problem, std::optional<int>* resting) {
+                                 StageProblem* problem, std::optional<int>* resting,
+                                 CreepWatcher* creep) {
   problem->Configure();
   BoundRestWatcher watcher(problem->WatchedBounds(), kStepsAtBoundBeforeHolding);
   ceres::Solver::Options options = MakeSolverOptions(settings);
@@ -116,6 +121,7 @@ ceres::Solver::Summary SolveOnce(ResidualKind kind, const SolverSettings& settin
     options.max_num_line_search_step_size_iterations = 0;
   }
   options.callbacks.push_back(&watcher);
+  if (creep != nullptr) options.callbacks.push_back(creep);
   options.update_state_every_iteration = true;
   ceres::Solver::Summary summary;
   ceres::Solve(options, problem->problem(), &summary);
@@ -226,6 +232,29 @@ StageSetup MakeSetup(const SolveContext& context, ResidualKind kind) {
   return setup;
 }
 
+bool IsBranchLabelled(ResidualKind kind) {
+  return kind == ResidualKind::kVertical || kind == ResidualKind::kAllRoots;
+}
+
+// The valley polish (valley_polish.h) of a solve that crept, on the
+// described blocks with a free entry; recorded in the stage's note and
+// iterations.
+void Polish(const SolveContext& context, const SolverSettings& settings, StageProblem* problem,
+            StageSummary* stage) {
+  std::vector<double*> blocks;
+  for (const FitBlock& block : context.fit.blocks) {
+    if (!problem->problem()->IsParameterBlockConstant(block.values)) blocks.push_back(block.values);
+  }
+  const ValleyPolish polish = PolishAlongValley(problem->problem(), blocks, settings);
+  stage->iterations += polish.iterations;
+  std::ostringstream note;
+  note << (stage->note.empty() ? "" : "; ") << "valley polish after " << kCreepSteps
+       << " steps in a row that lowered the cost over " << kCreepRatio
+       << " times the model's prediction: " << polish.message;
+  stage->note += note.str();
+  VLOG(1) << ResidualKindName(stage->residual) << " stage: " << note.str();
+}
+
 // One stage: the residual `kind` (with `penalties` on a vertical stage) from
 // the blocks' values, which it updates. False when a solve failed
 // (`*failure` says why). `rated`, when given, is a problem of the dwells
@@ -260,6 +289,7 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
   const int entries = context.fit.NumEntries();
   setup.held.assign(entries, false);
   std::vector<bool> released(entries, false);
+  int polishes = 0;
   stage->residual = kind;
   std::unique_ptr<StageProblem> assembled =
       rated != nullptr ? std::move(rated) : std::make_unique<StageProblem>(context.fit, setup);
@@ -276,7 +306,11 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
     if (round > 0) problem.EvaluateAfresh();
     std::optional<int> resting;
     const std::vector<double> start = context.fit.Values();
-    const ceres::Solver::Summary summary = SolveOnce(kind, settings, &problem, &resting);
+    CreepWatcher creep(kCreepSteps, kCreepRatio);
+    const bool watch_creep =
+        settings.valley_polish && IsBranchLabelled(kind) && polishes < kMaxPolishesPerStage;
+    const ceres::Solver::Summary summary =
+        SolveOnce(kind, settings, &problem, &resting, watch_creep ? &creep : nullptr);
     VLOG(2) << ResidualKindName(kind) << " stage, solve " << round + 1 << ": "
             << summary.BriefReport();
     RecordSolve(summary, round, with_penalties ? penalties : PenaltyOptions{}, &problem, stage);
@@ -294,6 +328,11 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
       setup.held[*resting] = true;
       VLOG(1) << ResidualKindName(kind) << " stage: holding " << context.fit.EntryName(*resting)
               << " at its bound";
+      continue;
+    }
+    if (creep.creeping()) {
+      ++polishes;
+      Polish(context, settings, &problem, stage);
       continue;
     }
     if (!ReleaseHeld(&problem, &setup.held, &released)) break;
@@ -384,10 +423,6 @@ struct StartRating {
     return data_cost < other.data_cost;
   }
 };
-
-bool IsBranchLabelled(ResidualKind kind) {
-  return kind == ResidualKind::kVertical || kind == ResidualKind::kAllRoots;
-}
 
 // Rates `values` (written into the blocks) as the start of a stage whose
 // problem of the dwells alone is `problem`, as a problem assembled for them

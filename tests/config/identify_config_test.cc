@@ -167,6 +167,24 @@ TEST(LoadIdentifyConfig, StartFunctionToleranceIsReadAndShown) {
   EXPECT_THAT(ConfigToYaml(config), HasSubstr("start_function_tolerance: 0.001"));
 }
 
+// The valley polish: on by default, off when the config says so, shown in
+// the configuration in effect; a value that is not a bool names its line.
+TEST(LoadIdentifyConfig, ValleyPolishIsReadAndShown) {
+  const ConfigDirectory dir;
+  const std::string line = "  max_iterations: 150\n";
+  ASSERT_NE(std::string(kValidConfig).find(line), std::string::npos);
+  const IdentifyConfig by_default = LoadIdentifyConfig(dir.WriteConfig(kValidConfig));
+  EXPECT_TRUE(by_default.identification.solver.valley_polish);
+  EXPECT_THAT(ConfigToYaml(by_default), HasSubstr("valley_polish: true"));
+  const IdentifyConfig off = LoadIdentifyConfig(
+      dir.WriteConfig(Replace(kValidConfig, line, line + "  valley_polish: false\n")));
+  EXPECT_FALSE(off.identification.solver.valley_polish);
+  EXPECT_THAT(ConfigToYaml(off), HasSubstr("valley_polish: false"));
+  std::string path;
+  const InputError error = ErrorWith(dir, line, line + "  valley_polish: sometimes\n", &path);
+  ExpectAt(error, path, 19, "solver.valley_polish");
+}
+
 TEST(ConfigToYaml, ShowsTheSourceFileAndOmegaInHz) {
   const ConfigDirectory dir;
   const std::string path = dir.WriteConfig(kValidConfig);
