@@ -10,6 +10,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/studies/chapter_tables.h"
+#include "dwellfit/tools/tool_flags.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -29,6 +30,7 @@ int main(int argc, char** argv) {
       "writes the chapter's Tables 3.3 and 3.4 (with and without the bifurcation-range "
       "penalty) as Markdown.\n  chapter_tables [--numerical CFG --truth_plan PLAN --measured CFG "
       "--output FILE]");
+  if (!dwellfit::FlagsGivenOnce(argc, argv, "chapter_tables")) return 2;
   gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
   try {
     const std::string markdown =

@@ -12,6 +12,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/studies/convergence_family.h"
+#include "dwellfit/tools/tool_flags.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -26,6 +27,7 @@ int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "fits the convergence family from the automatic start and writes its report.\n"
       "  convergence_family [--base CFG --output FILE]");
+  if (!dwellfit::FlagsGivenOnce(argc, argv, "convergence_family")) return 2;
   gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
   try {
     const dwellfit::IdentifyConfig base = dwellfit::LoadIdentifyConfig(FLAGS_base);

@@ -17,6 +17,7 @@
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/studies/coverage_study.h"
+#include "dwellfit/tools/tool_flags.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
       "Coverage of the 95 % parameter intervals over noisy simulated replicas.\n"
       "Usage: coverage_study --config beam.yaml --plan plan.yaml [--replicas 200] "
       "[--noise 0.01] [--set key.path=value,...]");
+  if (!dwellfit::FlagsGivenOnce(argc, argv, "coverage_study")) return 2;
   gflags::ParseCommandLineFlags(&argc, &argv, true);
   if (FLAGS_config.empty() || FLAGS_plan.empty() || FLAGS_replicas < 1 || !(FLAGS_noise >= 0.0)) {
     std::cerr << "coverage_study: give --config and --plan, --replicas >= 1, --noise >= 0\n"

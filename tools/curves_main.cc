@@ -20,6 +20,7 @@
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/curves/sweep_curves.h"
+#include "dwellfit/tools/tool_flags.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -114,6 +115,7 @@ int main(int argc, char** argv) {
       "The model's response curves as CSV.\nUsage: curves (--result result.yaml | --plan "
       "plan.yaml | --eta_e .. --omega_hz ..) [--kind frequency --a_base A --from HZ --to HZ | "
       "--kind amplitude --freq_hz HZ --from A --to A] [--output curves.csv]");
+  if (!dwellfit::FlagsGivenOnce(argc, argv, "curves")) return 2;
   gflags::ParseCommandLineFlags(&argc, &argv, true);
   try {
     std::optional<dwellfit::DwellPlan> plan;

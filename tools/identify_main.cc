@@ -9,6 +9,7 @@
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/identify_run.h"
+#include "dwellfit/tools/tool_flags.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -79,6 +80,7 @@ int main(int argc, char** argv) {
       "identifies a beam mode's parameters from sine-dwell sweeps.\n"
       "  identify --config beam.yaml [--output_dir DIR] [--fix delta,omega] [--set k=v,...]\n"
       "The config keys are documented in config/README.md.");
+  if (!dwellfit::FlagsGivenOnce(argc, argv, "identify")) return dwellfit::kExitUsage;
   gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
   if (FLAGS_config.empty() || argc > 1) {
     std::cerr << "identify: give the config file with --config FILE"

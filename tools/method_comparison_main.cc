@@ -10,6 +10,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/studies/method_comparison.h"
+#include "dwellfit/tools/tool_flags.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -32,6 +33,7 @@ int main(int argc, char** argv) {
       "compares the chapter's identification methods and writes the tables as Markdown.\n"
       "  method_comparison [--numerical CFG --truth_plan PLAN --measured CFG --output FILE "
       "--noise_seeds N --phase_bias_deg D --wall_time]");
+  if (!dwellfit::FlagsGivenOnce(argc, argv, "method_comparison")) return 2;
   gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
   try {
     dwellfit::MethodComparisonOptions options;

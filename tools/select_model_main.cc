@@ -15,6 +15,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/studies/model_selection.h"
+#include "dwellfit/tools/tool_flags.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -33,6 +34,7 @@ int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "compares model variants by cost, AIC, BIC and cross-validation.\n"
       "  select_model --config beam.yaml [--set k=v,...] [--threads N] [--output_dir DIR]");
+  if (!dwellfit::FlagsGivenOnce(argc, argv, "select_model")) return 2;
   gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
   if (FLAGS_config.empty()) {
     std::cerr << "select_model: --config is required\n";

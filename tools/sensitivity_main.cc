@@ -19,6 +19,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/studies/sensitivity_study.h"
+#include "dwellfit/tools/tool_flags.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -87,6 +88,7 @@ int main(int argc, char** argv) {
       "sets or fitted sweeps.\nUsage: sensitivity --config beam.yaml [--plan plan.yaml "
       "--replicas 1000 --noise 0.01] [--vary 'key=v1|v2'] [--threads 2] [--shard k/N] "
       "--output_dir study/\n       sensitivity --merge dir0,dir1,... --output_dir study/");
+  if (!dwellfit::FlagsGivenOnce(argc, argv, "sensitivity")) return 2;
   gflags::ParseCommandLineFlags(&argc, &argv, true);
   try {
     if (FLAGS_output_dir.empty()) throw dwellfit::InputError("--output_dir", 0, "", "required");

@@ -12,6 +12,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/data/sweep_csv_writer.h"
 #include "dwellfit/estimator/simulation/dwell_simulator.h"
+#include "dwellfit/tools/tool_flags.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -24,6 +25,7 @@ int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "Simulates sine-dwell sweeps on the model from a plan.\n"
       "Usage: simulate_dwell --plan plan.yaml --out sweeps.csv");
+  if (!dwellfit::FlagsGivenOnce(argc, argv, "simulate_dwell")) return 2;
   gflags::ParseCommandLineFlags(&argc, &argv, true);
   if (FLAGS_plan.empty() || FLAGS_out.empty()) {
     std::cerr << "simulate_dwell: give both --plan and --out\n" << gflags::ProgramUsage() << "\n";

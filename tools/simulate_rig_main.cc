@@ -21,6 +21,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/rig/rig_simulator.h"
+#include "dwellfit/tools/tool_flags.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -45,6 +46,7 @@ int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "Simulates a sine-dwell test on the virtual rig and writes time traces.\n"
       "Usage: simulate_rig --plan plan.yaml --rig rig.yaml --out traces_folder");
+  if (!dwellfit::FlagsGivenOnce(argc, argv, "simulate_rig")) return 2;
   gflags::ParseCommandLineFlags(&argc, &argv, true);
   if (FLAGS_plan.empty() || FLAGS_rig.empty() || FLAGS_out.empty()) {
     std::cerr << "simulate_rig: give --plan, --rig and --out\n" << gflags::ProgramUsage() << "\n";

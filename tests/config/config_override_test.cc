@@ -368,3 +368,45 @@ TEST(ConfigOverrides, SetOnAnAliasedValueChangesOnlyThatKey) {
 
 }  // namespace
 }  // namespace dwellfit
+
+namespace dwellfit {
+namespace {
+
+// The flags of a tool like identify: --set and --config take a value,
+// --figures is a bool.
+FlagKind IdentifyLikeFlag(const std::string& name) {
+  if (name == "set" || name == "config") return FlagKind::kValue;
+  if (name == "figures") return FlagKind::kBool;
+  return FlagKind::kUnknown;
+}
+
+std::optional<std::string> Repeated(const std::vector<std::string>& args) {
+  return RepeatedFlag(args, IdentifyLikeFlag);
+}
+
+TEST(RepeatedFlag, EachFlagOnceIsFine) {
+  EXPECT_EQ(Repeated({"--config", "a.yaml", "--set", "x=1,y=2", "--figures"}), std::nullopt);
+  EXPECT_EQ(Repeated({}), std::nullopt);
+}
+
+TEST(RepeatedFlag, NamesASecondSetInAnyForm) {
+  EXPECT_EQ(Repeated({"--set", "x=1", "--set", "y=2"}), "set");
+  EXPECT_EQ(Repeated({"--set=x=1", "-set", "y=2"}), "set");
+  EXPECT_EQ(Repeated({"-config=a.yaml", "--set=x=1", "--config", "b.yaml"}), "config");
+}
+
+TEST(RepeatedFlag, ABoolAndItsNegationAreOneFlag) {
+  EXPECT_EQ(Repeated({"--figures", "--nofigures"}), "figures");
+  EXPECT_EQ(Repeated({"--nofigures", "--figures=true"}), "figures");
+}
+
+TEST(RepeatedFlag, AValueThatLooksLikeAFlagIsAValue) {
+  // "--set" is --config's value here; after "--" nothing is a flag.
+  EXPECT_EQ(Repeated({"--config", "--set", "--set", "x=1"}), std::nullopt);
+  EXPECT_EQ(Repeated({"--set", "x=1", "--", "--set", "y=2"}), std::nullopt);
+  // Unknown names are gflags' to reject, not counted.
+  EXPECT_EQ(Repeated({"--what", "--what"}), std::nullopt);
+}
+
+}  // namespace
+}  // namespace dwellfit
