@@ -47,8 +47,12 @@
 // entry resting on its bound is held there (BoundRestWatcher) and the stage
 // solves again without it; a held entry whose cost gradient points into the
 // feasible side is released, once. The vertical stages run without Ceres'
-// projected line search (see RunStage in the .cc). The algebraic stage runs
-// with the damping unbounded and reflects its result into the physical range
+// projected line search (see RunStage in the .cc). A vertical or all-roots
+// solve that creeps along a weakly determined direction is finished by the
+// valley polish (valley_polish.h; SolverSettings::valley_polish), at most
+// twice a stage, and solved again from where the polish ended; the stage's
+// note says so. The algebraic stage runs with the damping unbounded and
+// reflects its result into the physical range
 // (ReflectDampingIntoPhysicalRange). Residual blocks are evaluated on
 // `solver.num_threads` threads in a fixed order: results do not depend on it.
 //
@@ -92,7 +96,7 @@ struct StageSummary {
   double penalty_unit = 0.0;
   int penalty_exponent = 0;  // n of eq. (3.17) in this stage (0: none)
   int residual_blocks = 0;   // dwell points fitted
-  int iterations = 0;        // over the stage's solves
+  int iterations = 0;        // over the stage's solves and valley polishes
   int solves = 0;            // one, and one more per bound held or released
   bool converged = false;    // its last solve met a convergence test
   // Bounded entries the stage ended holding on their bound (an active set),

@@ -39,7 +39,7 @@ constexpr int kLineSearchTrials = 4;
 
 // F(u) = F(x0 [+] R^-1 u) and its gradient R^-T g(x) in the whitened
 // coordinates u, g the gradient in the blocks' tangent coordinates. A point
-// past a lower bound of the problem fails (the line search steps back).
+// past a bound of the problem fails (the line search steps back).
 // Remembers the point of lowest cost it evaluated: a line search that fails
 // on a cost that is not smooth (folds, penalties) ends BFGS with a failure,
 // after steps that may already have lowered the cost.
@@ -104,7 +104,10 @@ class WhitenedCost : public ceres::FirstOrderFunction {
   bool WithinBounds() const {
     for (double* block : blocks_) {
       for (int i = 0; i < problem_->ParameterBlockSize(block); ++i) {
-        if (block[i] < problem_->GetParameterLowerBound(block, i)) return false;
+        if (block[i] < problem_->GetParameterLowerBound(block, i) ||
+            block[i] > problem_->GetParameterUpperBound(block, i)) {
+          return false;
+        }
       }
     }
     return true;
