@@ -127,8 +127,7 @@ ceres::GradientProblemSolver::Options PolishOptions(const SolverSettings& settin
   options.line_search_direction_type = ceres::BFGS;
   options.line_search_type = ceres::WOLFE;
   options.max_num_iterations = settings.max_iterations;
-  options.function_tolerance =
-      settings.function_tolerance * (getenv("PT") ? atof(getenv("PT")) : 1.0);
+  options.function_tolerance = settings.function_tolerance;
   options.gradient_tolerance = settings.gradient_tolerance;
   options.parameter_tolerance = settings.parameter_tolerance;
   // Ceres' default is 20 trial steps. On the floor of a valley whose cost is
