@@ -97,7 +97,7 @@ struct StageSummary {
   int penalty_exponent = 0;  // n of eq. (3.17) in this stage (0: none)
   int residual_blocks = 0;   // dwell points fitted
   int iterations = 0;        // over the stage's solves and valley polishes
-  int solves = 0;            // one, and one more per bound held or released
+  int solves = 0;            // one, and one more per bound held or released and per valley polish
   bool converged = false;    // its last solve met a convergence test
   // Bounded entries the stage ended holding on their bound (an active set),
   // as ambient indices of the description (for Identify: ParameterIndex).
