@@ -73,6 +73,17 @@ struct SolverSettings {
   bool IsValid(std::string* error) const;
 };
 
+// Sets the iteration limit and the convergence tests of `settings` on the
+// options of a Ceres solver: ceres::Solver::Options (the trust-region
+// stages) or ceres::GradientProblemSolver::Options (the valley polish).
+template <typename CeresOptions>
+void SetConvergenceTests(const SolverSettings& settings, CeresOptions* options) {
+  options->max_num_iterations = settings.max_iterations;
+  options->function_tolerance = settings.function_tolerance;
+  options->gradient_tolerance = settings.gradient_tolerance;
+  options->parameter_tolerance = settings.parameter_tolerance;
+}
+
 // The jumps a bifurcation-range penalty can enforce: the sweep kind and
 // which fold (jump-up: the lower branch ends; jump-down: the upper one ends).
 enum class JumpTarget {

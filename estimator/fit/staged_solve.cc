@@ -37,10 +37,7 @@ ceres::Solver::Options MakeSolverOptions(const SolverSettings& settings) {
   options.minimizer_type = ceres::TRUST_REGION;
   options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
   options.linear_solver_type = ceres::DENSE_QR;
-  options.max_num_iterations = settings.max_iterations;
-  options.function_tolerance = settings.function_tolerance;
-  options.gradient_tolerance = settings.gradient_tolerance;
-  options.parameter_tolerance = settings.parameter_tolerance;
+  SetConvergenceTests(settings, &options);
   // One thread: the residual blocks are evaluated on threads, in a fixed
   // order, by ParallelResidualEvaluator (ceres' own threads sum in an order
   // that varies between runs).

@@ -126,10 +126,7 @@ ceres::GradientProblemSolver::Options PolishOptions(const SolverSettings& settin
   ceres::GradientProblemSolver::Options options;
   options.line_search_direction_type = ceres::BFGS;
   options.line_search_type = ceres::WOLFE;
-  options.max_num_iterations = settings.max_iterations;
-  options.function_tolerance = settings.function_tolerance;
-  options.gradient_tolerance = settings.gradient_tolerance;
-  options.parameter_tolerance = settings.parameter_tolerance;
+  SetConvergenceTests(settings, &options);
   // Ceres' default is 20 trial steps. On the floor of a valley whose cost is
   // not smooth (dwells crossing the end of their branch as the folds move)
   // no step meets the Wolfe conditions: the last two iterations on the
