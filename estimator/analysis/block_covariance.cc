@@ -274,7 +274,7 @@ BlockCovariance EstimateBlockCovariance(const FitDescription& fit, const Residua
   // The dwells alone: their cost gives the noise.
   std::unique_ptr<StageProblem> problem = AssembleDataProblem(fit, residual, 1.0, false);
   Eigen::MatrixXd r;  // R of J = Q R, k x k
-  if (!FactorJacobian(problem->problem(), problem->dwell_blocks(), blocks, c.num_free,
+  if (!FactorJacobian(problem->dwell_problem(), problem->dwell_blocks(), blocks, c.num_free,
                       options.chunk_rows, &c.data_cost, &r)) {
     return Unavailable(c, "the model cannot be evaluated at the estimate on every fitted dwell");
   }

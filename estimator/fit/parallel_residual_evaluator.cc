@@ -6,9 +6,11 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <thread>
 #include <utility>
 
+#include "Eigen/QR"
 #include "glog/logging.h"
 #include "tbb/blocked_range.h"
 #include "tbb/parallel_for.h"
@@ -80,6 +82,35 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
     }
     return true;
   }
+
+  // Writes the precomputed rows into `a` from row `row` on: the Jacobian in
+  // the point's columns, the residuals in the last column (a's other
+  // entries are left as they are); false if the evaluation failed.
+  bool WriteRows(Eigen::MatrixXd* a, int row) const {
+    if (!ok_) return false;
+    const std::vector<int32_t>& sizes = parameter_block_sizes();
+    int start = 0;
+    for (size_t j = 0; j < sizes.size(); ++j) {
+      const double* jacobian = Jacobian() + rows_ * start;
+      for (int i = 0; i < rows_; ++i) {
+        for (int col = 0; col < sizes[j]; ++col) {
+          (*a)(row + i, Offset(j) + col) = jacobian[i * sizes[j] + col];
+        }
+      }
+      start += sizes[j];
+    }
+    for (int i = 0; i < rows_; ++i) (*a)(row + i, a->cols() - 1) = Residuals()[i];
+    return true;
+  }
+
+  // |r|^2 at the precomputed point.
+  double SquaredNorm() const {
+    double sum = 0.0;
+    for (int i = 0; i < rows_; ++i) sum += Residuals()[i] * Residuals()[i];
+    return sum;
+  }
+
+  int rows() const { return rows_; }
 
   // Computes the values at `point` (the evaluator's thread for this block).
   void Precompute(const double* point) {
@@ -198,6 +229,24 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
   bool valid_ = false;
 };
 
+// The one residual block of the compressed wrappers (Compress).
+class ParallelResidualEvaluator::CompressedCostFunction : public ceres::CostFunction {
+ public:
+  explicit CompressedCostFunction(ParallelResidualEvaluator* owner) : owner_(owner) {
+    set_num_residuals(owner->size_ + 1);
+    for (const Block& block : owner->blocks_)
+      mutable_parameter_block_sizes()->push_back(block.size);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    return owner_->EvaluateCompressed(parameters, residuals, jacobians);
+  }
+
+ private:
+  ParallelResidualEvaluator* const owner_;
+};
+
 ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads,
                                                      int kind)
     : blocks_(std::move(blocks)),
@@ -297,36 +346,144 @@ void ParallelResidualEvaluator::PrecomputeAll() {
   // Every thread reads this one copy of the point.
   computed_ = true;
   const double* copy = last_point_.data();
-  const int count = static_cast<int>(wrappers_.size());
+  const int chunks = static_cast<int>(chunk_ends_.size());
+  const int units = chunks + static_cast<int>(wrappers_.size()) - compressed_;
   // Handing work to a thread costs microseconds: threads only for enough rows.
-  const int threads = std::max(1, std::min({num_threads_, count, rows_ / kMinRowsPerThread}));
-  if (threads == 1) {
-    for (int i = 0; i < count; ++i) wrappers_[i]->Precompute(copy);
-    return;
-  }
-  const bool threaded = choice_.Next();
+  const int threads = std::max(1, std::min({num_threads_, units, rows_ / kMinRowsPerThread}));
+  const bool threaded = threads > 1 && choice_.Next();
   const auto start = std::chrono::steady_clock::now();
   if (!threaded) {
-    for (int i = 0; i < count; ++i) wrappers_[i]->Precompute(copy);
+    for (int unit = 0; unit < units; ++unit) PrecomputeUnit(unit, copy);
   } else {
-    // Idle workers sleep, and the blocks are split down to single batches
-    // that an idle thread steals: a worker the machine is slow to run holds
-    // up at most the batch it is in.
+    // Idle workers sleep, and the units are split down to single ones that
+    // an idle thread steals: a worker the machine is slow to run holds up
+    // at most the unit it is in.
     arena_.execute([&] {
       tbb::parallel_for(
-          tbb::blocked_range<int>(0, count, 1),
+          tbb::blocked_range<int>(0, units, 1),
           [&](const tbb::blocked_range<int>& range) {
-            for (int i = range.begin(); i < range.end(); ++i) wrappers_[i]->Precompute(copy);
+            for (int unit = range.begin(); unit < range.end(); ++unit) PrecomputeUnit(unit, copy);
           },
           tbb::simple_partitioner());
     });
   }
+  if (chunks > 0) CombineChunks();
+  if (threads == 1) return;
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // The process's first threaded evaluation starts TBB's workers: not timed.
   if (!threaded || workers_started.exchange(true, std::memory_order_relaxed)) {
     choice_.Record(threaded, seconds);
   }
+}
+
+void ParallelResidualEvaluator::PrecomputeUnit(int unit, const double* point) {
+  const int chunks = static_cast<int>(chunk_ends_.size());
+  if (unit >= chunks) {
+    wrappers_[compressed_ + unit - chunks]->Precompute(point);
+    return;
+  }
+  const int first = unit == 0 ? 0 : chunk_ends_[unit - 1];
+  for (int i = first; i < chunk_ends_[unit]; ++i) wrappers_[i]->Precompute(point);
+  FactorChunk(unit);
+}
+
+void ParallelResidualEvaluator::FactorChunk(int chunk) {
+  const int first = chunk == 0 ? 0 : chunk_ends_[chunk - 1];
+  int rows = 0;
+  for (int i = first; i < chunk_ends_[chunk]; ++i) rows += wrappers_[i]->rows();
+  const int width = size_ + 1;
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rows, width);
+  bool ok = true;
+  int row = 0;
+  for (int i = first; i < chunk_ends_[chunk] && ok; ++i) {
+    ok = wrappers_[i]->WriteRows(&a, row);
+    row += wrappers_[i]->rows();
+  }
+  chunk_ok_[chunk] = ok;
+  if (!ok) return;
+  const Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(a);  // in place
+  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> r(
+      chunk_r_.data() + static_cast<size_t>(chunk) * width * width, width, width);
+  r.setZero();
+  const int kept = std::min(rows, width);
+  r.topRows(kept) = a.topRows(kept).triangularView<Eigen::Upper>();
+}
+
+void ParallelResidualEvaluator::CombineChunks() {
+  const int chunks = static_cast<int>(chunk_ends_.size());
+  compressed_ok_ = std::all_of(chunk_ok_.begin(), chunk_ok_.end(), [](char ok) { return ok; });
+  if (!compressed_ok_) return;
+  const int width = size_ + 1;
+  const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>
+      stacked(chunk_r_.data(), static_cast<Eigen::Index>(chunks) * width, width);
+  if (chunks == 1) {
+    compressed_r_ = stacked;
+    return;
+  }
+  Eigen::MatrixXd a = stacked;
+  const Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(a);  // in place
+  compressed_r_ = a.topRows(width).triangularView<Eigen::Upper>();
+}
+
+ceres::CostFunction* ParallelResidualEvaluator::Compress() {
+  CHECK_EQ(compressed_, 0) << "Compress() once";
+  CHECK(!wrappers_.empty());
+  compressed_ = static_cast<int>(wrappers_.size());
+  int rows = 0;
+  for (int i = 0; i < compressed_; ++i) {
+    rows += wrappers_[i]->rows();
+    if (rows >= kCompressedChunkRows || i + 1 == compressed_) {
+      chunk_ends_.push_back(i + 1);
+      rows = 0;
+    }
+  }
+  const size_t width = size_ + 1;
+  chunk_r_.assign(chunk_ends_.size() * width * width, 0.0);
+  chunk_ok_.assign(chunk_ends_.size(), false);
+  computed_ = false;
+  return new CompressedCostFunction(this);
+}
+
+bool ParallelResidualEvaluator::EvaluateCompressed(double const* const* parameters,
+                                                   double* residuals, double** jacobians) {
+  bool at_point = computed_;
+  for (size_t b = 0; b < blocks_.size() && at_point; ++b) {
+    const double* last = last_point_.data() + offsets_[b];
+    at_point = std::equal(last, last + blocks_[b].size, parameters[b]);
+  }
+  if (at_point) {
+    ++replayed_;
+  } else {  // a point the callback did not see
+    ++evaluated_directly_;
+    last_point_.resize(size_);
+    for (size_t b = 0; b < blocks_.size(); ++b) {
+      std::copy(parameters[b], parameters[b] + blocks_[b].size, last_point_.begin() + offsets_[b]);
+    }
+    PrecomputeAll();
+  }
+  if (!compressed_ok_) return false;
+  const int width = size_ + 1;
+  for (int i = 0; i < width; ++i) residuals[i] = compressed_r_(i, size_);
+  if (jacobians == nullptr) {
+    // The cost alone: a Jacobian that is not finite (a dwell at a fold)
+    // spoils q and rho, not |r|.
+    if (compressed_r_.col(size_).allFinite()) return true;
+    double sum = 0.0;
+    for (int i = 0; i < compressed_; ++i) sum += wrappers_[i]->SquaredNorm();
+    std::fill(residuals, residuals + width, 0.0);
+    residuals[size_] = std::sqrt(sum);
+    return true;
+  }
+  for (size_t b = 0; b < blocks_.size(); ++b) {
+    if (jacobians[b] == nullptr) continue;
+    for (int i = 0; i < width; ++i) {
+      for (int col = 0; col < blocks_[b].size; ++col) {
+        jacobians[b][i * blocks_[b].size + col] = compressed_r_(i, offsets_[b] + col);
+      }
+    }
+  }
+  return true;
 }
 
 bool ParallelResidualEvaluator::CostGradient(const double* point, std::vector<double>* gradient) {

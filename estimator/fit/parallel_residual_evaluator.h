@@ -22,6 +22,25 @@
 // other cores are busy the evaluations run in the caller alone, as on one
 // thread.
 //
+// Compress() stands the wrappers made so far (a stage's dwells) in for one
+// residual block of a few rows: with the wrappers' rows stacked as
+// A = [J | r] (m rows; J over the whole point, r the residuals), the
+// Householder factorization A = Q [R_J q; 0 rho; 0 0] gives the block whose
+// residuals are [q; rho] and whose Jacobian is [R_J; 0]. Its cost
+// (|q|^2 + rho^2)/2 is |r|^2/2, its gradient R_J^T q is J^T r, its
+// Gauss-Newton matrix R_J^T R_J is J^T J, and for every step s
+// |[q; rho] + [R_J; 0] s| = |r + J s|: a trust-region solve takes the steps
+// it would take on the m rows, while Ceres' work per iteration (the
+// Jacobian's assembly, scaling and dense QR, each over m rows, about a third
+// of the measured beam's fit on one thread) shrinks to a few rows. The
+// factorization runs with the evaluation, on the threads: the wrappers in
+// chunks of about kCompressedChunkRows rows, fixed by the wrappers' order
+// whatever the thread count, each chunk's rows to an R of its own, and then
+// the chunks' R, stacked in order, to one (tall-skinny QR). Its Jacobian is
+// not the derivative of its residuals (Q moves with the point), so only a
+// Gauss-Newton-type solver may use it; the wrappers' own values stay as
+// they were for everything else (CostGradient, a problem of their own).
+//
 // A wrapped cost function (Wrap) keeps its own definition: for a dwell it is
 // the autodiff VerticalErrorResidual with its Newton root solve. Ceres then
 // calls the wrapper, which returns the values computed for the point the
@@ -42,6 +61,7 @@
 #include <memory>
 #include <vector>
 
+#include "Eigen/Core"
 #include "ceres/cost_function.h"
 #include "ceres/evaluation_callback.h"
 #include "dwellfit/estimator/fit/thread_choice.h"
@@ -77,6 +97,12 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
                             const std::vector<double*>& parameter_blocks);
   // The same for a cost function of the first watched block alone.
   ceres::CostFunction* Wrap(ceres::CostFunction* cost_function);
+  // The one residual block that stands in for every wrapper made so far
+  // (see above; at most once): `size + 1` residuals on every watched block,
+  // in order. Owned by the caller. The wrappers stay owned as before, and
+  // stay usable, in a problem of their own, for their values at the point.
+  ceres::CostFunction* Compress();
+
   // Makes room for `wrappers` more wrappers of one parameter block each,
   // holding `residuals` residuals over the whole point between them (the
   // dwells, in batches), so that wrapping them copies no stored values. Only
@@ -110,9 +136,24 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
 
  private:
   class ReplayingCostFunction;
+  class CompressedCostFunction;
 
-  // Evaluates every wrapper at last_point_, on the threads.
+  // Rows of the compressed wrappers' chunks, at the least (the last may
+  // have fewer).
+  static constexpr int kCompressedChunkRows = 256;
+
+  // Evaluates every wrapper at last_point_, on the threads, and factors the
+  // compressed ones.
   void PrecomputeAll();
+  // Work unit `unit` of PrecomputeAll at `point`: a chunk of compressed
+  // wrappers, evaluated and factored, or one other wrapper.
+  void PrecomputeUnit(int unit, const double* point);
+  // The R of chunk `chunk` (its wrappers evaluated) into chunk_r_.
+  void FactorChunk(int chunk);
+  // The chunks' R, stacked, into compressed_r_.
+  void CombineChunks();
+  // CompressedCostFunction::Evaluate.
+  bool EvaluateCompressed(double const* const* parameters, double* residuals, double** jacobians);
   // The watched blocks hold last_point_.
   bool AtLastPoint() const;
   // The watched blocks' values, concatenated, into `point` (resized to a point).
@@ -136,6 +177,15 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   std::vector<double> iterate_;     // the last point evaluated with Jacobians
   std::int64_t replayed_ = 0;
   std::int64_t evaluated_directly_ = 0;
+  // Compress(): wrappers [0, compressed_) stand behind one block, in chunks
+  // ending at chunk_ends_; per chunk its (size_ + 1)^2 R, row-major, and
+  // whether its wrappers evaluated; their R combined at last_point_.
+  int compressed_ = 0;
+  std::vector<int> chunk_ends_;
+  std::vector<double> chunk_r_;
+  std::vector<char> chunk_ok_;
+  Eigen::MatrixXd compressed_r_;
+  bool compressed_ok_ = false;
   // PrecomputeAll on the threads or in the caller alone.
   ThreadChoice choice_;
 };

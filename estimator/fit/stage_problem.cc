@@ -23,12 +23,13 @@ ceres::Problem::Options StageProblem::ProblemOptions(ParallelResidualEvaluator* 
   return options;
 }
 
-void StageProblem::OwnCostFunctions(const std::vector<ceres::ResidualBlockId>& blocks, size_t first,
+void StageProblem::OwnCostFunctions(const ceres::Problem& problem,
+                                    const std::vector<ceres::ResidualBlockId>& blocks, size_t first,
                                     bool may_share) {
   std::unordered_set<const ceres::CostFunction*> owned;
   cost_functions_.reserve(cost_functions_.size() + blocks.size() - first);
   for (size_t i = first; i < blocks.size(); ++i) {
-    const ceres::CostFunction* cost = problem_.GetCostFunctionForResidualBlock(blocks[i]);
+    const ceres::CostFunction* cost = problem.GetCostFunctionForResidualBlock(blocks[i]);
     if (!may_share || owned.insert(cost).second) cost_functions_.emplace_back(cost);
   }
 }
@@ -60,7 +61,8 @@ StageProblem::StageProblem(const FitDescription& fit, const StageSetup& setup)
       fixed_(fit.FixedEntries()),
       evaluator_(EvaluatedBlocks(fit), setup.num_threads,
                  static_cast<int>(setup.residuals.residual)),
-      problem_(ProblemOptions(&evaluator_, setup.threaded_evaluation)) {
+      problem_(ProblemOptions(&evaluator_, setup.threaded_evaluation)),
+      dwell_problem_(ProblemOptions(nullptr, false)) {
   const std::vector<bool> mu2 = fit.EntriesHolding(kMu2);
   for (size_t i = 0; i < mu2.size(); ++i) damping_entries_[i] = damping_entries_[i] || mu2[i];
   CHECK_EQ(setup.scale.size(), fixed_.size());
@@ -75,21 +77,32 @@ StageProblem::StageProblem(const FitDescription& fit, const StageSetup& setup)
   }
   if (setup.threaded_evaluation) evaluator_.Reserve(blocks, points);
   if (setup.residuals.residual == ResidualKind::kVertical) warm_started_.reserve(points);
+  AddDwells();
+  if (Compressed() && !dwell_blocks_.empty()) {
+    std::vector<double*> all;
+    for (const FitBlock& block : fit.blocks) all.push_back(block.values);
+    ceres::CostFunction* compressed = evaluator_.Compress();
+    cost_functions_.emplace_back(compressed);
+    problem_.AddResidualBlock(compressed, nullptr, all);
+  }
+}
+
+void StageProblem::AddDwells() {
+  ceres::Problem* problem = dwell_problem();
   try {
-    for (const FitDataset& dataset : fit.datasets) {
-      layouts_.push_back(LayoutOf(fit, dataset.parameters));
+    for (const FitDataset& dataset : fit_.datasets) {
+      layouts_.push_back(LayoutOf(fit_, dataset.parameters));
       for (const Sweep* sweep : dataset.sweeps) {
-        dwells_ +=
-            builder_.AddSweep(*sweep, layouts_.back(), &problem_, Evaluator(), &warm_started_);
+        dwells_ += builder_.AddSweep(*sweep, layouts_.back(), problem, Evaluator(), &warm_started_);
       }
     }
   } catch (...) {  // a sweep the residual cannot take: the earlier ones' blocks are owned
-    problem_.GetResidualBlocks(&dwell_blocks_);
-    OwnCostFunctions(dwell_blocks_, 0, false);
+    problem->GetResidualBlocks(&dwell_blocks_);
+    OwnCostFunctions(*problem, dwell_blocks_, 0, false);
     throw;
   }
-  problem_.GetResidualBlocks(&dwell_blocks_);
-  OwnCostFunctions(dwell_blocks_, 0, false);
+  problem->GetResidualBlocks(&dwell_blocks_);
+  OwnCostFunctions(*problem, dwell_blocks_, 0, false);
 }
 
 void StageProblem::AddPenalties(const PenaltyOptions& penalties) {
@@ -104,7 +117,7 @@ void StageProblem::AddPenalties(const PenaltyOptions& penalties) {
   }
   std::vector<ceres::ResidualBlockId> all;
   problem_.GetResidualBlocks(&all);
-  OwnCostFunctions(all, before, false);
+  OwnCostFunctions(problem_, all, before, false);
   penalty_blocks_.insert(penalty_blocks_.end(), all.begin() + before, all.end());
 }
 
@@ -142,11 +155,11 @@ void StageProblem::AddCallerResiduals() {
     fit_.add_residuals(&problem_);
   } catch (...) {  // what it added before it threw is owned all the same
     problem_.GetResidualBlocks(&all);
-    OwnCostFunctions(all, before, true);
+    OwnCostFunctions(problem_, all, before, true);
     throw;
   }
   problem_.GetResidualBlocks(&all);
-  OwnCostFunctions(all, before, true);
+  OwnCostFunctions(problem_, all, before, true);
   caller_blocks_.assign(all.begin() + before, all.end());
 }
 
@@ -210,7 +223,11 @@ double CostOf(const std::vector<ceres::ResidualBlockId>& blocks, ceres::Problem*
 
 }  // namespace
 
-double StageProblem::DataCost() { return CostOf(dwell_blocks_, &problem_); }
+double StageProblem::DataCost() {
+  // The dwells' own blocks answer from the evaluator's values at the point.
+  if (Compressed()) evaluator_.PrepareForEvaluation(false, true);
+  return CostOf(dwell_blocks_, dwell_problem());
+}
 
 double StageProblem::PenaltyCost() { return CostOf(penalty_blocks_, &problem_); }
 

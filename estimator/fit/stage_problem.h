@@ -3,10 +3,12 @@
 // and the covariance (estimator/analysis/block_covariance.h) build theirs
 // here.
 //
-// In order: every described block (AddParameterBlock, blocks in order); one
-// residual block per dwell of every dataset (ProblemBuilder::AddSweep on the
+// In order: every described block (AddParameterBlock, blocks in order); the
+// dwells of every dataset in batches (ProblemBuilder::AddSweep on the
 // dataset's layout), evaluated on the threads of a ParallelResidualEvaluator
-// that watches every described block (unless !threaded_evaluation); then, when asked, the penalties
+// that watches every described block (unless !threaded_evaluation), and
+// with threaded evaluation seen by the solver as one compressed block
+// (compress_dwells); then, when asked, the penalties
 // (AddPenalties) and the caller's residual blocks (AddCallerResiduals); and
 // last the entries' configuration (Configure):
 //   - lower bound 0 on every entry holding eta_e of some dataset, and on
@@ -45,6 +47,11 @@ struct StageSetup {
   // block itself, each time it asks (the covariance, which evaluates twice).
   bool threaded_evaluation = true;
   int num_threads = 1;
+  // With threaded_evaluation: the solver sees the dwells as one residual
+  // block of a few rows (ParallelResidualEvaluator::Compress), the same
+  // cost, gradient and Gauss-Newton matrix; the dwells' own blocks
+  // (dwell_blocks) live in a problem of their own, for their values.
+  bool compress_dwells = true;
 };
 
 class StageProblem {
@@ -97,14 +104,19 @@ class StageProblem {
   // WatchedBounds). Nothing without threaded evaluation.
   void MoveToIterate();
 
+  // The problem a solve solves: with compressed dwells it holds the one
+  // block that stands for them, not the dwells' own.
   ceres::Problem* problem() { return &problem_; }
+  // The problem holding dwell_blocks(): problem() unless the dwells are
+  // compressed.
+  ceres::Problem* dwell_problem() { return Compressed() ? &dwell_problem_ : &problem_; }
   int dwells() const { return dwells_; }
   // Why a solve could not evaluate its cost: the dwells (or penalties) whose
   // residual or Jacobian is not finite at the blocks' current values, named
   // by file, line and sweep, or else `ceres_message`.
   std::string DescribeFailure(const std::string& ceres_message);
   // The dwells' residual blocks, in dwell order: batches of consecutive
-  // dwells (ProblemBuilderOptions::batch_dwells).
+  // dwells (ProblemBuilderOptions::batch_dwells), in dwell_problem().
   const std::vector<ceres::ResidualBlockId>& dwell_blocks() const { return dwell_blocks_; }
   // The caller's residual blocks (after AddCallerResiduals).
   const std::vector<ceres::ResidualBlockId>& caller_blocks() const { return caller_blocks_; }
@@ -122,13 +134,17 @@ class StageProblem {
   // Takes ownership of the cost functions of `blocks` from `first` on; each
   // once when `may_share` (a caller's cost function may serve several
   // blocks), else each block's own.
-  void OwnCostFunctions(const std::vector<ceres::ResidualBlockId>& blocks, size_t first,
+  void OwnCostFunctions(const ceres::Problem& problem,
+                        const std::vector<ceres::ResidualBlockId>& blocks, size_t first,
                         bool may_share);
+  // Adds every dataset's dwells to dwell_problem() (AddSweep).
+  void AddDwells();
   static std::vector<ParallelResidualEvaluator::Block> EvaluatedBlocks(const FitDescription& fit);
   // The evaluator the dwells and penalties go through, or none.
   ParallelResidualEvaluator* Evaluator() {
     return setup_.threaded_evaluation ? &evaluator_ : nullptr;
   }
+  bool Compressed() const { return setup_.threaded_evaluation && setup_.compress_dwells; }
   // Whether an entry has the lower bound 0.
   bool IsBounded(int entry) const;
   bool IsHeld(int entry) const;
@@ -148,8 +164,11 @@ class StageProblem {
   // entry per cost function to count its blocks, at a million dwells some
   // 60 MB and a tree insertion per dwell. Destroyed after problem_.
   std::vector<std::unique_ptr<const ceres::CostFunction>> cost_functions_;
-  ParallelResidualEvaluator evaluator_;  // outlives problem_, which calls it
+  ParallelResidualEvaluator evaluator_;  // outlives the problems, which call it
   ceres::Problem problem_;
+  // The dwells' own blocks when compressed (no evaluation callback: the
+  // caller prepares the evaluator before evaluating them).
+  ceres::Problem dwell_problem_;
   std::vector<ceres::ResidualBlockId> dwell_blocks_;
   std::vector<ceres::ResidualBlockId> caller_blocks_;
   std::vector<ceres::ResidualBlockId> penalty_blocks_;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <set>
@@ -600,6 +601,214 @@ TEST(ParallelResidualEvaluator, ResolveThreadCount) {
   EXPECT_EQ(ResolveThreadCount(3), 3);
   EXPECT_EQ(ResolveThreadCount(1), 1);
   EXPECT_GE(ResolveThreadCount(0), 1);
+}
+
+}  // namespace
+}  // namespace dwellfit
+
+namespace dwellfit {
+namespace {
+
+// The fit of FitWithEvaluator with the wrapped blocks compressed into one
+// residual block (ParallelResidualEvaluator::Compress).
+Fit FitCompressed(const std::vector<Sample>& data, int num_threads) {
+  Fit fit;
+  fit.parameters = kStart;
+  ParallelResidualEvaluator evaluator(fit.parameters.data(), 3, num_threads);
+  std::vector<std::unique_ptr<ceres::CostFunction>> wrappers;
+  for (const Sample& sample : data)
+    wrappers.emplace_back(evaluator.Wrap(NewDecayingCosine(sample)));
+  ceres::Problem::Options problem_options;
+  problem_options.evaluation_callback = &evaluator;
+  ceres::Problem problem(problem_options);
+  problem.AddResidualBlock(evaluator.Compress(), nullptr, fit.parameters.data());
+  EXPECT_EQ(problem.NumResiduals(), 3 + 1);
+  ceres::Solve(FitOptions(), &problem, &fit.summary);
+  fit.replayed = evaluator.replayed();
+  fit.evaluated_directly = evaluator.evaluated_directly();
+  return fit;
+}
+
+// The compressed block's residuals and Jacobian at `point` ({a}, {b, c}).
+struct CompressedValues {
+  std::vector<double> residuals;
+  Eigen::MatrixXd jacobian;  // rows x 3
+};
+
+// The residuals and Jacobian of every MixedShapeCost row at `point`, with
+// Ceres evaluating the cost functions itself.
+void RowsAt(const std::vector<Sample>& data, double a, const double bc[2], Eigen::MatrixXd* j,
+            Eigen::VectorXd* r) {
+  double a_block = a;
+  double bc_block[2] = {bc[0], bc[1]};
+  ceres::Problem problem;
+  for (size_t i = 0; i < data.size(); ++i) {
+    ceres::CostFunction* cost = MixedShapeCost(data[i], static_cast<int>(i));
+    if (i % 2 == 0) {
+      problem.AddResidualBlock(cost, nullptr, &a_block, bc_block);
+    } else {
+      problem.AddResidualBlock(cost, nullptr, bc_block);
+    }
+  }
+  ceres::Problem::EvaluateOptions options;
+  options.parameter_blocks = {&a_block, bc_block};
+  std::vector<double> residuals;
+  ceres::CRSMatrix crs;
+  ASSERT_TRUE(problem.Evaluate(options, nullptr, &residuals, nullptr, &crs));
+  j->setZero(crs.num_rows, crs.num_cols);
+  for (int row = 0; row < crs.num_rows; ++row) {
+    for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) (*j)(row, crs.cols[k]) = crs.values[k];
+  }
+  *r = Eigen::Map<const Eigen::VectorXd>(residuals.data(), residuals.size());
+}
+
+// The compressed block of MixedShapeCost wrappers, evaluated at (a, bc) on
+// `num_threads` threads; one more wrapper made after Compress stays out.
+CompressedValues CompressedAt(const std::vector<Sample>& data, double a, const double bc[2],
+                              int num_threads) {
+  double a_block = a;
+  double bc_block[2] = {bc[0], bc[1]};
+  ParallelResidualEvaluator evaluator({{&a_block, 1}, {bc_block, 2}}, num_threads);
+  std::vector<std::unique_ptr<ceres::CostFunction>> wrappers;
+  for (size_t i = 0; i < data.size(); ++i) {
+    ceres::CostFunction* cost = MixedShapeCost(data[i], static_cast<int>(i));
+    wrappers.emplace_back(i % 2 == 0 ? evaluator.Wrap(cost, {&a_block, bc_block})
+                                     : evaluator.Wrap(cost, {bc_block}));
+  }
+  const std::unique_ptr<ceres::CostFunction> compressed(evaluator.Compress());
+  wrappers.emplace_back(evaluator.Wrap(MixedShapeCost(data[1], 1), {bc_block}));
+  EXPECT_EQ(compressed->num_residuals(), 4);
+  EXPECT_EQ(compressed->parameter_block_sizes(), (std::vector<int32_t>{1, 2}));
+  CompressedValues values;
+  values.residuals.resize(4);
+  double ja[4];
+  double jbc[8];
+  double* jacobians[] = {ja, jbc};
+  const double* blocks[] = {&a_block, bc_block};
+  evaluator.PrepareForEvaluation(true, true);
+  EXPECT_TRUE(compressed->Evaluate(blocks, values.residuals.data(), jacobians));
+  values.jacobian.resize(4, 3);
+  for (int row = 0; row < 4; ++row) {
+    values.jacobian(row, 0) = ja[row];
+    values.jacobian(row, 1) = jbc[2 * row];
+    values.jacobian(row, 2) = jbc[2 * row + 1];
+  }
+  EXPECT_EQ(evaluator.evaluated_directly(), 0);  // the callback's point
+  return values;
+}
+
+// The compressed block of rows A = [J | r] gives the rows' cost |r|^2/2,
+// gradient J^T r and Gauss-Newton matrix J^T J (wrappers of mixed shapes on
+// two blocks, several chunks), its last row has no Jacobian, and its values
+// are bitwise the same on 1 and 3 threads.
+TEST(ParallelResidualEvaluator, CompressedBlockKeepsCostGradientAndGaussNewtonMatrix) {
+  const std::vector<Sample> data = SyntheticData(1001);  // 1501 rows: 6 chunks
+  const double a = 1.7;
+  const double bc[2] = {0.4, 1.4};
+  Eigen::MatrixXd j;
+  Eigen::VectorXd r;
+  RowsAt(data, a, bc, &j, &r);
+  ASSERT_EQ(j.rows(), 1501);
+  const CompressedValues one = CompressedAt(data, a, bc, 1);
+  const Eigen::Map<const Eigen::VectorXd> q(one.residuals.data(), 4);
+  EXPECT_NEAR(q.squaredNorm(), r.squaredNorm(), 1e-12 * r.squaredNorm());
+  const Eigen::VectorXd gradient = j.transpose() * r;
+  EXPECT_LT((one.jacobian.transpose() * q - gradient).norm(), 1e-12 * j.norm() * r.norm());
+  const Eigen::MatrixXd gauss_newton = j.transpose() * j;
+  EXPECT_LT((one.jacobian.transpose() * one.jacobian - gauss_newton).norm(),
+            1e-12 * gauss_newton.norm());
+  EXPECT_EQ(one.jacobian.row(3).norm(), 0.0);
+  // So the trust-region model |r + J s| is the same for any step s.
+  const Eigen::Vector3d step(0.1, -0.2, 0.05);
+  EXPECT_NEAR((q + one.jacobian * step).norm(), (r + j * step).norm(), 1e-12 * r.norm());
+
+  const CompressedValues three = CompressedAt(data, a, bc, 3);
+  EXPECT_EQ(three.residuals, one.residuals);
+  EXPECT_EQ(three.jacobian, one.jacobian);
+}
+
+// A solve on the compressed block takes the rows' steps: it ends where the
+// solve on the rows ends, in as many iterations, every evaluation answered
+// from the callback's values, bitwise the same on 1, 2 and 3 threads.
+TEST(ParallelResidualEvaluator, CompressedSolveEndsWhereTheRowsSolveEnds) {
+  const std::vector<Sample> data = SyntheticData(kNumSamples);
+  const Fit plain = FitWithoutEvaluator(data);
+  const Fit one = FitCompressed(data, 1);
+  ASSERT_EQ(one.summary.termination_type, ceres::CONVERGENCE) << one.summary.FullReport();
+  ASSERT_GT(one.summary.num_successful_steps, 2);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(one.parameters[i], plain.parameters[i], 1e-9 * std::abs(plain.parameters[i])) << i;
+  }
+  EXPECT_NEAR(one.summary.final_cost, plain.summary.final_cost, 1e-9 * plain.summary.final_cost);
+  EXPECT_EQ(one.summary.iterations.size(), plain.summary.iterations.size());
+  EXPECT_EQ(one.evaluated_directly, 0);
+  EXPECT_GT(one.replayed, 0);
+  for (int threads : {2, 3}) {
+    const Fit many = FitCompressed(data, threads);
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(many.parameters[i], one.parameters[i]) << threads;
+    EXPECT_EQ(many.summary.final_cost, one.summary.final_cost) << threads;
+  }
+}
+
+// r = x^(3/2) - shift, whose Jacobian it reports infinite at x = 0: a row
+// with a finite residual and no finite derivative (as a dwell's root at a
+// fold). It fails for x < 0.
+class InfiniteSlopeAtZero : public ceres::SizedCostFunction<1, 1> {
+ public:
+  explicit InfiniteSlopeAtZero(double shift) : shift_(shift) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double x = parameters[0][0];
+    if (x < 0.0) return false;
+    residuals[0] = std::pow(x, 1.5) - shift_;
+    if (jacobians != nullptr && jacobians[0] != nullptr) {
+      jacobians[0][0] = x == 0.0 ? std::numeric_limits<double>::infinity() : 1.5 * std::sqrt(x);
+    }
+    return true;
+  }
+
+ private:
+  const double shift_;
+};
+
+// Where a row's Jacobian is not finite the cost alone is still |r|^2/2
+// (Ceres rates a trial point by it) and the Jacobian is not finite (Ceres
+// rejects it); where a row fails to evaluate the block fails.
+TEST(ParallelResidualEvaluator, CompressedBlockAtAnInfiniteSlopeOrAFailure) {
+  double x = 0.0;
+  ParallelResidualEvaluator evaluator(&x, 1, 2);
+  std::vector<std::unique_ptr<ceres::CostFunction>> wrappers;
+  for (int i = 0; i < 600; ++i)
+    wrappers.emplace_back(evaluator.Wrap(new InfiniteSlopeAtZero(0.01 * i)));
+  const std::unique_ptr<ceres::CostFunction> compressed(evaluator.Compress());
+  double expected = 0.0;
+  for (int i = 0; i < 600; ++i) expected += 0.5 * (0.01 * i) * (0.01 * i);
+  const double* blocks[] = {&x};
+  double residuals[2];
+  evaluator.PrepareForEvaluation(false, true);
+  ASSERT_TRUE(compressed->Evaluate(blocks, residuals, nullptr));
+  EXPECT_NEAR(0.5 * (residuals[0] * residuals[0] + residuals[1] * residuals[1]), expected,
+              1e-12 * expected);
+  double jacobian[2];
+  double* jacobians[] = {jacobian};
+  ASSERT_TRUE(compressed->Evaluate(blocks, residuals, jacobians));
+  EXPECT_FALSE(std::isfinite(jacobian[0]) && std::isfinite(residuals[0]));
+
+  // A point the callback has not seen is evaluated there.
+  const double minus = -1.0;
+  const double* failing[] = {&minus};
+  EXPECT_FALSE(compressed->Evaluate(failing, residuals, nullptr));
+  EXPECT_EQ(evaluator.evaluated_directly(), 1);
+  const double one = 1.0;
+  const double* at_one[] = {&one};
+  ASSERT_TRUE(compressed->Evaluate(at_one, residuals, jacobians));
+  double at_one_cost = 0.0;
+  for (int i = 0; i < 600; ++i) at_one_cost += 0.5 * (1.0 - 0.01 * i) * (1.0 - 0.01 * i);
+  EXPECT_NEAR(0.5 * (residuals[0] * residuals[0] + residuals[1] * residuals[1]), at_one_cost,
+              1e-12 * at_one_cost);
+  EXPECT_NEAR(jacobian[0] * jacobian[0], 600 * 1.5 * 1.5, 1e-9);  // J^T J
+  EXPECT_EQ(jacobian[1], 0.0);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 // with other entries held as problems assembled for each would.
 #include "dwellfit/estimator/fit/stage_problem.h"
 
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -51,8 +52,13 @@ TEST(StageProblem, OneBlockGetsBoundsFixedEntriesAndScaling) {
   vertical.Configure();
   ceres::Problem& problem = *vertical.problem();
   EXPECT_EQ(vertical.dwells(), fit.NumDwells());
-  EXPECT_EQ(problem.NumResiduals(), fit.NumDwells());
-  EXPECT_EQ(problem.NumResidualBlocks(), Batches(fit));
+  // The solver sees the dwells compressed: one block of 6 + 1 rows; their
+  // own batches are in the dwell problem.
+  EXPECT_EQ(problem.NumResidualBlocks(), 1);
+  EXPECT_EQ(problem.NumResiduals(), kNumParameters + 1);
+  EXPECT_EQ(vertical.dwell_problem()->NumResiduals(), fit.NumDwells());
+  EXPECT_EQ(vertical.dwell_problem()->NumResidualBlocks(), Batches(fit));
+  EXPECT_EQ(static_cast<int>(vertical.dwell_blocks().size()), Batches(fit));
   EXPECT_EQ(problem.ParameterBlockTangentSize(p.data()), 4);
   for (int i : {kEtaE, kMu1, kMu2}) EXPECT_EQ(problem.GetParameterLowerBound(p.data(), i), 0.0);
   EXPECT_EQ(problem.GetParameterLowerBound(p.data(), kDelta), kNoBound);
@@ -92,8 +98,11 @@ TEST(StageProblem, SharedEntriesAreBoundedAndEachBlockIsScaled) {
   stage.Configure();
   ceres::Problem& problem = *stage.problem();
   EXPECT_EQ(problem.NumParameterBlocks(), 3);
-  EXPECT_EQ(problem.NumResiduals(), fit.NumDwells());
-  EXPECT_EQ(problem.NumResidualBlocks(), Batches(fit));
+  // One compressed block over every described entry (3 blocks, 5 + 1 + 1).
+  EXPECT_EQ(problem.NumResidualBlocks(), 1);
+  EXPECT_EQ(problem.NumResiduals(), 7 + 1);
+  EXPECT_EQ(stage.dwell_problem()->NumResiduals(), fit.NumDwells());
+  EXPECT_EQ(stage.dwell_problem()->NumResidualBlocks(), Batches(fit));
   EXPECT_EQ(problem.ParameterBlockTangentSize(model.shared), 5);
   EXPECT_EQ(problem.ParameterBlockTangentSize(model.w_b), 1);
   for (int i : {0, 1, 2}) EXPECT_EQ(problem.GetParameterLowerBound(model.shared, i), 0.0);
@@ -230,6 +239,47 @@ TEST(StageProblem, SolvingAgainWithOtherHeldEntriesMatchesANewProblem) {
   EXPECT_EQ(reused.problem()->ParameterBlockTangentSize(p.data()), kNumParameters);
 }
 
+// The dwells compressed into one block (the default) and as their own
+// blocks: the same start cost, and a vertical-error solve on the noisy
+// thesis case that ends at the same estimate, cost and data cost.
+TEST(StageProblem, CompressedDwellsSolveAsTheDwellsThemselves) {
+  const std::vector<Sweep> sweeps = SimulateDataset(kThesisTruth, 0.01, 7);
+  ParameterVector start = ThesisStart(kThesisTruth);
+  ParameterVector ends[2];
+  double costs[2];
+  double data_costs[2];
+  for (bool compress : {true, false}) {
+    ParameterVector p = start;
+    const FitDescription fit = SingleBlockFit(Pointers(sweeps), {}, &p);
+    StageSetup setup = SetupFor(fit, ResidualKind::kVertical);
+    setup.compress_dwells = compress;
+    setup.num_threads = 2;
+    StageProblem stage(fit, setup);
+    stage.Configure();
+    EXPECT_EQ(stage.problem()->NumResidualBlocks(),
+              compress ? 1 : static_cast<int>(stage.dwell_blocks().size()));
+    ceres::Solver::Options options;
+    options.linear_solver_type = ceres::DENSE_QR;
+    options.max_num_iterations = 100;
+    options.function_tolerance = 1e-12;
+    options.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(options, stage.problem(), &summary);
+    ASSERT_EQ(summary.termination_type, ceres::CONVERGENCE) << summary.BriefReport();
+    ends[compress] = p;
+    costs[compress] = summary.final_cost;
+    data_costs[compress] = stage.DataCost();
+  }
+  // The solve went from the start (eta_e 30 % off) to near the truth.
+  EXPECT_NEAR(ends[1][kEtaE], kThesisTruth[kEtaE], 0.02 * kThesisTruth[kEtaE]);
+  EXPECT_NEAR(costs[1], costs[0], 1e-9 * costs[0]);
+  EXPECT_NEAR(data_costs[1], costs[1], 1e-12 * costs[1]);
+  EXPECT_NEAR(data_costs[0], costs[0], 1e-12 * costs[0]);
+  for (int i = 0; i < kNumParameters; ++i) {
+    EXPECT_NEAR(ends[1][i], ends[0][i], 1e-6 * std::abs(ends[0][i])) << i;
+  }
+}
+
 // Counts its destructions; r = p[mu1] - target otherwise.
 class CountedPrior : public ceres::SizedCostFunction<1, kNumParameters> {
  public:
@@ -271,7 +321,8 @@ TEST(StageProblem, OwnsEveryCostFunctionOnce) {
       StageProblem stage(fit, setup);
       stage.AddCallerResiduals();
       ASSERT_EQ(stage.caller_blocks().size(), 3u);
-      EXPECT_EQ(stage.problem()->NumResidualBlocks(), Batches(fit) + 3);
+      // Threaded, the dwells are compressed into one block.
+      EXPECT_EQ(stage.problem()->NumResidualBlocks(), (threaded ? 1 : Batches(fit)) + 3);
       // The dwells are exact at the truth; the priors' r = -0.1, -0.1, 0.1.
       double cost = 0.0;
       ASSERT_TRUE(stage.problem()->Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr,
