@@ -32,7 +32,11 @@ double ThreadChoice::RecentTimes::Typical() const {
 
 bool ThreadChoice::Next() {
   bool trial = false;
-  if (confirm_left_ == 0 && ++since_trial_ >= trial_interval_) {
+  // A trial is measured against the median of three of the preferred way
+  // taken by this choice.
+  const RecentTimes& preferred = prefer_threaded_ ? threaded_times_ : alone_times_;
+  if (confirm_left_ == 0 && ++since_trial_ >= trial_interval_ &&
+      preferred.count >= kTimesCompared) {
     since_trial_ = 0;
     trial = true;
   }
@@ -46,6 +50,10 @@ bool ThreadChoice::Faster(bool threaded, double seconds, double other_seconds) {
 }
 
 void ThreadChoice::Record(bool threaded, double seconds) {
+  if (!timed_first_) {  // the first evaluation of a solve: cold, not timed
+    timed_first_ = true;
+    return;
+  }
   RecentTimes& times = threaded ? threaded_times_ : alone_times_;
   const RecentTimes& other = threaded ? alone_times_ : threaded_times_;
   times.Add(seconds);

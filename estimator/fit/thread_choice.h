@@ -8,7 +8,13 @@
 // choice therefore changes only by trial: every so often one evaluation runs
 // the way not preferred, and its time is compared with the median of the
 // preferred way's last three evaluations, the ones just before it (the
-// median: one evaluation the machine held up does not decide). A trial that
+// median: one evaluation the machine held up does not decide), so it waits
+// until this choice has timed three; the first evaluation a choice sees (its
+// solve's first, the roots and buffers cold, the dearest of the solve) is
+// not timed. Taken just after a dear start, a trial of either way would
+// look faster than it is: on the measured beam the caller alone won the
+// vertical stage's first trial against the threads' first two evaluations
+// and kept the evaluations for some fifty more. A trial that
 // wins switches the way, and the next three evaluations confirm it against
 // the same median, or the way switches back. A trial that loses doubles the
 // wait before the next (16, 32, then 64 evaluations), so a machine that stays
@@ -22,7 +28,8 @@
 // of the same history goes on from: the evaluators of one residual kind
 // share one (ForKind), so a study of many fits pays for the trials once. A
 // history nobody has used yet starts on the threads and tries the caller
-// alone after three evaluations. Which way runs changes no value.
+// alone after four evaluations (one untimed, three timed). Which way runs
+// changes no value.
 #ifndef DWELLFIT_ESTIMATOR_FIT_THREAD_CHOICE_H_
 #define DWELLFIT_ESTIMATOR_FIT_THREAD_CHOICE_H_
 
@@ -53,6 +60,9 @@ class ThreadChoice {
   static constexpr int kMaxTrialInterval = 64;
   static constexpr int kFirstTrialAfter = 3;
   static constexpr int kConfirmations = 3;
+  // Evaluations of the preferred way a trial is compared with (their
+  // median).
+  static constexpr int kTimesCompared = 3;
 
   // Goes on from `history` (not owned; it must outlive this).
   explicit ThreadChoice(ThreadChoiceHistory* history);
@@ -68,7 +78,7 @@ class ThreadChoice {
  private:
   // The wall times of one way's last evaluations.
   struct RecentTimes {
-    std::array<double, 3> seconds{};
+    std::array<double, kTimesCompared> seconds{};
     int count = 0;  // timed so far, at most seconds.size() kept
     void Add(double value) { seconds[count++ % seconds.size()] = value; }
     // The median of the last three, the least of fewer (0: none yet).
@@ -84,7 +94,8 @@ class ThreadChoice {
   bool prefer_threaded_ = true;
   int trial_interval_ = kFirstTrialAfter;
   int since_trial_ = 0;
-  int confirm_left_ = 0;  // evaluations still to confirm a switch
+  int confirm_left_ = 0;      // evaluations still to confirm a switch
+  bool timed_first_ = false;  // the first Record, which is not timed, has come
 };
 
 }  // namespace dwellfit
