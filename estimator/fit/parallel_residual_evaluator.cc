@@ -70,16 +70,8 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
   // coordinates); false if the evaluation failed.
   bool AddGradient(double* gradient) const {
     if (!ok_) return false;
-    const std::vector<int32_t>& sizes = parameter_block_sizes();
-    int start = 0;
-    for (size_t j = 0; j < sizes.size(); ++j) {
-      const double* jacobian = Jacobian() + rows_ * start;
-      for (int row = 0; row < rows_; ++row) {
-        for (int col = 0; col < sizes[j]; ++col)
-          gradient[Offset(j) + col] += jacobian[row * sizes[j] + col] * Residuals()[row];
-      }
-      start += sizes[j];
-    }
+    ForEachJacobianEntry(
+        [&](int row, int column, double value) { gradient[column] += value * Residuals()[row]; });
     return true;
   }
 
@@ -88,17 +80,7 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
   // entries are left as they are); false if the evaluation failed.
   bool WriteRows(Eigen::MatrixXd* a, int row) const {
     if (!ok_) return false;
-    const std::vector<int32_t>& sizes = parameter_block_sizes();
-    int start = 0;
-    for (size_t j = 0; j < sizes.size(); ++j) {
-      const double* jacobian = Jacobian() + rows_ * start;
-      for (int i = 0; i < rows_; ++i) {
-        for (int col = 0; col < sizes[j]; ++col) {
-          (*a)(row + i, Offset(j) + col) = jacobian[i * sizes[j] + col];
-        }
-      }
-      start += sizes[j];
-    }
+    ForEachJacobianEntry([&](int i, int column, double value) { (*a)(row + i, column) = value; });
     for (int i = 0; i < rows_; ++i) (*a)(row + i, a->cols() - 1) = Residuals()[i];
     return true;
   }
@@ -153,6 +135,23 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
   }
 
  private:
+  // Calls visit(row, column, value) for every entry of the precomputed
+  // Jacobian, `column` the entry's place in the evaluator's point.
+  template <typename Visit>
+  void ForEachJacobianEntry(Visit visit) const {
+    const std::vector<int32_t>& sizes = parameter_block_sizes();
+    int start = 0;
+    for (size_t j = 0; j < sizes.size(); ++j) {
+      const double* jacobian = Jacobian() + rows_ * start;
+      for (int row = 0; row < rows_; ++row) {
+        for (int col = 0; col < sizes[j]; ++col) {
+          visit(row, Offset(j) + col, jacobian[row * sizes[j] + col]);
+        }
+      }
+      start += sizes[j];
+    }
+  }
+
   // Parameter blocks whose pointers fit on the stack (every dwellfit
   // residual reads at most six).
   static constexpr size_t kStackBlocks = 8;
