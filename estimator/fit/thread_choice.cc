@@ -16,9 +16,7 @@ ThreadChoice::ThreadChoice(ThreadChoiceHistory* history) : history_(history) {
   const int way = history->preferred_way.load(std::memory_order_relaxed);
   if (way == 0) return;  // a new history: threads first, a trial after three
   prefer_threaded_ = way == 1;
-  // The first trial of a new choice comes after at most kTrialInterval.
-  trial_interval_ =
-      std::min(kTrialInterval, history->trial_interval.load(std::memory_order_relaxed));
+  trial_interval_ = history->trial_interval.load(std::memory_order_relaxed);
   since_trial_ = history->since_trial.load(std::memory_order_relaxed);
 }
 

@@ -26,12 +26,7 @@
 // What the choice has come to (the way, the wait between trials, the count
 // since the last) is kept in a ThreadChoiceHistory, which the next choice
 // of the same history goes on from: the evaluators of one residual kind
-// share one (ForKind), so a study of many fits pays for the trials once.
-// Only the wait is cut back to kTrialInterval for a new choice's first
-// trial: a solve that starts after the machine's load has changed finds
-// out within 16 evaluations rather than 64 (the measured beam's fits run
-// alternately idle and beside a busy core: two threads 1.46x faster than
-// one before, 1.62x after; the trials cost a busy core about 1 %). A
+// share one (ForKind), so a study of many fits pays for the trials once. A
 // history nobody has used yet starts on the threads and tries the caller
 // alone after four evaluations (one untimed, three timed). Which way runs
 // changes no value.
