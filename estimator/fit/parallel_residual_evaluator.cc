@@ -228,6 +228,24 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
   bool valid_ = false;
 };
 
+template <typename Values>
+bool ParallelResidualEvaluator::AtLastPoint(const Values& values) const {
+  for (size_t b = 0; b < blocks_.size(); ++b) {
+    const double* last = last_point_.data() + offsets_[b];
+    if (!std::equal(last, last + blocks_[b].size, values(b))) return false;
+  }
+  return true;
+}
+
+template <typename Values>
+void ParallelResidualEvaluator::CopyToPoint(const Values& values,
+                                            std::vector<double>* point) const {
+  point->resize(size_);
+  for (size_t b = 0; b < blocks_.size(); ++b) {
+    std::copy(values(b), values(b) + blocks_[b].size, point->begin() + offsets_[b]);
+  }
+}
+
 // The one residual block of the compressed wrappers (Compress).
 class ParallelResidualEvaluator::CompressedCostFunction : public ceres::CostFunction {
  public:
@@ -260,7 +278,7 @@ ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, 
     size_ += block.size;
   }
   CHECK_GE(num_threads, 1);
-  CopyBlocksTo(&iterate_);  // sized once: IterateEntry hands out pointers into it
+  CopyToPoint(BlockValues(), &iterate_);  // sized once: IterateEntry hands out pointers into it
 }
 
 ParallelResidualEvaluator::ParallelResidualEvaluator(const double* parameters, int size,
@@ -303,21 +321,6 @@ void ParallelResidualEvaluator::Reserve(int wrappers, int residuals) {
                    static_cast<size_t>(residuals) * (1 + size_));
 }
 
-void ParallelResidualEvaluator::CopyBlocksTo(std::vector<double>* point) const {
-  point->resize(size_);
-  for (size_t b = 0; b < blocks_.size(); ++b) {
-    std::copy(blocks_[b].values, blocks_[b].values + blocks_[b].size, point->begin() + offsets_[b]);
-  }
-}
-
-bool ParallelResidualEvaluator::AtLastPoint() const {
-  for (size_t b = 0; b < blocks_.size(); ++b) {
-    const double* last = last_point_.data() + offsets_[b];
-    if (!std::equal(last, last + blocks_[b].size, blocks_[b].values)) return false;
-  }
-  return true;
-}
-
 const double* ParallelResidualEvaluator::IterateEntry(const double* value) const {
   for (size_t b = 0; b < blocks_.size(); ++b) {
     const double* begin = blocks_[b].values;
@@ -333,8 +336,8 @@ void ParallelResidualEvaluator::PrepareForEvaluation(bool evaluate_jacobians,
   // Ceres has copied the point into the caller's blocks. The same point
   // again (the Jacobian at an accepted step, a line search's trial step and
   // the trust-region candidate): the values, Jacobians included, are there.
-  if (!computed_ || !AtLastPoint()) {
-    CopyBlocksTo(&last_point_);
+  if (!computed_ || !AtLastPoint(BlockValues())) {
+    CopyToPoint(BlockValues(), &last_point_);
     PrecomputeAll();
   }
   // last_point_ now holds the caller's blocks either way.
@@ -446,19 +449,12 @@ ceres::CostFunction* ParallelResidualEvaluator::Compress() {
 
 bool ParallelResidualEvaluator::EvaluateCompressed(double const* const* parameters,
                                                    double* residuals, double** jacobians) {
-  bool at_point = computed_;
-  for (size_t b = 0; b < blocks_.size() && at_point; ++b) {
-    const double* last = last_point_.data() + offsets_[b];
-    at_point = std::equal(last, last + blocks_[b].size, parameters[b]);
-  }
-  if (at_point) {
+  const auto values = [parameters](size_t b) { return parameters[b]; };
+  if (computed_ && AtLastPoint(values)) {
     ++replayed_;
   } else {  // a point the callback did not see
     ++evaluated_directly_;
-    last_point_.resize(size_);
-    for (size_t b = 0; b < blocks_.size(); ++b) {
-      std::copy(parameters[b], parameters[b] + blocks_[b].size, last_point_.begin() + offsets_[b]);
-    }
+    CopyToPoint(values, &last_point_);
     PrecomputeAll();
   }
   if (!compressed_ok_) return false;

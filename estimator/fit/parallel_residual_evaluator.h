@@ -154,10 +154,17 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   void CombineChunks();
   // CompressedCostFunction::Evaluate.
   bool EvaluateCompressed(double const* const* parameters, double* residuals, double** jacobians);
-  // The watched blocks hold last_point_.
-  bool AtLastPoint() const;
-  // The watched blocks' values, concatenated, into `point` (resized to a point).
-  void CopyBlocksTo(std::vector<double>* point) const;
+  // Whether the watched blocks' values, block b's at values(b) (the blocks'
+  // own, BlockValues, or a cost function's parameters), are last_point_.
+  template <typename Values>
+  bool AtLastPoint(const Values& values) const;
+  // Those values, concatenated, into `point` (resized to a point).
+  template <typename Values>
+  void CopyToPoint(const Values& values, std::vector<double>* point) const;
+  // The watched blocks' own values, for the two above.
+  auto BlockValues() const {
+    return [this](size_t b) -> const double* { return blocks_[b].values; };
+  }
 
   const std::vector<Block> blocks_;
   std::vector<int> offsets_;  // of each block in a point
