@@ -30,8 +30,7 @@ int main(int argc, char** argv) {
       "writes the chapter's Tables 3.3 and 3.4 (with and without the bifurcation-range "
       "penalty) as Markdown.\n  chapter_tables [--numerical CFG --truth_plan PLAN --measured CFG "
       "--output FILE]");
-  if (!dwellfit::FlagsGivenOnce(argc, argv, "chapter_tables")) return 2;
-  gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
+  if (!dwellfit::ParseToolFlags(&argc, &argv, "chapter_tables")) return 2;
   try {
     const std::string markdown =
         dwellfit::ChapterTablesMarkdown(dwellfit::LoadIdentifyConfig(FLAGS_numerical),

@@ -27,8 +27,7 @@ int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "fits the convergence family from the automatic start and writes its report.\n"
       "  convergence_family [--base CFG --output FILE]");
-  if (!dwellfit::FlagsGivenOnce(argc, argv, "convergence_family")) return 2;
-  gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
+  if (!dwellfit::ParseToolFlags(&argc, &argv, "convergence_family")) return 2;
   try {
     const dwellfit::IdentifyConfig base = dwellfit::LoadIdentifyConfig(FLAGS_base);
     std::vector<dwellfit::FamilyOutcome> outcomes;

@@ -41,8 +41,7 @@ int main(int argc, char** argv) {
       "Coverage of the 95 % parameter intervals over noisy simulated replicas.\n"
       "Usage: coverage_study --config beam.yaml --plan plan.yaml [--replicas 200] "
       "[--noise 0.01] [--set key.path=value,...]");
-  if (!dwellfit::FlagsGivenOnce(argc, argv, "coverage_study")) return 2;
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  if (!dwellfit::ParseToolFlags(&argc, &argv, "coverage_study")) return 2;
   if (FLAGS_config.empty() || FLAGS_plan.empty() || FLAGS_replicas < 1 || !(FLAGS_noise >= 0.0)) {
     std::cerr << "coverage_study: give --config and --plan, --replicas >= 1, --noise >= 0\n"
               << gflags::ProgramUsage() << "\n";

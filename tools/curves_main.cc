@@ -115,8 +115,7 @@ int main(int argc, char** argv) {
       "The model's response curves as CSV.\nUsage: curves (--result result.yaml | --plan "
       "plan.yaml | --eta_e .. --omega_hz ..) [--kind frequency --a_base A --from HZ --to HZ | "
       "--kind amplitude --freq_hz HZ --from A --to A] [--output curves.csv]");
-  if (!dwellfit::FlagsGivenOnce(argc, argv, "curves")) return 2;
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  if (!dwellfit::ParseToolFlags(&argc, &argv, "curves")) return 2;
   try {
     std::optional<dwellfit::DwellPlan> plan;
     if (!FLAGS_plan.empty()) plan = dwellfit::ReadDwellPlan(FLAGS_plan);

@@ -80,8 +80,7 @@ int main(int argc, char** argv) {
       "identifies a beam mode's parameters from sine-dwell sweeps.\n"
       "  identify --config beam.yaml [--output_dir DIR] [--fix delta,omega] [--set k=v,...]\n"
       "The config keys are documented in config/README.md.");
-  if (!dwellfit::FlagsGivenOnce(argc, argv, "identify")) return dwellfit::kExitUsage;
-  gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
+  if (!dwellfit::ParseToolFlags(&argc, &argv, "identify")) return dwellfit::kExitUsage;
   if (FLAGS_config.empty() || argc > 1) {
     std::cerr << "identify: give the config file with --config FILE"
               << (argc > 1 ? std::string(" (unexpected argument '") + argv[1] + "')" : "")

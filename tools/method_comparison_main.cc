@@ -33,8 +33,7 @@ int main(int argc, char** argv) {
       "compares the chapter's identification methods and writes the tables as Markdown.\n"
       "  method_comparison [--numerical CFG --truth_plan PLAN --measured CFG --output FILE "
       "--noise_seeds N --phase_bias_deg D --wall_time]");
-  if (!dwellfit::FlagsGivenOnce(argc, argv, "method_comparison")) return 2;
-  gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
+  if (!dwellfit::ParseToolFlags(&argc, &argv, "method_comparison")) return 2;
   try {
     dwellfit::MethodComparisonOptions options;
     options.noise_seeds = FLAGS_noise_seeds;

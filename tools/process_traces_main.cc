@@ -63,8 +63,7 @@ int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "Dwell points (and optionally harmonic-balance estimates) from sine-dwell time traces.\n"
       "Usage: process_traces --rig rig.yaml --traces folder --out sweeps.csv");
-  if (!dwellfit::FlagsGivenOnce(argc, argv, "process_traces")) return 2;
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  if (!dwellfit::ParseToolFlags(&argc, &argv, "process_traces")) return 2;
   if (FLAGS_rig.empty() || FLAGS_traces.empty() || FLAGS_out.empty()) {
     std::cerr << "process_traces: give --rig, --traces and --out\n"
               << gflags::ProgramUsage() << "\n";

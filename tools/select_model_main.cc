@@ -34,8 +34,7 @@ int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "compares model variants by cost, AIC, BIC and cross-validation.\n"
       "  select_model --config beam.yaml [--set k=v,...] [--threads N] [--output_dir DIR]");
-  if (!dwellfit::FlagsGivenOnce(argc, argv, "select_model")) return 2;
-  gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
+  if (!dwellfit::ParseToolFlags(&argc, &argv, "select_model")) return 2;
   if (FLAGS_config.empty()) {
     std::cerr << "select_model: --config is required\n";
     return 1;

@@ -88,8 +88,7 @@ int main(int argc, char** argv) {
       "sets or fitted sweeps.\nUsage: sensitivity --config beam.yaml [--plan plan.yaml "
       "--replicas 1000 --noise 0.01] [--vary 'key=v1|v2'] [--threads 2] [--shard k/N] "
       "--output_dir study/\n       sensitivity --merge dir0,dir1,... --output_dir study/");
-  if (!dwellfit::FlagsGivenOnce(argc, argv, "sensitivity")) return 2;
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  if (!dwellfit::ParseToolFlags(&argc, &argv, "sensitivity")) return 2;
   try {
     if (FLAGS_output_dir.empty()) throw dwellfit::InputError("--output_dir", 0, "", "required");
     dwellfit::CheckOutputDirectory(FLAGS_output_dir, "--output_dir");

@@ -25,8 +25,7 @@ int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "Simulates sine-dwell sweeps on the model from a plan.\n"
       "Usage: simulate_dwell --plan plan.yaml --out sweeps.csv");
-  if (!dwellfit::FlagsGivenOnce(argc, argv, "simulate_dwell")) return 2;
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  if (!dwellfit::ParseToolFlags(&argc, &argv, "simulate_dwell")) return 2;
   if (FLAGS_plan.empty() || FLAGS_out.empty()) {
     std::cerr << "simulate_dwell: give both --plan and --out\n" << gflags::ProgramUsage() << "\n";
     return 2;

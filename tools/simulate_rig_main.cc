@@ -46,8 +46,7 @@ int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "Simulates a sine-dwell test on the virtual rig and writes time traces.\n"
       "Usage: simulate_rig --plan plan.yaml --rig rig.yaml --out traces_folder");
-  if (!dwellfit::FlagsGivenOnce(argc, argv, "simulate_rig")) return 2;
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  if (!dwellfit::ParseToolFlags(&argc, &argv, "simulate_rig")) return 2;
   if (FLAGS_plan.empty() || FLAGS_rig.empty() || FLAGS_out.empty()) {
     std::cerr << "simulate_rig: give --plan, --rig and --out\n" << gflags::ProgramUsage() << "\n";
     return 2;
