@@ -152,6 +152,8 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   void FactorChunk(int chunk);
   // The chunks' R, stacked, into compressed_r_.
   void CombineChunks();
+  // Whether every wrapper's values came out at last_point_.
+  bool EveryUnitEvaluated() const;
   // CompressedCostFunction::Evaluate.
   bool EvaluateCompressed(double const* const* parameters, double* residuals, double** jacobians);
   // Whether the watched blocks' values, block b's at values(b) (the blocks'

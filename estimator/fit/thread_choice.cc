@@ -1,6 +1,11 @@
 #include "dwellfit/estimator/fit/thread_choice.h"
 
+#include <fcntl.h>
+#include <sys/sysinfo.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstdio>
 
 #include "glog/logging.h"
 
@@ -12,7 +17,23 @@ ThreadChoiceHistory& ThreadChoiceHistory::ForKind(int kind) {
   return histories[kind];
 }
 
-ThreadChoice::ThreadChoice(ThreadChoiceHistory* history) : history_(history) {
+int IdleProcessors() {
+  // "0.38 0.48 1.02 1/78 7400": the fourth field is runnable/all tasks.
+  const int fd = open("/proc/loadavg", O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return -1;
+  char text[128];
+  const ssize_t length = read(fd, text, sizeof(text) - 1);
+  close(fd);
+  if (length <= 0) return -1;
+  text[length] = '\0';
+  int runnable = 0;
+  int tasks = 0;
+  if (std::sscanf(text, "%*s %*s %*s %d/%d", &runnable, &tasks) != 2 || runnable < 1) return -1;
+  return std::max(0, get_nprocs() - runnable);
+}
+
+ThreadChoice::ThreadChoice(ThreadChoiceHistory* history, IdleProbe idle_probe)
+    : history_(history), idle_probe_(idle_probe) {
   const int way = history->preferred_way.load(std::memory_order_relaxed);
   if (way == 0) return;  // a new history: threads first, a trial after three
   prefer_threaded_ = way == 1;
@@ -38,7 +59,8 @@ bool ThreadChoice::Next() {
   if (confirm_left_ == 0 && ++since_trial_ >= trial_interval_ &&
       preferred.count >= kTimesCompared) {
     since_trial_ = 0;
-    trial = true;
+    // Threads with no idle processor to run on: put off, not lost.
+    trial = prefer_threaded_ || idle_probe_() != 0;
   }
   history_->since_trial.store(since_trial_, std::memory_order_relaxed);
   return trial ? !prefer_threaded_ : prefer_threaded_;

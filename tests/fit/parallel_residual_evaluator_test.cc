@@ -519,6 +519,29 @@ TEST(ParallelResidualEvaluator, FailureOfAWrappedFunctionIsReplayed) {
   EXPECT_EQ(evaluator.evaluated_directly(), 0);
 }
 
+// A point some residual fails at is not timed for the choice of threads
+// (its rows stop early, so its time says nothing of the next evaluation's):
+// only evaluations that came out reach the evaluators' shared history.
+TEST(ParallelResidualEvaluator, AFailedEvaluationIsNotTimed) {
+  constexpr int kKind = ThreadChoiceHistory::kKinds - 1;  // no other test's
+  ThreadChoiceHistory& history = ThreadChoiceHistory::ForKind(kKind);
+  history.preferred_way = 0;
+  double x = 0.0;
+  ParallelResidualEvaluator evaluator(&x, 1, 2, kKind);
+  std::vector<std::unique_ptr<ceres::CostFunction>> wrappers;
+  for (int i = 0; i < 1000; ++i) wrappers.emplace_back(evaluator.Wrap(new SqrtCost(0.0)));
+  for (int i = 1; i <= 8; ++i) {  // every SqrtCost fails below 0
+    x = -i;
+    evaluator.PrepareForEvaluation(true, true);
+  }
+  EXPECT_EQ(history.preferred_way.load(), 0);
+  for (int i = 1; i <= 3; ++i) {  // the first a choice sees is not timed
+    x = i;
+    evaluator.PrepareForEvaluation(true, true);
+  }
+  EXPECT_NE(history.preferred_way.load(), 0);
+}
+
 // Two residuals of {b, c} alone: the cosine's residual and its square.
 struct TwoResidualsOfBC {
   explicit TwoResidualsOfBC(const Sample& sample) : cosine(sample) {}

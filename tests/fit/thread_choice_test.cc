@@ -1,11 +1,17 @@
 #include "dwellfit/estimator/fit/thread_choice.h"
 
+#include <sys/sysinfo.h>
+
 #include <functional>
 
 #include "gtest/gtest.h"
 
 namespace dwellfit {
 namespace {
+
+// Probes of the machine: one processor idle besides the caller's, or none.
+int OneIdle() { return 1; }
+int NoneIdle() { return 0; }
 
 // Runs `count` evaluations whose time [s] in each way is
 // `seconds(threaded, evaluation)`; returns how many ran threaded.
@@ -22,7 +28,7 @@ int RunEvaluations(ThreadChoice* choice, int count, const std::function<double(b
 
 TEST(ThreadChoice, ANewHistoryStartsOnTheThreadsAndTriesTheCallerAloneAfterFour) {
   ThreadChoiceHistory history;
-  ThreadChoice choice(&history);
+  ThreadChoice choice(&history, &OneIdle);
   for (int i = 0; i < 4; ++i) {  // the first not timed, then three
     EXPECT_TRUE(choice.Next()) << i;
     choice.Record(true, 1e-3);
@@ -41,7 +47,7 @@ TEST(ThreadChoice, ATrialWaitsForThreeTimedEvaluationsAfterTheColdFirst) {
   history.preferred_way = 1;
   history.trial_interval = ThreadChoice::kTrialInterval;
   history.since_trial = ThreadChoice::kTrialInterval - 3;  // a trial due at the third
-  ThreadChoice choice(&history);
+  ThreadChoice choice(&history, &OneIdle);
   const auto cooling = [](bool t, int i) {
     if (!t) return 0.96e-3;
     return i == 0 ? 1.2e-3 : i == 1 ? 0.95e-3 : i == 2 ? 0.6e-3 : 0.5e-3;
@@ -55,7 +61,7 @@ TEST(ThreadChoice, ATrialWaitsForThreeTimedEvaluationsAfterTheColdFirst) {
 // evaluations stay threaded, and the caller alone is tried ever more rarely.
 TEST(ThreadChoice, ThreadsTwiceAsFastStayThreadedWithRarerTrials) {
   ThreadChoiceHistory history;
-  ThreadChoice choice(&history);
+  ThreadChoice choice(&history, &OneIdle);
   const int threaded =
       RunEvaluations(&choice, 200, [](bool t, int) { return t ? 0.5e-3 : 1.0e-3; });
   EXPECT_TRUE(choice.prefers_threaded());
@@ -69,7 +75,7 @@ TEST(ThreadChoice, ThreadsTwiceAsFastStayThreadedWithRarerTrials) {
 // rarely.
 TEST(ThreadChoice, ThreadsNotClearlyFasterGiveWayToTheCallerAlone) {
   ThreadChoiceHistory history;
-  ThreadChoice choice(&history);
+  ThreadChoice choice(&history, &OneIdle);
   const int threaded =
       RunEvaluations(&choice, 200, [](bool t, int) { return t ? 0.9e-3 : 1.0e-3; });
   EXPECT_FALSE(choice.prefers_threaded());
@@ -87,7 +93,7 @@ TEST(ThreadChoice, ADriftingCostIsNotTakenForFasterThreads) {
   ThreadChoiceHistory history;
   history.preferred_way = 2;  // the caller alone
   history.trial_interval = ThreadChoice::kTrialInterval;
-  ThreadChoice choice(&history);
+  ThreadChoice choice(&history, &OneIdle);
   const auto drifting = [](bool t, int i) { return (t ? 0.9 : 1.0) * (0.4e-3 + 0.05e-3 * i); };
   const int threaded = RunEvaluations(&choice, 120, drifting);
   EXPECT_FALSE(choice.prefers_threaded());
@@ -99,7 +105,7 @@ TEST(ThreadChoice, ADriftingCostIsNotTakenForFasterThreads) {
 // measured against the median of the last three.
 TEST(ThreadChoice, OneHeldUpEvaluationDoesNotDecide) {
   ThreadChoiceHistory history;
-  ThreadChoice choice(&history);
+  ThreadChoice choice(&history, &OneIdle);
   RunEvaluations(&choice, 10, [](bool t, int) { return t ? 0.5e-3 : 1.0e-3; });
   ASSERT_TRUE(choice.prefers_threaded());
   // The next trial comes after 16 evaluations: hold up the one before it.
@@ -114,7 +120,7 @@ TEST(ThreadChoice, ASwitchThatDoesNotHoldIsUndone) {
   ThreadChoiceHistory history;
   history.preferred_way = 2;
   history.trial_interval = ThreadChoice::kTrialInterval;
-  ThreadChoice choice(&history);
+  ThreadChoice choice(&history, &OneIdle);
   RunEvaluations(&choice, 15, [](bool t, int) { return t ? 2e-3 : 1e-3; });
   // The trial (evaluation 15) is lucky; the three after it are not.
   RunEvaluations(
@@ -127,15 +133,55 @@ TEST(ThreadChoice, ASwitchThatDoesNotHoldIsUndone) {
   EXPECT_EQ(choice.trial_interval(), 2 * ThreadChoice::kTrialInterval);
 }
 
+// With no idle processor the threads are not tried: the caller alone runs
+// every evaluation, and the trials are only put off (the wait stays 16), so
+// they resume at the next interval once a processor is idle.
+TEST(ThreadChoice, NoIdleProcessorPutsOffTheTrialsOfTheThreads) {
+  ThreadChoiceHistory history;
+  history.preferred_way = 2;  // the caller alone
+  history.trial_interval = ThreadChoice::kTrialInterval;
+  const auto twice_as_fast = [](bool t, int) { return t ? 0.5e-3 : 1.0e-3; };
+  {
+    ThreadChoice busy(&history, &NoneIdle);
+    EXPECT_EQ(RunEvaluations(&busy, 100, twice_as_fast), 0);
+    EXPECT_FALSE(busy.prefers_threaded());
+    EXPECT_EQ(busy.trial_interval(), ThreadChoice::kTrialInterval);
+  }
+  ThreadChoice idle(&history, &OneIdle);
+  // Put off at evaluations 16, 32, ..., 96: the next falls due at 112 (the
+  // twelfth of these), wins and holds.
+  const int threaded = RunEvaluations(&idle, 20, twice_as_fast, 100);
+  EXPECT_TRUE(idle.prefers_threaded());
+  EXPECT_EQ(threaded, 20 - 11);
+}
+
+// A probe that cannot read the machine (-1) leaves the trials as they are.
+TEST(ThreadChoice, AnUnreadableMachineStillTriesTheThreads) {
+  ThreadChoiceHistory history;
+  history.preferred_way = 2;
+  history.trial_interval = ThreadChoice::kTrialInterval;
+  ThreadChoice choice(&history, [] { return -1; });
+  EXPECT_EQ(RunEvaluations(&choice, 16, [](bool t, int) { return t ? 0.5e-3 : 1.0e-3; }), 1);
+  EXPECT_TRUE(choice.prefers_threaded());
+}
+
+// The probe of this machine reads a count: at least zero, and not more idle
+// processors than the machine has besides the caller's.
+TEST(ThreadChoice, IdleProcessorsReadsThisMachine) {
+  const int idle = IdleProcessors();
+  ASSERT_GE(idle, 0) << "/proc/loadavg unreadable";
+  EXPECT_LT(idle, get_nprocs());
+}
+
 // The next choice of one history goes on from where the last left off.
 TEST(ThreadChoice, TheNextChoiceOfAHistoryGoesOnFromTheLast) {
   ThreadChoiceHistory history;
   {
-    ThreadChoice first(&history);
+    ThreadChoice first(&history, &OneIdle);
     RunEvaluations(&first, 40, [](bool t, int) { return t ? 0.9e-3 : 1.0e-3; });
     ASSERT_FALSE(first.prefers_threaded());
   }
-  ThreadChoice next(&history);
+  ThreadChoice next(&history, &OneIdle);
   EXPECT_FALSE(next.prefers_threaded());
   EXPECT_EQ(next.trial_interval(), 2 * ThreadChoice::kTrialInterval);
   EXPECT_FALSE(next.Next());
