@@ -11,10 +11,33 @@
 
 namespace dwellfit {
 
-ThreadChoiceHistory& ThreadChoiceHistory::ForKind(int kind) {
+namespace {
+std::atomic<int> last_preferred_way{0};
+}  // namespace
+
+int ThreadChoiceHistory::LastPreferredWay() {
+  return last_preferred_way.load(std::memory_order_relaxed);
+}
+
+ThreadChoiceHistory& ThreadChoiceHistory::ForKind(int kind, IdleProbe idle_probe) {
   static ThreadChoiceHistory histories[kKinds];
   CHECK(kind >= 0 && kind < kKinds);
-  return histories[kind];
+  static const bool marked = [] {
+    for (ThreadChoiceHistory& history : histories) history.shared = true;
+    return true;
+  }();
+  (void)marked;
+  ThreadChoiceHistory& history = histories[kind];
+  if (history.preferred_way.load(std::memory_order_relaxed) != 0) return history;
+  // Before any choice has recorded no worker has started: the probe counts
+  // other programs alone.
+  const int last = LastPreferredWay();
+  if (last == 2 || (last == 0 && idle_probe() == 0)) {
+    history.trial_interval.store(ThreadChoice::kFirstTrialAfter, std::memory_order_relaxed);
+    history.since_trial.store(0, std::memory_order_relaxed);
+    history.preferred_way.store(2, std::memory_order_relaxed);
+  }
+  return history;
 }
 
 int IdleProcessors() {
@@ -76,6 +99,7 @@ void ThreadChoice::Record(bool threaded, double seconds) {
     timed_first_ = true;
     return;
   }
+  history_->timed.fetch_add(1, std::memory_order_relaxed);
   RecentTimes& times = threaded ? threaded_times_ : alone_times_;
   const RecentTimes& other = threaded ? alone_times_ : threaded_times_;
   times.Add(seconds);
@@ -99,6 +123,8 @@ void ThreadChoice::Record(bool threaded, double seconds) {
 
 void ThreadChoice::Publish() {
   history_->preferred_way.store(prefer_threaded_ ? 1 : 2, std::memory_order_relaxed);
+  if (history_->shared)
+    last_preferred_way.store(prefer_threaded_ ? 1 : 2, std::memory_order_relaxed);
   history_->trial_interval.store(trial_interval_, std::memory_order_relaxed);
   history_->since_trial.store(since_trial_, std::memory_order_relaxed);
 }

@@ -46,11 +46,28 @@
 
 namespace dwellfit {
 
+// The processors of this machine that nothing runs on just now, besides the
+// one the caller runs on: the online processors less the tasks the kernel
+// counts runnable (/proc/loadavg, the caller among them). -1 where the count
+// cannot be read. Machine-wide: in a container the count is the host's.
+int IdleProcessors();
+// A probe of idle processors (IdleProcessors; tests give their own).
+using IdleProbe = int (*)();
+
 struct ThreadChoiceHistory {
   // Histories shared by this process's evaluators of one kind (0 <= kind <
-  // kKinds; the dwells' residual kind).
+  // kKinds; the dwells' residual kind). One nobody has used yet starts from
+  // what the process knows: on the caller alone, a trial of the threads
+  // after three evaluations, where the process's last choice came to prefer
+  // the caller alone, or where none has recorded yet and `idle_probe` finds
+  // no idle processor; on the threads otherwise.
   static constexpr int kKinds = 8;
-  static ThreadChoiceHistory& ForKind(int kind);
+  static ThreadChoiceHistory& ForKind(int kind, IdleProbe idle_probe = &IdleProcessors);
+  // The way the process's choice that recorded last prefers, whatever its
+  // kind (0: none has recorded yet, 1: threaded, 2: alone): what the threads
+  // last did for this process on this machine. Only the choices of ForKind's
+  // histories count.
+  static int LastPreferredWay();
 
   // The way last preferred (0: none yet, 1: threaded, 2: alone), the wait
   // between trials and the evaluations since the last. Relaxed atomics:
@@ -59,19 +76,14 @@ struct ThreadChoiceHistory {
   std::atomic<int> preferred_way{0};
   std::atomic<int> trial_interval{0};
   std::atomic<int> since_trial{0};
+  // Evaluations its choices have timed.
+  std::atomic<long> timed{0};
+  // One of ForKind's: its choices' ways are the process's (LastPreferredWay).
+  bool shared = false;
 };
-
-// The processors of this machine that nothing runs on just now, besides the
-// one the caller runs on: the online processors less the tasks the kernel
-// counts runnable (/proc/loadavg, the caller among them). -1 where the count
-// cannot be read. Machine-wide: in a container the count is the host's.
-int IdleProcessors();
 
 class ThreadChoice {
  public:
-  // The probe of idle processors (IdleProcessors; tests give their own).
-  using IdleProbe = int (*)();
-
   static constexpr double kThreadedMargin = 1.3;
   static constexpr int kTrialInterval = 16;
   static constexpr int kMaxTrialInterval = 64;

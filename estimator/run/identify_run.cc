@@ -10,6 +10,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
+#include "dwellfit/estimator/fit/thread_choice.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/run/run_figures.h"
 #include "glog/logging.h"
@@ -105,8 +106,11 @@ void ComputeAfterFit(const ResolvedRun& run, const IdentificationResult& result,
   // Three parts: more threads would idle.
   const int threads = std::min(ResolveThreadCount(run.options.solver.num_threads), 3);
   const bool large = dwells >= kLargeRunDwells;
+  // Where the fit's evaluations went to the caller alone (a busy machine),
+  // the parts would not gain from threads either.
+  const bool threads_lost = ThreadChoiceHistory::LastPreferredWay() == 2;
   if (large) ReturnFreedMemory();
-  if (threads == 1 || dwells < kMinDwellsForThreadsAfterFit || large) {
+  if (threads == 1 || dwells < kMinDwellsForThreadsAfterFit || large || threads_lost) {
     estimate_uncertainty();
     trace_curves();
     predict();

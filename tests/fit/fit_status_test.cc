@@ -36,8 +36,7 @@ ResolvedRun DuffingRun(const std::string& fixed, const std::string& initial_gues
 constexpr double kDuffingMinimum = 620.66;
 
 TEST(FitStatus, DuffingBeamFromTheAutomaticStartReachesItsMinimum) {
-  const IdentificationResult fit =
-      FitRun(DuffingRun("[delta, mu2]", "{delta: 0, mu2: 0}")).best;
+  const IdentificationResult fit = FitRun(DuffingRun("[delta, mu2]", "{delta: 0, mu2: 0}")).best;
   EXPECT_EQ(fit.status, FitStatus::kConverged) << fit.message;
   EXPECT_NEAR(fit.final_cost, kDuffingMinimum, 0.01 * kDuffingMinimum);
 }
@@ -64,11 +63,11 @@ TEST(FitStatus, DuffingBeamFromAStartWithoutFoldsRunsAFoldStage) {
 // The numerical case with mu1 held at 25 times its value: the damping leaves
 // the frequency sweep no jump, so the fit fails and says which fold.
 TEST(FitStatus, AFitWithoutItsEnforcedFoldIsAFailureNamingIt) {
-  const IdentifyConfig config = LoadIdentifyConfig(
-      std::string(DWELLFIT_SOURCE_DIR) + "/datasets/thesis-numerical/beam.yaml",
-      {{"fixed", "[omega, mu1]", "test"},
-       {"initial_guess.mu1", "5", "test"},
-       {"penalties.bifurcation_range.enabled", "true", "test"}});
+  const IdentifyConfig config =
+      LoadIdentifyConfig(std::string(DWELLFIT_SOURCE_DIR) + "/datasets/thesis-numerical/beam.yaml",
+                         {{"fixed", "[omega, mu1]", "test"},
+                          {"initial_guess.mu1", "5", "test"},
+                          {"penalties.bifurcation_range.enabled", "true", "test"}});
   const IdentificationResult fit = FitRun(ResolveRun(config)).best;
   EXPECT_EQ(fit.status, FitStatus::kFailure);
   EXPECT_FALSE(fit.converged);

@@ -12,12 +12,12 @@
 #include <vector>
 
 #include "dwellfit/config/dwell_plan_reader.h"
-#include "dwellfit/estimator/simulation/dwell_simulator.h"
-#include "dwellfit/estimator/fit/identification.h"
+#include "dwellfit/estimator/analysis/sweep_prediction.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/data/sweep_csv.h"
-#include "dwellfit/estimator/analysis/sweep_prediction.h"
+#include "dwellfit/estimator/fit/identification.h"
+#include "dwellfit/estimator/simulation/dwell_simulator.h"
 #include "gtest/gtest.h"
 
 namespace dwellfit {
@@ -74,7 +74,8 @@ void ExpectWithinFactorTwo(const ParameterVector& guess, const std::string& cont
       EffectiveNonlinearity(guess, kOmegaRef) / EffectiveNonlinearity(kTruth, kOmegaRef);
   EXPECT_GT(alpha_e_ratio, 0.5) << "alpha_e " << context;
   EXPECT_LT(alpha_e_ratio, 2.0) << "alpha_e " << context;
-  EXPECT_NEAR(guess[kNaturalFrequency] / kTruth[kNaturalFrequency], 1.0, 0.02) << "omega " << context;
+  EXPECT_NEAR(guess[kNaturalFrequency] / kTruth[kNaturalFrequency], 1.0, 0.02)
+      << "omega " << context;
 }
 
 class InitialGuessThesis : public ::testing::Test {

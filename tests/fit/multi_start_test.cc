@@ -47,7 +47,8 @@ TEST_F(ThesisStarts, StartsAreDeterministicAndSpreadWithinTheFactor) {
   EXPECT_EQ(a, b);
   EXPECT_EQ(a[0], config_.identification.initial);
   for (const ParameterVector& start : a) {
-    EXPECT_EQ(start[kNaturalFrequency], config_.identification.initial[kNaturalFrequency]);  // fixed
+    EXPECT_EQ(start[kNaturalFrequency],
+              config_.identification.initial[kNaturalFrequency]);  // fixed
     for (int i = 0; i < 5; ++i) {
       const double factor = start[i] / config_.identification.initial[i];
       EXPECT_GE(factor, 1.0 / 3.0);

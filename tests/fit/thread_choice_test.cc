@@ -173,6 +173,25 @@ TEST(ThreadChoice, IdleProcessorsReadsThisMachine) {
   EXPECT_LT(idle, get_nprocs());
 }
 
+// A history nobody has used yet starts from what the process knows: on the
+// caller alone (a trial of the threads after three evaluations) where the
+// process's last choice preferred the caller alone, or where none has
+// recorded yet and no processor is idle; on the threads otherwise. Kinds 4
+// and 5 are no residual kind's, and no other test uses them.
+TEST(ThreadChoice, ANewHistoryStartsFromWhatTheProcessKnows) {
+  const int last = ThreadChoiceHistory::LastPreferredWay();
+  const ThreadChoiceHistory& busy = ThreadChoiceHistory::ForKind(4, &NoneIdle);
+  EXPECT_EQ(busy.preferred_way.load(), last == 1 ? 0 : 2);
+  if (last != 1) EXPECT_EQ(busy.trial_interval.load(), ThreadChoice::kFirstTrialAfter);
+  const ThreadChoiceHistory& idle = ThreadChoiceHistory::ForKind(5, &OneIdle);
+  EXPECT_EQ(idle.preferred_way.load(), last == 2 ? 2 : 0);
+  // Once used, a history stays as its choices left it.
+  ThreadChoice choice(&ThreadChoiceHistory::ForKind(5, &OneIdle), &OneIdle);
+  RunEvaluations(&choice, 10, [](bool t, int) { return t ? 0.5e-3 : 1.0e-3; });
+  EXPECT_EQ(ThreadChoiceHistory::LastPreferredWay(), 1);
+  EXPECT_EQ(ThreadChoiceHistory::ForKind(5, &NoneIdle).preferred_way.load(), 1);
+}
+
 // The next choice of one history goes on from where the last left off.
 TEST(ThreadChoice, TheNextChoiceOfAHistoryGoesOnFromTheLast) {
   ThreadChoiceHistory history;
