@@ -19,25 +19,15 @@ int ThreadChoiceHistory::LastPreferredWay() {
   return last_preferred_way.load(std::memory_order_relaxed);
 }
 
-ThreadChoiceHistory& ThreadChoiceHistory::ForKind(int kind, IdleProbe idle_probe) {
+ThreadChoiceHistory& ThreadChoiceHistory::ForKind(int kind) {
   static ThreadChoiceHistory histories[kKinds];
-  CHECK(kind >= 0 && kind < kKinds);
   static const bool marked = [] {
     for (ThreadChoiceHistory& history : histories) history.shared = true;
     return true;
   }();
   (void)marked;
-  ThreadChoiceHistory& history = histories[kind];
-  if (history.preferred_way.load(std::memory_order_relaxed) != 0) return history;
-  // Before any choice has recorded no worker has started: the probe counts
-  // other programs alone.
-  const int last = LastPreferredWay();
-  if (last == 2 || (last == 0 && idle_probe() == 0)) {
-    history.trial_interval.store(ThreadChoice::kFirstTrialAfter, std::memory_order_relaxed);
-    history.since_trial.store(0, std::memory_order_relaxed);
-    history.preferred_way.store(2, std::memory_order_relaxed);
-  }
-  return history;
+  CHECK(kind >= 0 && kind < kKinds);
+  return histories[kind];
 }
 
 int IdleProcessors() {
@@ -58,7 +48,10 @@ int IdleProcessors() {
 ThreadChoice::ThreadChoice(ThreadChoiceHistory* history, IdleProbe idle_probe)
     : history_(history), idle_probe_(idle_probe) {
   const int way = history->preferred_way.load(std::memory_order_relaxed);
-  if (way == 0) return;  // a new history: threads first, a trial after three
+  if (way == 0) {  // a new history: its start waits for the first Next
+    new_history_ = true;
+    return;
+  }
   prefer_threaded_ = way == 1;
   trial_interval_ = history->trial_interval.load(std::memory_order_relaxed);
   since_trial_ = history->since_trial.load(std::memory_order_relaxed);
@@ -74,7 +67,19 @@ double ThreadChoice::RecentTimes::Typical() const {
   return sorted[1];
 }
 
+void ThreadChoice::StartNewHistory() {
+  new_history_ = false;
+  // Until a choice has recorded no worker has started, so the probe counts
+  // other programs alone.
+  const int last = history_->shared ? ThreadChoiceHistory::LastPreferredWay() : 0;
+  if (last == 2 || (last == 0 && idle_probe_() == 0)) {
+    prefer_threaded_ = false;
+    trial_interval_ = kFirstTrialAfter;
+  }
+}
+
 bool ThreadChoice::Next() {
+  if (new_history_) StartNewHistory();
   bool trial = false;
   // A trial is measured against the median of three of the preferred way
   // taken by this choice.

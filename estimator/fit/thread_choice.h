@@ -29,8 +29,10 @@
 // share one (ForKind), so a study of many fits pays for the trials once. A
 // history nobody has used yet starts on the threads and tries the caller
 // alone after four evaluations (one untimed, three timed), unless the
-// process already knows better (ForKind: its last choice went to the caller
-// alone, or at its first no processor was idle); then the other way round.
+// process already knows better; then the other way round, the caller alone
+// first. It does where its last choice (of ForKind's histories) came to
+// prefer the caller alone, or, before any choice has recorded, where no
+// processor is idle as the history's first evaluation comes.
 // An evaluation some residual failed at is not timed (its rows stop early:
 // on the beam 0.02 ms against 0.18, which as a trial of the caller alone
 // won the algebraic stage for it). Which way runs changes no value.
@@ -60,13 +62,9 @@ using IdleProbe = int (*)();
 
 struct ThreadChoiceHistory {
   // Histories shared by this process's evaluators of one kind (0 <= kind <
-  // kKinds; the dwells' residual kind). One nobody has used yet starts from
-  // what the process knows: on the caller alone, a trial of the threads
-  // after three evaluations, where the process's last choice came to prefer
-  // the caller alone, or where none has recorded yet and `idle_probe` finds
-  // no idle processor; on the threads otherwise.
+  // kKinds; the dwells' residual kind).
   static constexpr int kKinds = 8;
-  static ThreadChoiceHistory& ForKind(int kind, IdleProbe idle_probe = &IdleProcessors);
+  static ThreadChoiceHistory& ForKind(int kind);
   // The way the process's choice that recorded last prefers, whatever its
   // kind (0: none has recorded yet, 1: threaded, 2: alone): what the threads
   // last did for this process on this machine. Only the choices of ForKind's
@@ -120,6 +118,8 @@ class ThreadChoice {
   // Whether `seconds` of the way `threaded` beats `other_seconds` of the other.
   static bool Faster(bool threaded, double seconds, double other_seconds);
   void Publish();
+  // Where a new history starts (see the top of the file).
+  void StartNewHistory();
 
   ThreadChoiceHistory* const history_;
   const IdleProbe idle_probe_;
@@ -130,6 +130,7 @@ class ThreadChoice {
   int since_trial_ = 0;
   int confirm_left_ = 0;      // evaluations still to confirm a switch
   bool timed_first_ = false;  // the first Record, which is not timed, has come
+  bool new_history_ = false;  // nobody had used the history: its start is to come
 };
 
 }  // namespace dwellfit

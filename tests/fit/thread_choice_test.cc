@@ -173,23 +173,33 @@ TEST(ThreadChoice, IdleProcessorsReadsThisMachine) {
   EXPECT_LT(idle, get_nprocs());
 }
 
-// A history nobody has used yet starts from what the process knows: on the
-// caller alone (a trial of the threads after three evaluations) where the
-// process's last choice preferred the caller alone, or where none has
-// recorded yet and no processor is idle; on the threads otherwise. Kinds 4
-// and 5 are no residual kind's, and no other test uses them.
-TEST(ThreadChoice, ANewHistoryStartsFromWhatTheProcessKnows) {
-  const int last = ThreadChoiceHistory::LastPreferredWay();
-  const ThreadChoiceHistory& busy = ThreadChoiceHistory::ForKind(4, &NoneIdle);
-  EXPECT_EQ(busy.preferred_way.load(), last == 1 ? 0 : 2);
-  if (last != 1) EXPECT_EQ(busy.trial_interval.load(), ThreadChoice::kFirstTrialAfter);
-  const ThreadChoiceHistory& idle = ThreadChoiceHistory::ForKind(5, &OneIdle);
-  EXPECT_EQ(idle.preferred_way.load(), last == 2 ? 2 : 0);
-  // Once used, a history stays as its choices left it.
-  ThreadChoice choice(&ThreadChoiceHistory::ForKind(5, &OneIdle), &OneIdle);
-  RunEvaluations(&choice, 10, [](bool t, int) { return t ? 0.5e-3 : 1.0e-3; });
+// A history nobody has used yet starts on the caller alone where, as its
+// first evaluation comes, no processor is idle, and the trials of the
+// threads wait for one; on the threads where one is.
+TEST(ThreadChoice, ANewHistoryStartsOnTheCallerAloneWhereNoProcessorIsIdle) {
+  const auto twice_as_fast = [](bool t, int) { return t ? 0.5e-3 : 1.0e-3; };
+  ThreadChoiceHistory busy_history;
+  ThreadChoice busy(&busy_history, &NoneIdle);
+  EXPECT_EQ(RunEvaluations(&busy, 50, twice_as_fast), 0);
+  EXPECT_FALSE(busy.prefers_threaded());
+  ThreadChoiceHistory idle_history;
+  ThreadChoice idle(&idle_history, &OneIdle);
+  EXPECT_TRUE(idle.Next());
+}
+
+// A new history of ForKind's (kinds 4 and 5: no residual kind's, no other
+// test's) starts as the process's last choice of them came to prefer, on
+// the caller alone with a trial after four, whatever the probe says.
+TEST(ThreadChoice, ANewSharedHistoryStartsAsTheProcessLastPreferred) {
+  ThreadChoice settle(&ThreadChoiceHistory::ForKind(4), &OneIdle);
+  RunEvaluations(&settle, 40, [](bool t, int) { return t ? 0.9e-3 : 1.0e-3; });
+  ASSERT_FALSE(settle.prefers_threaded());
+  ASSERT_EQ(ThreadChoiceHistory::LastPreferredWay(), 2);
+  ThreadChoice next(&ThreadChoiceHistory::ForKind(5), &OneIdle);
+  // Alone, then the trial after the untimed first and three timed; it wins.
+  EXPECT_EQ(RunEvaluations(&next, 6, [](bool t, int) { return t ? 0.5e-3 : 1.0e-3; }), 2);
+  EXPECT_TRUE(next.prefers_threaded());
   EXPECT_EQ(ThreadChoiceHistory::LastPreferredWay(), 1);
-  EXPECT_EQ(ThreadChoiceHistory::ForKind(5, &NoneIdle).preferred_way.load(), 1);
 }
 
 // The next choice of one history goes on from where the last left off.
