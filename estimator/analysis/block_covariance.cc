@@ -11,6 +11,7 @@
 #include "Eigen/SVD"
 #include "boost/math/distributions/normal.hpp"
 #include "boost/math/distributions/students_t.hpp"
+#include "ceres/context.h"
 #include "ceres/covariance.h"
 #include "ceres/normal_prior.h"
 #include "dwellfit/estimator/common/string_printf.h"
@@ -197,6 +198,17 @@ bool CheckCollinearity(const FitDescription& fit, const Eigen::MatrixXd& r_norma
 // So Ceres inverts the same matrix as on the whole problem, C_t =
 // (J_n^T J_n)^-1, and lifts it to the ambient entries as D C_t D^T, D the
 // manifold's PlusJacobian (unit_scale_j at (free[j], j)).
+// The context of every covariance's problem. Ceres' covariance makes sure
+// its problem's context holds a pool of options.num_threads (here one)
+// threads before it computes the one block inline; on each problem's own
+// context that was a thread started and joined per covariance, with a malloc
+// arena of its own (two per run on the beam). Shared, the pool's one thread
+// is started once per process. Ceres' thread pool locks its own resizing.
+ceres::Context* CovarianceContext() {
+  static ceres::Context* const context = ceres::Context::Create();
+  return context;
+}
+
 bool ComputeCovariance(const FitDescription& fit, double factor,
                        const Eigen::MatrixXd& r_normalised, BlockCovariance* c) {
   const int n = fit.NumEntries();
@@ -210,7 +222,9 @@ bool ComputeCovariance(const FitDescription& fit, double factor,
   }
   std::vector<double> x = c->values;
   const ceres::Vector x0 = Eigen::Map<const ceres::Vector>(c->values.data(), n);
-  ceres::Problem problem;
+  ceres::Problem::Options problem_options;
+  problem_options.context = CovarianceContext();
+  ceres::Problem problem(problem_options);
   problem.AddParameterBlock(x.data(), n, new ScaledSubsetManifold(unit, fixed));
   problem.AddResidualBlock(new ceres::NormalPrior(m, x0), nullptr, x.data());
 
