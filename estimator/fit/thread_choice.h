@@ -28,14 +28,12 @@
 // of the same history goes on from: the evaluators of one residual kind
 // share one (ForKind), so a study of many fits pays for the trials once. A
 // history nobody has used yet starts on the threads and tries the caller
-// alone after four evaluations (one untimed, three timed), unless the
-// process already knows better; then the other way round, the caller alone
-// first. It does where its last choice (of ForKind's histories) came to
-// prefer the caller alone, or, before any choice has recorded, where no
-// processor is idle as the history's first evaluation comes.
-// An evaluation some residual failed at is not timed (its rows stop early:
-// on the beam 0.02 ms against 0.18, which as a trial of the caller alone
-// won the algebraic stage for it). Which way runs changes no value.
+// alone after four evaluations (one untimed, three timed), unless no
+// processor is idle as its first evaluation comes: then the other way
+// round, the caller alone first. An evaluation some residual failed at is
+// not timed (its rows stop early: on the beam 0.02 ms against 0.18, which
+// as a trial of the caller alone won the algebraic stage for it). Which way
+// runs changes no value.
 //
 // A trial of the threads that falls due while the caller alone is preferred
 // first asks the machine whether a processor is idle (IdleProcessors): with
@@ -43,7 +41,7 @@
 // another program, and the threaded evaluation could at best tie (on two
 // cores with one kept busy: 0.195 against 0.194 ms on the measured beam)
 // while its workers' waking and spinning cost the run around it. The trial
-// is then put off by one interval, not counted as lost.
+// is then put off, and the wait doubled as after a trial lost.
 #ifndef DWELLFIT_ESTIMATOR_FIT_THREAD_CHOICE_H_
 #define DWELLFIT_ESTIMATOR_FIT_THREAD_CHOICE_H_
 
@@ -53,9 +51,11 @@
 namespace dwellfit {
 
 // The processors of this machine that nothing runs on just now, besides the
-// one the caller runs on: the online processors less the tasks the kernel
-// counts runnable (/proc/loadavg, the caller among them). -1 where the count
-// cannot be read. Machine-wide: in a container the count is the host's.
+// one the caller runs on: the online processors, less the caller's, less the
+// tasks the kernel counts runnable (/proc/loadavg) that are not this
+// process's threads (/proc/self/task: a worker still looking for work before
+// it sleeps holds no processor from the next evaluation). -1 where the
+// counts cannot be read. Machine-wide: in a container the count is the host's.
 int IdleProcessors();
 // A probe of idle processors (IdleProcessors; tests give their own).
 using IdleProbe = int (*)();

@@ -2,7 +2,9 @@
 
 #include <sys/sysinfo.h>
 
+#include <atomic>
 #include <functional>
+#include <thread>
 
 #include "gtest/gtest.h"
 
@@ -134,8 +136,9 @@ TEST(ThreadChoice, ASwitchThatDoesNotHoldIsUndone) {
 }
 
 // With no idle processor the threads are not tried: the caller alone runs
-// every evaluation, and the trials are only put off (the wait stays 16), so
-// they resume at the next interval once a processor is idle.
+// every evaluation, and each trial put off doubles the wait as a lost one
+// would (16, 32, then 64), so the probe is read rarely; once a processor is
+// idle the next trial runs.
 TEST(ThreadChoice, NoIdleProcessorPutsOffTheTrialsOfTheThreads) {
   ThreadChoiceHistory history;
   history.preferred_way = 2;  // the caller alone
@@ -143,16 +146,17 @@ TEST(ThreadChoice, NoIdleProcessorPutsOffTheTrialsOfTheThreads) {
   const auto twice_as_fast = [](bool t, int) { return t ? 0.5e-3 : 1.0e-3; };
   {
     ThreadChoice busy(&history, &NoneIdle);
-    EXPECT_EQ(RunEvaluations(&busy, 100, twice_as_fast), 0);
+    // Put off at evaluations 16, 48 and 112 (waits of 16, 32 and 64).
+    EXPECT_EQ(RunEvaluations(&busy, 120, twice_as_fast), 0);
     EXPECT_FALSE(busy.prefers_threaded());
-    EXPECT_EQ(busy.trial_interval(), ThreadChoice::kTrialInterval);
+    EXPECT_EQ(busy.trial_interval(), ThreadChoice::kMaxTrialInterval);
   }
   ThreadChoice idle(&history, &OneIdle);
-  // Put off at evaluations 16, 32, ..., 96: the next falls due at 112 (the
-  // twelfth of these), wins and holds.
-  const int threaded = RunEvaluations(&idle, 20, twice_as_fast, 100);
+  // The next trial falls due at evaluation 176 (the 56th of these), wins
+  // and holds.
+  const int threaded = RunEvaluations(&idle, 60, twice_as_fast, 120);
   EXPECT_TRUE(idle.prefers_threaded());
-  EXPECT_EQ(threaded, 20 - 11);
+  EXPECT_EQ(threaded, 60 - 55);
 }
 
 // A probe that cannot read the machine (-1) leaves the trials as they are.
@@ -171,6 +175,17 @@ TEST(ThreadChoice, IdleProcessorsReadsThisMachine) {
   const int idle = IdleProcessors();
   ASSERT_GE(idle, 0) << "/proc/loadavg unreadable";
   EXPECT_LT(idle, get_nprocs());
+  // Threads of this process that spin do not count as busy processors.
+  std::atomic<bool> stop{false};
+  std::thread spinning([&stop] {
+    while (!stop.load()) {
+    }
+  });
+  const int with_own_spinning = IdleProcessors();
+  stop = true;
+  spinning.join();
+  EXPECT_GE(with_own_spinning, 0);
+  if (get_nprocs() >= 2 && idle >= 1) EXPECT_GE(with_own_spinning, 1);
 }
 
 // A history nobody has used yet starts on the caller alone where, as its
@@ -185,21 +200,6 @@ TEST(ThreadChoice, ANewHistoryStartsOnTheCallerAloneWhereNoProcessorIsIdle) {
   ThreadChoiceHistory idle_history;
   ThreadChoice idle(&idle_history, &OneIdle);
   EXPECT_TRUE(idle.Next());
-}
-
-// A new history of ForKind's (kinds 4 and 5: no residual kind's, no other
-// test's) starts as the process's last choice of them came to prefer, on
-// the caller alone with a trial after four, whatever the probe says.
-TEST(ThreadChoice, ANewSharedHistoryStartsAsTheProcessLastPreferred) {
-  ThreadChoice settle(&ThreadChoiceHistory::ForKind(4), &OneIdle);
-  RunEvaluations(&settle, 40, [](bool t, int) { return t ? 0.9e-3 : 1.0e-3; });
-  ASSERT_FALSE(settle.prefers_threaded());
-  ASSERT_EQ(ThreadChoiceHistory::LastPreferredWay(), 2);
-  ThreadChoice next(&ThreadChoiceHistory::ForKind(5), &OneIdle);
-  // Alone, then the trial after the untimed first and three timed; it wins.
-  EXPECT_EQ(RunEvaluations(&next, 6, [](bool t, int) { return t ? 0.5e-3 : 1.0e-3; }), 2);
-  EXPECT_TRUE(next.prefers_threaded());
-  EXPECT_EQ(ThreadChoiceHistory::LastPreferredWay(), 1);
 }
 
 // The next choice of one history goes on from where the last left off.
