@@ -1,13 +1,11 @@
 #include "dwellfit/estimator/fit/thread_choice.h"
 
-#include <dirent.h>
 #include <fcntl.h>
 #include <sys/sysinfo.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
-#include <cstring>
 
 #include "glog/logging.h"
 
@@ -32,35 +30,6 @@ ThreadChoiceHistory& ThreadChoiceHistory::ForKind(int kind) {
   return histories[kind];
 }
 
-namespace {
-
-// The threads of this process the kernel counts runnable ('R' in their
-// /proc/self/task/<tid>/stat), the caller among them; -1 where unreadable.
-int RunnableThreadsOfThisProcess() {
-  DIR* tasks = opendir("/proc/self/task");
-  if (tasks == nullptr) return -1;
-  int runnable = 0;
-  char path[64];
-  char text[512];
-  while (const dirent* entry = readdir(tasks)) {
-    if (entry->d_name[0] == '.') continue;
-    std::snprintf(path, sizeof(path), "/proc/self/task/%s/stat", entry->d_name);
-    const int fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (fd < 0) continue;  // the thread has just ended
-    const ssize_t length = read(fd, text, sizeof(text) - 1);
-    close(fd);
-    if (length <= 0) continue;
-    text[length] = '\0';
-    // "tid (name) S ...": the state follows the name's last ')'.
-    const char* end_of_name = std::strrchr(text, ')');
-    if (end_of_name != nullptr && end_of_name[1] == ' ' && end_of_name[2] == 'R') ++runnable;
-  }
-  closedir(tasks);
-  return runnable;
-}
-
-}  // namespace
-
 int IdleProcessors() {
   // "0.38 0.48 1.02 1/78 7400": the fourth field is runnable/all tasks.
   const int fd = open("/proc/loadavg", O_RDONLY | O_CLOEXEC);
@@ -73,11 +42,7 @@ int IdleProcessors() {
   int runnable = 0;
   int tasks = 0;
   if (std::sscanf(text, "%*s %*s %*s %d/%d", &runnable, &tasks) != 2 || runnable < 1) return -1;
-  // This process's own runnable threads (a worker still looking for work
-  // before it sleeps) do not hold a processor from the next evaluation.
-  const int own = RunnableThreadsOfThisProcess();
-  if (own < 1) return -1;
-  return std::max(0, get_nprocs() - 1 - std::max(0, runnable - own));
+  return std::max(0, get_nprocs() - runnable);
 }
 
 ThreadChoice::ThreadChoice(ThreadChoiceHistory* history, IdleProbe idle_probe)

@@ -51,11 +51,12 @@
 namespace dwellfit {
 
 // The processors of this machine that nothing runs on just now, besides the
-// one the caller runs on: the online processors, less the caller's, less the
-// tasks the kernel counts runnable (/proc/loadavg) that are not this
-// process's threads (/proc/self/task: a worker still looking for work before
-// it sleeps holds no processor from the next evaluation). -1 where the
-// counts cannot be read. Machine-wide: in a container the count is the host's.
+// one the caller runs on: the online processors less the tasks the kernel
+// counts runnable (/proc/loadavg, the caller among them). -1 where the count
+// cannot be read. Machine-wide: in a container the count is the host's. A
+// worker of this process still looking for work before it sleeps counts as
+// busy; the choice reads the probe where its workers have been idle for a
+// while (a trial of the threads) or not started (a new history's start).
 int IdleProcessors();
 // A probe of idle processors (IdleProcessors; tests give their own).
 using IdleProbe = int (*)();
