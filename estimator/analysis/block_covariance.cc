@@ -187,17 +187,6 @@ bool CheckCollinearity(const FitDescription& fit, const Eigen::MatrixXd& r_norma
   return false;
 }
 
-// (J^T J)^-1 by ceres::Covariance, in physical units, into c->covariance
-// (times `factor`). Its problem holds a copy x of every described entry
-// (ambient order), stepping in the normalised units (ScaledSubsetManifold:
-// x = x0 + unit_scale_j t_j on free entry j, fixed entries held), and one
-// linear residual block r = M (x - x0) (ceres::NormalPrior), M (k x ambient)
-// with column R_n.col(j) / unit_scale_j for free entry j and zeros for fixed
-// ones. Its Jacobian in t is M's free columns times unit_scale: R_n, whose
-// R_n^T R_n is J_n^T J_n of the dwells' problem stepping in the same units.
-// So Ceres inverts the same matrix as on the whole problem, C_t =
-// (J_n^T J_n)^-1, and lifts it to the ambient entries as D C_t D^T, D the
-// manifold's PlusJacobian (unit_scale_j at (free[j], j)).
 // The context of every covariance's problem. Ceres' covariance makes sure
 // its problem's context holds a pool of options.num_threads (here one)
 // threads before it computes the one block inline; on each problem's own
@@ -209,6 +198,17 @@ ceres::Context* CovarianceContext() {
   return context;
 }
 
+// (J^T J)^-1 by ceres::Covariance, in physical units, into c->covariance
+// (times `factor`). Its problem holds a copy x of every described entry
+// (ambient order), stepping in the normalised units (ScaledSubsetManifold:
+// x = x0 + unit_scale_j t_j on free entry j, fixed entries held), and one
+// linear residual block r = M (x - x0) (ceres::NormalPrior), M (k x ambient)
+// with column R_n.col(j) / unit_scale_j for free entry j and zeros for fixed
+// ones. Its Jacobian in t is M's free columns times unit_scale: R_n, whose
+// R_n^T R_n is J_n^T J_n of the dwells' problem stepping in the same units.
+// So Ceres inverts the same matrix as on the whole problem, C_t =
+// (J_n^T J_n)^-1, and lifts it to the ambient entries as D C_t D^T, D the
+// manifold's PlusJacobian (unit_scale_j at (free[j], j)).
 bool ComputeCovariance(const FitDescription& fit, double factor,
                        const Eigen::MatrixXd& r_normalised, BlockCovariance* c) {
   const int n = fit.NumEntries();

@@ -81,7 +81,8 @@ constexpr std::size_t kLargeRunDwells = 100000;
 
 // What the run computes from the estimate once the fit has ended, side by
 // side on the run's threads (solver.num_threads) when there are enough
-// dwells and not too many (kLargeRunDwells), each part in its own variable so that none
+// dwells and not too many (kLargeRunDwells), and the fit's last choice of
+// threads did not go to the caller alone, each part in its own variable so that none
 // depends on which thread runs it or when: the covariance into
 // report->uncertainty, the predictions of every sweep into
 // report->predictions and `predictions_csv`, and the response curves into
