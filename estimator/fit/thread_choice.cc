@@ -40,8 +40,7 @@ int IdleProcessors() {
   if (length <= 0) return -1;
   text[length] = '\0';
   int runnable = 0;
-  int tasks = 0;
-  if (std::sscanf(text, "%*s %*s %*s %d/%d", &runnable, &tasks) != 2 || runnable < 1) return -1;
+  if (std::sscanf(text, "%*s %*s %*s %d/", &runnable) != 1 || runnable < 1) return -1;
   return std::max(0, get_nprocs() - runnable);
 }
 
@@ -88,7 +87,7 @@ bool ThreadChoice::Next() {
     // as after a trial lost.
     trial = prefer_threaded_ || idle_probe_() != 0;
     if (!trial) {
-      trial_interval_ = std::clamp(2 * trial_interval_, kTrialInterval, kMaxTrialInterval);
+      LengthenTheWait();
       history_->trial_interval.store(trial_interval_, std::memory_order_relaxed);
     }
   }
@@ -117,7 +116,7 @@ void ThreadChoice::Record(bool threaded, double seconds) {
       since_trial_ = 0;
       confirm_left_ = kConfirmations;
     } else {
-      trial_interval_ = std::clamp(2 * trial_interval_, kTrialInterval, kMaxTrialInterval);
+      LengthenTheWait();
     }
   } else if (confirm_left_ > 0 && --confirm_left_ == 0 &&
              !Faster(threaded, times.Typical(), other.Typical())) {
@@ -126,6 +125,10 @@ void ThreadChoice::Record(bool threaded, double seconds) {
     since_trial_ = 0;
   }
   Publish();
+}
+
+void ThreadChoice::LengthenTheWait() {
+  trial_interval_ = std::clamp(2 * trial_interval_, kTrialInterval, kMaxTrialInterval);
 }
 
 void ThreadChoice::Publish() {

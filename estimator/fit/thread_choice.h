@@ -119,6 +119,8 @@ class ThreadChoice {
   // Whether `seconds` of the way `threaded` beats `other_seconds` of the other.
   static bool Faster(bool threaded, double seconds, double other_seconds);
   void Publish();
+  // After a trial lost or put off: twice the wait, 16 to 64 evaluations.
+  void LengthenTheWait();
   // Where a new history starts (see the top of the file).
   void StartNewHistory();
 
