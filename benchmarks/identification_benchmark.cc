@@ -3,7 +3,8 @@
 // three), the whole two-stage thesis-numerical fit (about 260 points; target
 // under 20 ms), the measured clamped-beam fit (two levels, 4096 dwells, with
 // the bifurcation-range penalty; target under 200 ms), and a joint fit of two
-// simulated datasets sharing eta_e (mapped blocks). The fits run with the
+// simulated datasets sharing eta_e (mapped blocks), and the response curves
+// of an identify run with their curves.csv text. The fits run with the
 // residual blocks evaluated on 1 and on 2 threads (the argument); their
 // results do not depend on it.
 #include <atomic>
@@ -25,6 +26,7 @@
 #include "dwellfit/estimator/fit/staged_solve.h"
 #include "dwellfit/estimator/run/identify_run.h"
 #include "dwellfit/estimator/run/resolved_run.h"
+#include "dwellfit/estimator/run/run_figures.h"
 #include "dwellfit/estimator/simulation/dwell_simulator.h"
 
 namespace dwellfit {
@@ -267,6 +269,27 @@ BENCHMARK(BM_TwoDatasetsSharedEtaEFit)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// The response curves of an identify run and their curves.csv text
+// (TraceRunCurves) at the case's fitted estimate, for every fitted and
+// validation sweep: 2 curves for the thesis case, 12 for the beam.
+void TraceCurvesAtEstimate(benchmark::State& state, ResolvedRun& run) {
+  const ParameterVector estimate = FitRun(run).best.parameters;
+  std::vector<const Sweep*> sweeps = run.fitted;
+  sweeps.insert(sweeps.end(), run.validation.begin(), run.validation.end());
+  for (auto _ : state) {
+    const RunCurves traced = TraceRunCurves(estimate, sweeps);
+    benchmark::DoNotOptimize(traced.csv.data());
+    state.counters["curves"] = static_cast<double>(traced.curves.size());
+    state.counters["csv_bytes"] = static_cast<double>(traced.csv.size());
+  }
+}
+void BM_ThesisRunCurves(benchmark::State& state) { TraceCurvesAtEstimate(state, Thesis()); }
+BENCHMARK(BM_ThesisRunCurves)->Unit(benchmark::kMillisecond)->UseRealTime();
+void BM_ClampedBeamRunCurves(benchmark::State& state) {
+  TraceCurvesAtEstimate(state, ClampedBeam());
+}
+BENCHMARK(BM_ClampedBeamRunCurves)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace dwellfit

@@ -1,10 +1,11 @@
 #include "dwellfit/estimator/analysis/identification_report.h"
 
 #include <sstream>
+#include <utility>
 
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/common/version.h"
-#include "dwellfit/estimator/data/sweep_csv_writer.h"
+#include "dwellfit/estimator/data/csv_text.h"
 #include "yaml-cpp/yaml.h"
 
 namespace dwellfit {
@@ -245,34 +246,33 @@ std::string ReportToYaml(const IdentificationReport& report) {
 }
 
 std::string ReportToPredictionsCsv(const IdentificationReport& report) {
-  // Appended to one reserved string (no stream, no temporary per number):
-  // the beam's validation sweeps are tens of thousands of rows.
   size_t rows = 0;
   for (const SweepPrediction& prediction : report.predictions) {
     rows += prediction.sweep->points.size();
   }
-  std::string csv = "sweep,direction,role,freq_hz,a_base,a,a_model,branch,model_status\n";
-  csv.reserve(csv.size() + rows * kPredictionRowBytes);
+  CsvText csv("sweep,direction,role,freq_hz,a_base,a,a_model,branch,model_status",
+              (rows + 1) * kPredictionRowBytes);
   for (const SweepPrediction& prediction : report.predictions) {
     const Sweep& sweep = *prediction.sweep;
-    const std::string prefix =
-        sweep.id + ',' + SweepDirectionName(sweep.direction) + ',' + Role(prediction) + ',';
+    const char* direction = SweepDirectionName(sweep.direction);
     for (size_t i = 0; i < sweep.points.size(); ++i) {
       const DwellPoint& point = sweep.points[i];
       const StableRoot& model = prediction.model[i];
-      const char* status = model.status == RootStatus::kOnBranch    ? "on_branch"
-                           : model.status == RootStatus::kBranchEnd ? "branch_end"
-                                                                    : "failed";
-      csv += prefix;
+      csv.Text(sweep.id);
+      csv.Text(direction);
+      csv.Text(Role(prediction));
       for (double value : {RadPerSecondToHz(point.drive_frequency_rad_s), point.a_base,
                            point.amplitude, model.a}) {
-        AppendRoundTrip(value, &csv);
-        csv += ',';
+        csv.Number(value);
       }
-      csv.append(BranchName(point.branch)).append(1, ',').append(status).append(1, '\n');
+      csv.Text(BranchName(point.branch));
+      csv.Text(model.status == RootStatus::kOnBranch    ? "on_branch"
+               : model.status == RootStatus::kBranchEnd ? "branch_end"
+                                                        : "failed");
+      csv.EndRow();
     }
   }
-  return csv;
+  return std::move(csv).Release();
 }
 
 namespace {

@@ -3,8 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 
-#include "dwellfit/estimator/data/sweep_csv_writer.h"
+#include "dwellfit/estimator/data/csv_text.h"
 
 namespace dwellfit {
 namespace {
@@ -19,16 +20,22 @@ double Median(std::vector<double> values) {
 // empty.
 void AppendRow(const ResponseCurve& curve, const char* role, int segment, double omega,
                double a_base, double a, const char* stable, const char* fold, double phase_rad,
-               std::string* csv) {
-  csv->append(curve.spec.name).append(1, ',').append(SweepKindName(curve.spec.kind));
-  csv->append(1, ',').append(role).append(1, ',').append(std::to_string(segment));
-  for (double value : {RadPerSecondToHz(omega), a_base, a}) {
-    csv->append(1, ',');
-    AppendRoundTrip(value, csv);
+               CsvText* csv) {
+  csv->Text(curve.spec.name);
+  csv->Text(SweepKindName(curve.spec.kind));
+  csv->Text(role);
+  csv->Integer(segment);
+  csv->Number(RadPerSecondToHz(omega));
+  csv->Number(a_base);
+  csv->Number(a);
+  csv->Text(stable);
+  csv->Text(fold);
+  if (std::isfinite(phase_rad)) {
+    csv->Number(phase_rad * 180.0 / kPi);
+  } else {
+    csv->Empty();
   }
-  csv->append(1, ',').append(stable).append(1, ',').append(fold).append(1, ',');
-  if (std::isfinite(phase_rad)) AppendRoundTrip(phase_rad * 180.0 / kPi, csv);
-  csv->append(1, '\n');
+  csv->EndRow();
 }
 
 // About the length of one curves.csv row, to reserve the text at once.
@@ -75,11 +82,10 @@ std::vector<ResponseCurve> TraceCurves(const ParameterVector& parameters,
 }
 
 std::string CurvesToCsv(const std::vector<ResponseCurve>& curves) {
-  // Appended to one reserved string (no stream, no temporary per number).
-  size_t rows = 0;
+  size_t rows = 1;
   for (const ResponseCurve& curve : curves) rows += curve.points.size() + curve.backbone.size();
-  std::string csv = "sweep,kind,curve,segment,freq_hz,a_base,a,stable,fold,phase_deg\n";
-  csv.reserve(csv.size() + rows * kCurveRowBytes);
+  CsvText csv("sweep,kind,curve,segment,freq_hz,a_base,a,stable,fold,phase_deg",
+              rows * kCurveRowBytes);
   for (const ResponseCurve& curve : curves) {
     for (const CurvePoint& p : curve.points) {
       AppendRow(curve, "response", p.segment, p.omega_rad_s, p.a_base, p.a, p.stable ? "1" : "0",
@@ -89,7 +95,7 @@ std::string CurvesToCsv(const std::vector<ResponseCurve>& curves) {
       AppendRow(curve, "backbone", -1, p.omega_rad_s, p.a_base, p.a, "", "", kPi / 2.0, &csv);
     }
   }
-  return csv;
+  return std::move(csv).Release();
 }
 
 }  // namespace dwellfit

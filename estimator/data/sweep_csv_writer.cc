@@ -29,11 +29,6 @@ std::string FormatRoundTrip(double value) {
   return std::string(buffer, ToCharsRoundTrip(value, buffer));
 }
 
-void AppendRoundTrip(double value, std::string* text) {
-  char buffer[64];
-  text->append(buffer, ToCharsRoundTrip(value, buffer));
-}
-
 std::string FormatFrequencyHz(double omega_rad_s) {
   const double hz = RadPerSecondToHz(omega_rad_s);
   for (int digits = 1; digits <= 17; ++digits) {

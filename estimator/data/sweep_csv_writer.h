@@ -21,9 +21,6 @@ namespace dwellfit {
 
 // The shortest decimal text that reads back as exactly `value`.
 std::string FormatRoundTrip(double value);
-// Appends FormatRoundTrip(value) to `text`, without a temporary string (the
-// large CSV files: tens of thousands of rows of several numbers each).
-void AppendRoundTrip(double value, std::string* text);
 
 // The shortest decimal frequency [Hz] f such that HzToRadPerSecond(f) ==
 // omega_rad_s; the round-trip text of RadPerSecondToHz(omega_rad_s) when no

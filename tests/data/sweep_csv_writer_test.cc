@@ -10,11 +10,10 @@
 namespace dwellfit {
 namespace {
 
-// AppendRoundTrip appends exactly FormatRoundTrip's text, and that text
-// reads back as the same double, for values of every size the CSV files
-// carry (amplitudes near 1e-6 m, frequencies in Hz, phases in degrees) and
-// the extremes.
-TEST(SweepCsvWriterTest, AppendRoundTripAppendsTheShortestTextThatReadsBack) {
+// FormatRoundTrip's text reads back as the same double, for values of every
+// size the CSV files carry (amplitudes near 1e-6 m, frequencies in Hz,
+// phases in degrees) and the extremes.
+TEST(SweepCsvWriterTest, FormatRoundTripGivesTheShortestTextThatReadsBack) {
   const double values[] = {0.0,
                            -0.0,
                            3.6119182382678226e-05,
@@ -26,17 +25,11 @@ TEST(SweepCsvWriterTest, AppendRoundTripAppendsTheShortestTextThatReadsBack) {
                            std::numeric_limits<double>::denorm_min(),
                            std::numeric_limits<double>::max(),
                            std::numeric_limits<double>::lowest()};
-  std::string appended = "prefix,";
-  std::string expected = "prefix,";
   for (double value : values) {
     const std::string text = FormatRoundTrip(value);
     EXPECT_EQ(std::strtod(text.c_str(), nullptr), value) << text;
     EXPECT_EQ(std::signbit(std::strtod(text.c_str(), nullptr)), std::signbit(value)) << text;
-    AppendRoundTrip(value, &appended);
-    appended += ',';
-    expected += text + ',';
   }
-  EXPECT_EQ(appended, expected);
   EXPECT_EQ(FormatRoundTrip(41.5), "41.5");
   EXPECT_EQ(FormatRoundTrip(1e-6), "1e-06");
 }
