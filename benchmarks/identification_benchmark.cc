@@ -2,7 +2,7 @@
 // dwell point (read from one block, and through MappedCostFunction from
 // three), the whole two-stage thesis-numerical fit (about 260 points; target
 // under 20 ms), the measured clamped-beam fit (two levels, 4096 dwells, with
-// the bifurcation-range penalty; target under 200 ms), and a joint fit of two
+// the bifurcation-range penalty; target under 200 ms), a joint fit of two
 // simulated datasets sharing eta_e (mapped blocks), and the response curves
 // of an identify run with their curves.csv text. The fits run with the
 // residual blocks evaluated on 1 and on 2 threads (the argument); their
