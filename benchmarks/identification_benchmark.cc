@@ -7,14 +7,16 @@
 // of an identify run with their curves.csv text. The fits run with the
 // residual blocks evaluated on 1 and on 2 threads (the argument); their
 // results do not depend on it.
-#include <atomic>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <ostream>
 #include <streambuf>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "benchmark/benchmark.h"
@@ -149,21 +151,28 @@ BENCHMARK(BM_ClampedBeamFit)
     ->Iterations(5)
     ->UseRealTime();
 
-// The same on a busy machine: `busy` background threads spin for the whole
-// run, each keeping one core occupied, as other jobs do on a shared machine.
-// The default (threads:0) must not be slower than one thread here either.
+// The same on a busy machine: `busy` other processes spin for the whole run,
+// each keeping one core occupied, as other jobs do on a shared machine. The
+// default (threads:0) must not be slower than one thread here either.
 void BM_ClampedBeamFitBusy(benchmark::State& state) {
-  std::atomic<bool> stop{false};
-  std::vector<std::thread> load;
+  std::vector<pid_t> load;
   for (int64_t i = 0; i < state.range(1); ++i) {
-    load.emplace_back([&stop] {
+    const pid_t pid = fork();
+    if (pid == 0) {  // the child only spins until it is killed
       volatile double x = 0.0;
-      while (!stop.load(std::memory_order_relaxed)) x = x + 1.0;
-    });
+      for (;;) x = x + 1.0;
+    }
+    if (pid < 0) {
+      state.SkipWithError("cannot start a process to load the machine");
+      break;
+    }
+    load.push_back(pid);
   }
-  RunConfiguredFit(state, ClampedBeam());
-  stop = true;
-  for (std::thread& thread : load) thread.join();
+  if (load.size() == static_cast<size_t>(state.range(1))) RunConfiguredFit(state, ClampedBeam());
+  for (const pid_t pid : load) {
+    kill(pid, SIGKILL);
+    waitpid(pid, nullptr, 0);
+  }
 }
 BENCHMARK(BM_ClampedBeamFitBusy)
     ->ArgNames({"threads", "busy"})

@@ -1,11 +1,14 @@
 #include "dwellfit/estimator/fit/thread_choice.h"
 
+#include <dirent.h>
 #include <fcntl.h>
 #include <sys/sysinfo.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdio>
+#include <cstring>
 
 #include "glog/logging.h"
 
@@ -30,18 +33,62 @@ ThreadChoiceHistory& ThreadChoiceHistory::ForKind(int kind) {
   return histories[kind];
 }
 
-int IdleProcessors() {
-  // "0.38 0.48 1.02 1/78 7400": the fourth field is runnable/all tasks.
-  const int fd = open("/proc/loadavg", O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return -1;
-  char text[128];
-  const ssize_t length = read(fd, text, sizeof(text) - 1);
+namespace {
+
+// Reads the small file `path` (a /proc file) into `text`, ending it with a
+// NUL; false where it cannot be read.
+template <std::size_t kSize>
+bool ReadSmallFile(const char* path, char (&text)[kSize]) {
+  const int fd = open(path, O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return false;
+  const ssize_t length = read(fd, text, kSize - 1);
   close(fd);
-  if (length <= 0) return -1;
+  if (length <= 0) return false;
   text[length] = '\0';
+  return true;
+}
+
+// The runnable tasks of the machine (/proc/loadavg's "runnable/all": "0.38
+// 0.48 1.02 1/78 7400"), the caller among them; -1 where it cannot be read.
+int RunnableTasks() {
+  char text[128];
+  if (!ReadSmallFile("/proc/loadavg", text)) return -1;
   int runnable = 0;
   if (std::sscanf(text, "%*s %*s %*s %d/", &runnable) != 1 || runnable < 1) return -1;
-  return std::max(0, get_nprocs() - runnable);
+  return runnable;
+}
+
+// Whether the thread `tid` of this process is running or runnable (state R
+// in /proc/self/task/<tid>/stat, after the name in parentheses).
+bool ThreadRunnable(const char* tid) {
+  char path[64];
+  std::snprintf(path, sizeof(path), "/proc/self/task/%s/stat", tid);
+  char text[512];
+  if (!ReadSmallFile(path, text)) return false;
+  const char* name_end = std::strrchr(text, ')');
+  return name_end != nullptr && name_end[1] == ' ' && name_end[2] == 'R';
+}
+
+}  // namespace
+
+int OwnRunnableThreads() {
+  DIR* tasks = opendir("/proc/self/task");
+  if (tasks == nullptr) return 1;
+  int runnable = 0;
+  while (const dirent* entry = readdir(tasks)) {
+    if (entry->d_name[0] != '.' && ThreadRunnable(entry->d_name)) ++runnable;
+  }
+  closedir(tasks);
+  return std::max(runnable, 1);
+}
+
+int IdleProcessors() {
+  const int runnable = RunnableTasks();
+  if (runnable < 0) return -1;
+  // Besides the caller's: the processors less the other programs' tasks
+  // (none where the caller is the only task runnable).
+  const int others = runnable == 1 ? 0 : std::max(0, runnable - OwnRunnableThreads());
+  return std::max(0, get_nprocs() - 1 - others);
 }
 
 ThreadChoice::ThreadChoice(ThreadChoiceHistory* history, IdleProbe idle_probe)
@@ -68,7 +115,8 @@ double ThreadChoice::RecentTimes::Typical() const {
 
 void ThreadChoice::StartNewHistory() {
   new_history_ = false;
-  if (idle_probe_() == 0) {
+  favour_threads_ = idle_probe_() != 0;
+  if (!favour_threads_) {
     prefer_threaded_ = false;
     trial_interval_ = kFirstTrialAfter;
   }
@@ -76,6 +124,10 @@ void ThreadChoice::StartNewHistory() {
 
 bool ThreadChoice::Next() {
   if (new_history_) StartNewHistory();
+  if (last_ == Evaluation::kWarmUp) {  // the trial the warm-up woke the workers for
+    last_ = Evaluation::kTrial;
+    return true;
+  }
   bool trial = false;
   // A trial is measured against the median of three of the preferred way
   // taken by this choice.
@@ -83,21 +135,29 @@ bool ThreadChoice::Next() {
   if (confirm_left_ == 0 && ++since_trial_ >= trial_interval_ &&
       preferred.count >= kTimesCompared) {
     since_trial_ = 0;
-    // Threads with no idle processor to run on: put off, the wait doubled
-    // as after a trial lost.
-    trial = prefer_threaded_ || idle_probe_() != 0;
+    // The machine decides which way the margin favours; threads with no
+    // idle processor to run on are not tried: put off, the wait doubled as
+    // after a trial lost.
+    favour_threads_ = idle_probe_() != 0;
+    trial = prefer_threaded_ || favour_threads_;
     if (!trial) {
       LengthenTheWait();
       history_->trial_interval.store(trial_interval_, std::memory_order_relaxed);
     }
   }
   history_->since_trial.store(since_trial_, std::memory_order_relaxed);
+  // A trial of the threads starts with an evaluation that wakes the workers.
+  last_ = !trial             ? Evaluation::kPreferred
+          : prefer_threaded_ ? Evaluation::kTrial
+                             : Evaluation::kWarmUp;
   return trial ? !prefer_threaded_ : prefer_threaded_;
 }
 
-bool ThreadChoice::Faster(bool threaded, double seconds, double other_seconds) {
-  return threaded ? kThreadedMargin * seconds <= other_seconds
-                  : seconds < kThreadedMargin * other_seconds;
+bool ThreadChoice::Faster(bool threaded, double seconds, double other_seconds) const {
+  // The favoured way wins unless it takes kThreadedMargin times as long;
+  // the other must be kThreadedMargin times faster.
+  return threaded == favour_threads_ ? seconds < kThreadedMargin * other_seconds
+                                     : kThreadedMargin * seconds <= other_seconds;
 }
 
 void ThreadChoice::Record(bool threaded, double seconds) {
@@ -105,11 +165,12 @@ void ThreadChoice::Record(bool threaded, double seconds) {
     timed_first_ = true;
     return;
   }
+  if (last_ == Evaluation::kWarmUp) return;  // the workers just woken: not timed
   history_->timed.fetch_add(1, std::memory_order_relaxed);
   RecentTimes& times = threaded ? threaded_times_ : alone_times_;
   const RecentTimes& other = threaded ? alone_times_ : threaded_times_;
   times.Add(seconds);
-  if (threaded != prefer_threaded_) {  // a trial
+  if (last_ == Evaluation::kTrial) {
     if (other.count > 0 && Faster(threaded, seconds, other.Typical())) {
       prefer_threaded_ = threaded;
       trial_interval_ = kTrialInterval;

@@ -18,10 +18,26 @@
 // wins switches the way, and the next three evaluations confirm it against
 // the same median, or the way switches back. A trial that loses doubles the
 // wait before the next (16, 32, then 64 evaluations), so a machine that stays
-// as it is pays for few. The threads must be kThreadedMargin times faster: a
-// threaded evaluation also costs time outside itself (the workers that wake,
-// and that look for more work before they sleep, take the processor from the
-// caller's serial work on a busy machine).
+// as it is pays for few. A trial of the threads is two threaded evaluations:
+// the first wakes the workers and is not timed (after a stretch on the
+// caller alone, the first threaded evaluation of `identify` on the beam
+// took 1.3-1.6 times as long as the threaded ones after it).
+//
+// The machine decides which way a trial must beat by a margin. Each trial,
+// and a new history's start, asks whether a processor is idle
+// (IdleProcessors). With one idle the threads are favoured: the caller alone
+// takes over only where it is kThreadedMargin times faster, and the threads
+// win back where they are not kThreadedMargin times slower. With none idle
+// the other way round: a threaded evaluation then also costs time outside
+// itself (the workers that wake, and that look for more work before they
+// sleep, take the processor from the caller's serial work), and could at
+// best tie (on two cores with one kept busy: 0.195 against 0.194 ms on the
+// measured beam). A trial of the threads that falls due with no processor
+// idle is therefore put off, and the wait doubled as after a trial lost.
+// Favouring the caller alone on an idle machine too, as before, lost the
+// threads the beam's vertical stage in a quarter of `identify` processes:
+// its first evaluations are dear and drift, and the caller alone within 30 %
+// of the threads' cold start took them over (fit 45-50 ms against 30 ms).
 //
 // What the choice has come to (the way, the wait between trials, the count
 // since the last) is kept in a ThreadChoiceHistory, which the next choice
@@ -34,14 +50,6 @@
 // not timed (its rows stop early: on the beam 0.02 ms against 0.18, which
 // as a trial of the caller alone won the algebraic stage for it). Which way
 // runs changes no value.
-//
-// A trial of the threads that falls due while the caller alone is preferred
-// first asks the machine whether a processor is idle (IdleProcessors): with
-// none, a worker would only share a processor with the caller or with
-// another program, and the threaded evaluation could at best tie (on two
-// cores with one kept busy: 0.195 against 0.194 ms on the measured beam)
-// while its workers' waking and spinning cost the run around it. The trial
-// is then put off, and the wait doubled as after a trial lost.
 #ifndef DWELLFIT_ESTIMATOR_FIT_THREAD_CHOICE_H_
 #define DWELLFIT_ESTIMATOR_FIT_THREAD_CHOICE_H_
 
@@ -50,14 +58,21 @@
 
 namespace dwellfit {
 
-// The processors of this machine that nothing runs on just now, besides the
-// one the caller runs on: the online processors less the tasks the kernel
-// counts runnable (/proc/loadavg, the caller among them). -1 where the count
-// cannot be read. Machine-wide: in a container the count is the host's. A
-// worker of this process still looking for work before it sleeps counts as
-// busy; the choice reads the probe where its workers have been idle for a
-// while (a trial of the threads) or not started (a new history's start).
+// The processors of this machine that no other program runs on just now,
+// besides the one the caller runs on: the online processors less one, less
+// the tasks the kernel counts runnable (/proc/loadavg) that are not this
+// process's threads (/proc/self/task). -1 where the count cannot be read.
+// Machine-wide: in a container the count is the host's. This process's own
+// threads are left out: its workers still looking for work after a threaded
+// evaluation (on two idle cores one was runnable at half of the vertical
+// stage's starts on the beam) sleep once the caller goes on alone, and the
+// work it runs side by side (the starts of a multi-start, a study's
+// replicas) divides the threads among itself beforehand.
 int IdleProcessors();
+// This process's running or runnable threads (state R in
+// /proc/self/task/<tid>/stat), the caller among them; 1 where they cannot be
+// read.
+int OwnRunnableThreads();
 // A probe of idle processors (IdleProcessors; tests give their own).
 using IdleProbe = int (*)();
 
@@ -87,6 +102,7 @@ struct ThreadChoiceHistory {
 
 class ThreadChoice {
  public:
+  // How many times faster than the favoured way the other must be.
   static constexpr double kThreadedMargin = 1.3;
   static constexpr int kTrialInterval = 16;
   static constexpr int kMaxTrialInterval = 64;
@@ -117,7 +133,7 @@ class ThreadChoice {
     double Typical() const;
   };
   // Whether `seconds` of the way `threaded` beats `other_seconds` of the other.
-  static bool Faster(bool threaded, double seconds, double other_seconds);
+  bool Faster(bool threaded, double seconds, double other_seconds) const;
   void Publish();
   // After a trial lost or put off: twice the wait, 16 to 64 evaluations.
   void LengthenTheWait();
@@ -134,6 +150,13 @@ class ThreadChoice {
   int confirm_left_ = 0;      // evaluations still to confirm a switch
   bool timed_first_ = false;  // the first Record, which is not timed, has come
   bool new_history_ = false;  // nobody had used the history: its start is to come
+  // Whether the margin favours the threads: a processor was idle when the
+  // last trial or the history's start asked (or the machine could not say).
+  bool favour_threads_ = true;
+  // What the last Next chose: the preferred way, a trial, or the threaded
+  // evaluation before a trial of the threads that wakes their workers.
+  enum class Evaluation { kPreferred, kTrial, kWarmUp };
+  Evaluation last_ = Evaluation::kPreferred;
 };
 
 }  // namespace dwellfit

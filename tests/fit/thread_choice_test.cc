@@ -2,7 +2,10 @@
 
 #include <sys/sysinfo.h>
 
+#include <atomic>
 #include <functional>
+#include <thread>
+#include <vector>
 
 #include "gtest/gtest.h"
 
@@ -70,34 +73,80 @@ TEST(ThreadChoice, ThreadsTwiceAsFastStayThreadedWithRarerTrials) {
   EXPECT_EQ(200 - threaded, 5);
 }
 
-// A busy core: the threads are faster, but not by the margin. The caller
-// alone takes over at the first trial and the threads are tried ever more
-// rarely.
-TEST(ThreadChoice, ThreadsNotClearlyFasterGiveWayToTheCallerAlone) {
+// A processor idle, the threads slower but not by the margin (1.1 times the
+// caller's time): the margin favours the threads, and they keep the
+// evaluations through every trial of the caller alone.
+TEST(ThreadChoice, WithAnIdleProcessorThreadsNotClearlySlowerStay) {
   ThreadChoiceHistory history;
   ThreadChoice choice(&history, &OneIdle);
   const int threaded =
-      RunEvaluations(&choice, 200, [](bool t, int) { return t ? 0.9e-3 : 1.0e-3; });
-  EXPECT_FALSE(choice.prefers_threaded());
-  EXPECT_EQ(choice.trial_interval(), ThreadChoice::kMaxTrialInterval);
-  // The four before the first trial (the first not timed), then trials
-  // after 16, 32, 64 and 64.
-  EXPECT_EQ(threaded, 8);
+      RunEvaluations(&choice, 200, [](bool t, int) { return t ? 1.1e-3 : 1.0e-3; });
+  EXPECT_TRUE(choice.prefers_threaded());
+  // Trials of the caller alone after 4, 16, 32, 64 and 64 evaluations.
+  EXPECT_EQ(200 - threaded, 5);
 }
 
-// The evaluations grow dearer as the solve goes on, the threads 0.9 times
+// A processor idle, the threads clearly slower (1.5 times the caller's
+// time): the caller alone takes over at the first trial, and the threads
+// are tried ever more rarely, each trial an evaluation that wakes the
+// workers and one that is timed.
+TEST(ThreadChoice, ThreadsClearlySlowerGiveWayToTheCallerAlone) {
+  ThreadChoiceHistory history;
+  ThreadChoice choice(&history, &OneIdle);
+  const int threaded =
+      RunEvaluations(&choice, 200, [](bool t, int) { return t ? 1.5e-3 : 1.0e-3; });
+  EXPECT_FALSE(choice.prefers_threaded());
+  EXPECT_EQ(choice.trial_interval(), ThreadChoice::kMaxTrialInterval);
+  // The four before the first trial (the first not timed), then trials of
+  // two evaluations after waits of 16, 32, 64 and 64.
+  EXPECT_EQ(threaded, 4 + 2 * 4);
+}
+
+// No processor idle as a trial of the caller alone falls due: the margin
+// favours the caller, and threads only 0.9 times its time (a worker sharing
+// a core with another program) give the evaluations up; the trials of the
+// threads are then put off.
+TEST(ThreadChoice, WithNoIdleProcessorThreadsNotClearlyFasterGiveWay) {
+  ThreadChoiceHistory history;
+  history.preferred_way = 1;
+  history.trial_interval = ThreadChoice::kTrialInterval;
+  ThreadChoice choice(&history, &NoneIdle);
+  const int threaded = RunEvaluations(&choice, 40, [](bool t, int) { return t ? 0.9e-3 : 1.0e-3; });
+  EXPECT_FALSE(choice.prefers_threaded());
+  EXPECT_EQ(threaded, 15);  // the trial at the 16th, and none after it
+  EXPECT_EQ(choice.trial_interval(), 2 * ThreadChoice::kTrialInterval);
+}
+
+// The evaluations grow cheaper as the solve goes on, the threads 1.4 times
 // the caller's time at every moment: a trial is measured against the
-// evaluations just before it, so the drift does not make the threads look
-// faster than older times of the caller.
+// caller's evaluations just before it, not older, dearer ones, so the drift
+// does not make the threads look faster than they are.
 TEST(ThreadChoice, ADriftingCostIsNotTakenForFasterThreads) {
   ThreadChoiceHistory history;
   history.preferred_way = 2;  // the caller alone
   history.trial_interval = ThreadChoice::kTrialInterval;
   ThreadChoice choice(&history, &OneIdle);
-  const auto drifting = [](bool t, int i) { return (t ? 0.9 : 1.0) * (0.4e-3 + 0.05e-3 * i); };
+  const auto drifting = [](bool t, int i) { return (t ? 1.4 : 1.0) * (2.0e-3 - 0.01e-3 * i); };
   const int threaded = RunEvaluations(&choice, 120, drifting);
   EXPECT_FALSE(choice.prefers_threaded());
-  EXPECT_EQ(threaded, 3);  // trials after 16, 32 and 64 evaluations
+  EXPECT_EQ(threaded, 2 * 3);  // trials of two after 16, 32 and 64 evaluations
+}
+
+// A trial of the threads starts with an evaluation that wakes the workers,
+// which is not timed: held up (a worker asleep is slow to join), it does
+// not lose the trial; the next evaluation, threaded too, decides.
+TEST(ThreadChoice, ATrialOfTheThreadsFirstWakesTheWorkers) {
+  ThreadChoiceHistory history;
+  history.preferred_way = 2;
+  history.trial_interval = ThreadChoice::kTrialInterval;
+  ThreadChoice choice(&history, &OneIdle);
+  EXPECT_EQ(RunEvaluations(&choice, 15, [](bool t, int) { return t ? 0.5e-3 : 1e-3; }), 0);
+  EXPECT_TRUE(choice.Next());
+  choice.Record(true, 5e-3);  // the workers slow to wake
+  EXPECT_FALSE(choice.prefers_threaded());
+  EXPECT_TRUE(choice.Next());
+  choice.Record(true, 0.5e-3);
+  EXPECT_TRUE(choice.prefers_threaded());
 }
 
 // One threaded evaluation the machine held up, just before a trial of the
@@ -122,12 +171,13 @@ TEST(ThreadChoice, ASwitchThatDoesNotHoldIsUndone) {
   history.trial_interval = ThreadChoice::kTrialInterval;
   ThreadChoice choice(&history, &OneIdle);
   RunEvaluations(&choice, 15, [](bool t, int) { return t ? 2e-3 : 1e-3; });
-  // The trial (evaluation 15) is lucky; the three after it are not.
+  // The trial (evaluations 15, waking the workers, and 16) is lucky; the
+  // three after it are not.
   RunEvaluations(
-      &choice, 1, [](bool t, int) { return t ? 0.5e-3 : 1e-3; }, 15);
+      &choice, 2, [](bool t, int) { return t ? 0.5e-3 : 1e-3; }, 15);
   EXPECT_TRUE(choice.prefers_threaded());
   const int threaded = RunEvaluations(
-      &choice, 3, [](bool t, int) { return t ? 2e-3 : 1e-3; }, 16);
+      &choice, 3, [](bool t, int) { return t ? 2e-3 : 1e-3; }, 17);
   EXPECT_EQ(threaded, 3);
   EXPECT_FALSE(choice.prefers_threaded());
   EXPECT_EQ(choice.trial_interval(), 2 * ThreadChoice::kTrialInterval);
@@ -150,8 +200,8 @@ TEST(ThreadChoice, NoIdleProcessorPutsOffTheTrialsOfTheThreads) {
     EXPECT_EQ(busy.trial_interval(), ThreadChoice::kMaxTrialInterval);
   }
   ThreadChoice idle(&history, &OneIdle);
-  // The next trial falls due at evaluation 176 (the 56th of these), wins
-  // and holds.
+  // The next trial falls due at evaluation 176 (the 56th of these, which
+  // wakes the workers), wins at the 57th and holds.
   const int threaded = RunEvaluations(&idle, 60, twice_as_fast, 120);
   EXPECT_TRUE(idle.prefers_threaded());
   EXPECT_EQ(threaded, 60 - 55);
@@ -163,7 +213,7 @@ TEST(ThreadChoice, AnUnreadableMachineStillTriesTheThreads) {
   history.preferred_way = 2;
   history.trial_interval = ThreadChoice::kTrialInterval;
   ThreadChoice choice(&history, [] { return -1; });
-  EXPECT_EQ(RunEvaluations(&choice, 16, [](bool t, int) { return t ? 0.5e-3 : 1.0e-3; }), 1);
+  EXPECT_EQ(RunEvaluations(&choice, 17, [](bool t, int) { return t ? 0.5e-3 : 1.0e-3; }), 2);
   EXPECT_TRUE(choice.prefers_threaded());
 }
 
@@ -173,6 +223,26 @@ TEST(ThreadChoice, IdleProcessorsReadsThisMachine) {
   const int idle = IdleProcessors();
   ASSERT_GE(idle, 0) << "/proc/loadavg unreadable";
   EXPECT_LT(idle, get_nprocs());
+}
+
+// Threads of this process that spin are counted as its own runnable ones
+// (which the probe leaves out of the machine's load), beside the caller.
+TEST(ThreadChoice, OwnRunnableThreadsCountsThisProcessesSpinningThreads) {
+  std::atomic<bool> stop{false};
+  std::atomic<int> started{0};
+  std::vector<std::thread> spinning;
+  for (int i = 0; i < 2; ++i) {
+    spinning.emplace_back([&] {
+      started.fetch_add(1);
+      while (!stop.load(std::memory_order_relaxed)) {
+      }
+    });
+  }
+  while (started.load() < 2) std::this_thread::yield();
+  const int runnable = OwnRunnableThreads();
+  stop = true;
+  for (std::thread& thread : spinning) thread.join();
+  EXPECT_GE(runnable, 3);
 }
 
 // A history nobody has used yet starts on the caller alone where, as its
@@ -194,7 +264,7 @@ TEST(ThreadChoice, TheNextChoiceOfAHistoryGoesOnFromTheLast) {
   ThreadChoiceHistory history;
   {
     ThreadChoice first(&history, &OneIdle);
-    RunEvaluations(&first, 40, [](bool t, int) { return t ? 0.9e-3 : 1.0e-3; });
+    RunEvaluations(&first, 40, [](bool t, int) { return t ? 1.5e-3 : 1.0e-3; });
     ASSERT_FALSE(first.prefers_threaded());
   }
   ThreadChoice next(&history, &OneIdle);
