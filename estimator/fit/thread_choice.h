@@ -35,9 +35,10 @@
 // measured beam). A trial of the threads that falls due with no processor
 // idle is therefore put off, and the wait doubled as after a trial lost.
 // Favouring the caller alone on an idle machine too, as before, lost the
-// threads the beam's vertical stage in a quarter of `identify` processes:
-// its first evaluations are dear and drift, and the caller alone within 30 %
-// of the threads' cold start took them over (fit 45-50 ms against 30 ms).
+// threads the beam's vertical stage in a quarter to two fifths of the
+// `identify` processes: its first evaluations are dear and drift, and the
+// caller alone within 30 % of the threads' cold start took them over (fit
+// 45-50 ms against 30 ms).
 //
 // What the choice has come to (the way, the wait between trials, the count
 // since the last) is kept in a ThreadChoiceHistory, which the next choice
