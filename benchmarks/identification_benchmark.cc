@@ -281,7 +281,7 @@ BENCHMARK(BM_TwoDatasetsSharedEtaEFit)
 
 // The response curves of an identify run and their curves.csv text
 // (TraceRunCurves) at the case's fitted estimate, for every fitted and
-// validation sweep: 2 curves for the thesis case, 12 for the beam.
+// validation sweep: 4 curves for the thesis case, 12 for the beam.
 void TraceCurvesAtEstimate(benchmark::State& state, ResolvedRun& run) {
   const ParameterVector estimate = FitRun(run).best.parameters;
   std::vector<const Sweep*> sweeps = run.fitted;
