@@ -35,21 +35,18 @@ void CsvText::Text(std::string_view text) {
   size_ += text.size() + 1;
 }
 
-void CsvText::Number(double value) {
+template <typename T>
+void CsvText::Field(T value) {
   char* at = Room(kNumberBytes);
   const std::to_chars_result result = std::to_chars(at, at + kNumberBytes - 1, value);
-  CHECK(result.ec == std::errc()) << "31 characters hold any double";
+  CHECK(result.ec == std::errc()) << "31 characters hold any double or long";
   *result.ptr = ',';
   size_ = static_cast<std::size_t>(result.ptr + 1 - buffer_.data());
 }
 
-void CsvText::Integer(long value) {
-  char* at = Room(kNumberBytes);
-  const std::to_chars_result result = std::to_chars(at, at + kNumberBytes - 1, value);
-  CHECK(result.ec == std::errc()) << "31 characters hold any long";
-  *result.ptr = ',';
-  size_ = static_cast<std::size_t>(result.ptr + 1 - buffer_.data());
-}
+void CsvText::Number(double value) { Field(value); }
+
+void CsvText::Integer(long value) { Field(value); }
 
 void CsvText::Empty() {
   *Room(1) = ',';

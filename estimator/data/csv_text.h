@@ -43,6 +43,9 @@ class CsvText {
  private:
   // Room for `bytes` more characters at the end; returns where they go.
   char* Room(std::size_t bytes);
+  // One field of std::to_chars' text of `value` (a double or a long).
+  template <typename T>
+  void Field(T value);
 
   std::string buffer_;    // its first size_ characters are the text
   std::size_t size_ = 0;  // every field ends with a comma, which EndRow() turns into the line end
