@@ -27,9 +27,10 @@ DEFINE_string(plan, "", "YAML dwell plan: truth and sweeps to simulate (required
 DEFINE_int32(replicas, 200, "number of noisy replicas.");
 DEFINE_double(noise, 0.01, "relative noise sigma: a *= 1 + noise N(0, 1).");
 DEFINE_uint64(first_seed, 1, "seed of the first replica; replica r uses first_seed + r.");
-DEFINE_string(interval_method, "penalty_sandwich",
-              "how the intervals treat the bifurcation-range penalty: penalty_sandwich "
-              "(identify's) or data_only.");
+DEFINE_string(interval_method, "profile",
+              "which intervals: profile (identify's: profile likelihood of the fitted cost), "
+              "linearised (with the penalty's curvature) or data_only (the dwells' "
+              "linearisation alone).");
 DEFINE_string(set, "",
               "Overrides config values as identify's --set does: key.path=value[,...], e.g. "
               "'initial_guess=auto,fixed=[]'");
@@ -57,7 +58,7 @@ int main(int argc, char** argv) {
     options.first_seed = FLAGS_first_seed;
     if (!dwellfit::ParseIntervalMethod(FLAGS_interval_method, &options.method)) {
       std::cerr << "coverage_study: --interval_method '" << FLAGS_interval_method
-                << "': give penalty_sandwich or data_only\n";
+                << "': give profile, linearised or data_only\n";
       return 2;
     }
     dwellfit::PrintCoverageStudy(dwellfit::RunCoverageStudy(config, plan, options), std::cout);

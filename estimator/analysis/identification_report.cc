@@ -45,9 +45,24 @@ double ControlInFileUnit(const Sweep& sweep, double control) {
 
 namespace {
 
-void EmitInterval(double low, double high, YAML::Emitter* out) {
+// ci95: the reported interval (its kind in uncertainty.interval_kind);
+// ci95_ends: how the profile found each end (crossed, bound, open);
+// linearised_ci95: estimate -/+ q standard_error, when the reported one is
+// the profile's.
+void EmitInterval(double low, double high, const ProfileInterval* profile, double linear_low,
+                  double linear_high, YAML::Emitter* out) {
   *out << YAML::Key << "ci95" << YAML::Value << YAML::Flow << YAML::BeginSeq << low << high
        << YAML::EndSeq;
+  if (profile == nullptr || !profile->computed) return;
+  *out << YAML::Key << "ci95_ends" << YAML::Value << YAML::Flow << YAML::BeginSeq
+       << ProfileEndName(profile->low_end) << ProfileEndName(profile->high_end) << YAML::EndSeq;
+  *out << YAML::Key << "linearised_ci95" << YAML::Value << YAML::Flow << YAML::BeginSeq
+       << linear_low << linear_high << YAML::EndSeq;
+}
+
+const ProfileInterval* ProfileOf(const ParameterUncertainty& u, int i) {
+  if (u.interval_kind != "profile_likelihood") return nullptr;
+  return i < kNumParameters ? &u.profile.parameters[i] : &u.profile.effective_nonlinearity;
 }
 
 // parameters: value, start, fixed and interval of each; the natural frequency
@@ -63,7 +78,8 @@ void EmitParameters(const IdentificationReport& report, YAML::Emitter* out) {
     *out << YAML::Key << "fixed" << YAML::Value << report.options.fixed[i];
     if (u.available && !report.options.fixed[i]) {
       *out << YAML::Key << "standard_error" << YAML::Value << u.standard_error[i];
-      EmitInterval(u.ci95_low[i], u.ci95_high[i], out);
+      EmitInterval(u.ci95_low[i], u.ci95_high[i], ProfileOf(u, i), u.linearised_ci95_low[i],
+                   u.linearised_ci95_high[i], out);
     }
     if (i == kNaturalFrequency) *out << YAML::Key << "unit" << YAML::Value << "rad/s";
     *out << YAML::EndMap;
@@ -77,7 +93,9 @@ void EmitParameters(const IdentificationReport& report, YAML::Emitter* out) {
   *out << YAML::Key << "omega_ref_rad_s" << YAML::Value << report.omega_ref_rad_s;
   if (u.available) {
     *out << YAML::Key << "standard_error" << YAML::Value << u.effective_nonlinearity_standard_error;
-    EmitInterval(u.effective_nonlinearity_ci95_low, u.effective_nonlinearity_ci95_high, out);
+    EmitInterval(u.effective_nonlinearity_ci95_low, u.effective_nonlinearity_ci95_high,
+                 ProfileOf(u, kNumParameters), u.effective_nonlinearity_linearised_ci95_low,
+                 u.effective_nonlinearity_linearised_ci95_high, out);
   }
   *out << YAML::EndMap;
 }
@@ -88,7 +106,10 @@ void EmitUncertainty(const IdentificationReport& report, YAML::Emitter* out) {
   *out << YAML::Key << "available" << YAML::Value << u.available;
   *out << YAML::Key << "interval_kind" << YAML::Value << u.interval_kind;
   *out << YAML::Key << "penalty_terms" << YAML::Value << u.penalty_terms;
-  *out << YAML::Key << "label_pulls" << YAML::Value << u.label_pulls;
+  if (u.interval_kind == "profile_likelihood") {
+    *out << YAML::Key << "profile_threshold" << YAML::Value << u.profile.threshold;
+    *out << YAML::Key << "profile_fits" << YAML::Value << u.profile.fits;
+  }
   *out << YAML::Key << "message" << YAML::Value << u.message;
   *out << YAML::Key << "noise_sigma" << YAML::Value << u.noise_sigma;
   *out << YAML::Key << "degrees_of_freedom" << YAML::Value << u.degrees_of_freedom;
@@ -297,8 +318,11 @@ void PrintStages(const IdentificationResult& result, std::ostream& out) {
 void PrintParameters(const IdentificationReport& report, std::ostream& out) {
   const IdentificationResult& result = report.result;
   const ParameterUncertainty& u = report.uncertainty;
-  out << StringPrintf("%-8s %-18s %-12s %-34s %-14s %s\n", "param", "estimate", "std.error",
-                      "95% interval", "initial", "fixed");
+  const bool profile = u.interval_kind == "profile_likelihood";
+  out << StringPrintf("%-8s %-18s %-12s %-34s %-14s %s\n", "param", "estimate",
+                      profile ? "lin.std.err" : "std.error",
+                      profile ? "95% interval (profile)" : "95% interval (linearised)", "initial",
+                      "fixed");
   for (int i = 0; i < kNumParameters; ++i) {
     const bool interval = u.available && !report.options.fixed[i];
     const std::string se = interval ? StringPrintf("%.3g", u.standard_error[i]) : "-";

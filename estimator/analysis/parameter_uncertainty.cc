@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "Eigen/Cholesky"
+#include "dwellfit/estimator/analysis/profile_likelihood.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/fit/fit_description.h"
 #include "dwellfit/estimator/fit/problem_builder.h"
@@ -206,7 +207,6 @@ ParameterUncertainty Unavailable(ParameterUncertainty u, const std::string& mess
   out.warnings = u.warnings;
   out.interval_kind = u.interval_kind;
   out.penalty_terms = u.penalty_terms;
-  out.label_pulls = u.label_pulls;
   return out;
 }
 
@@ -332,138 +332,13 @@ BlockCovariance PenalisedCovariance(const std::vector<const Sweep*>& fitted,
   return EstimateBlockCovariance(fit, options.residual);
 }
 
-// Re-derives standard errors and intervals from c->covariance.
-bool SetStandardErrors(BlockCovariance* c) {
-  for (int i : c->free) {
-    if (!(c->covariance(i, i) > 0.0)) return false;
-    c->standard_error[i] = std::sqrt(c->covariance(i, i));
-    c->ci95_low[i] = c->values[i] - c->interval_quantile * c->standard_error[i];
-    c->ci95_high[i] = c->values[i] + c->interval_quantile * c->standard_error[i];
-  }
-  return true;
-}
-
-// The share of the pull's square b b^T that is bias rather than noise. b is
-// estimated at the estimate, so its square overstates the squared bias by
-// b's own variance V (b moves by C_d I_p dp when the estimate moves by dp:
-// V = (C_d I_p) S (C_d I_p)^T, S the sampling covariance). Along b, in the
-// metric of S (z = L^-1 b, L L^T = S over the free entries), the unbiased
-// estimate of the squared bias is |z|^2 - z^T (L^-1 V L^-T) z / |z|^2: the
-// share 1 - z^T L^-1 V L^-T z / |z|^4, floored at 0. 1 where S cannot be
-// factored.
-double PullShare(const Eigen::VectorXd& pull, const Eigen::MatrixXd& pull_variance,
-                 const Eigen::MatrixXd& sampling, const std::vector<int>& free) {
-  const int k = static_cast<int>(free.size());
-  Eigen::MatrixXd s(k, k), v(k, k);
-  Eigen::VectorXd b(k);
-  for (int i = 0; i < k; ++i) {
-    b[i] = pull[free[i]];
-    for (int j = 0; j < k; ++j) {
-      s(i, j) = sampling(free[i], free[j]);
-      v(i, j) = pull_variance(free[i], free[j]);
-    }
-  }
-  const Eigen::LLT<Eigen::MatrixXd> llt(s);
-  if (llt.info() != Eigen::Success) return 1.0;
-  const Eigen::VectorXd z = llt.matrixL().solve(b);
-  const double length_squared = z.squaredNorm();
-  if (!(length_squared > 0.0)) return 0.0;
-  const Eigen::VectorXd w = llt.matrixL().solve(v * llt.matrixU().solve(z));
-  // z^T L^-1 V L^-T z = (L^-1 b)^T (L^-1 V L^-T)(L^-1 b)
-  const double noise = z.dot(w);
-  return std::max(0.0, 1.0 - noise / (length_squared * length_squared));
-}
-
-// The sandwich S = s^2 H^-1 J_d^T J_d H^-1 = C_A - C_A I_p C_A, I_p =
-// sum_k (kappa_k / s^2) g_k g_k^T, g_k = grad u_k in physical units, plus
-// the penalty's pull beta b b^T: b = C_d grad P / s^2 = C_d sum_k (W n
-// u_k^(n-1) / (2 s^2)) g_k, how far the penalty moved the estimate from the
-// dwells' own minimum (C_d: the dwells' covariance), beta its share that is
-// bias (PullShare). False when a gradient cannot be
-// evaluated.
-bool SandwichCovariance(const std::vector<PenaltyCurvature>& terms, double weight, int exponent,
-                        const BlockCovariance& data_only, const ParameterVector& estimate,
-                        const std::array<bool, kNumParameters>& fixed, BlockCovariance* c,
-                        Eigen::MatrixXd* sampling) {
-  const double noise_variance = data_only.noise_sigma * data_only.noise_sigma;
-  Eigen::MatrixXd penalty_information = Eigen::MatrixXd::Zero(kNumParameters, kNumParameters);
-  Eigen::VectorXd penalty_gradient = Eigen::VectorXd::Zero(kNumParameters);
-  for (const PenaltyCurvature& term : terms) {
-    const std::unique_ptr<ceres::CostFunction> row(DistanceRow(term, 1.0));
-    const double* blocks[] = {estimate.data()};
-    double distance = 0.0;
-    Eigen::Matrix<double, 1, kNumParameters, Eigen::RowMajor> gradient;
-    double* jacobians[] = {gradient.data()};
-    if (!row->Evaluate(blocks, &distance, jacobians) || !gradient.allFinite()) return false;
-    for (int i = 0; i < kNumParameters; ++i) {
-      if (fixed[i]) gradient[i] = 0.0;
-    }
-    penalty_information += (term.curvature / noise_variance) * gradient.transpose() * gradient;
-    penalty_gradient +=
-        0.5 * weight * exponent * std::pow(distance, exponent - 1) * gradient.transpose();
-  }
-  const Eigen::MatrixXd a = c->covariance;
-  const Eigen::VectorXd pull = data_only.covariance * penalty_gradient / noise_variance;
-  c->covariance = a - a * penalty_information * a;
-  *sampling = c->covariance;
-  const Eigen::MatrixXd pull_response = data_only.covariance * penalty_information;
-  const double share =
-      PullShare(pull, pull_response * *sampling * pull_response.transpose(), *sampling, c->free);
-  c->covariance += share * pull * pull.transpose();
-  return SetStandardErrors(c);
-}
-
-// For each measured jump whose ending branch the estimate ends before the
-// dwell just ahead of the jump (a label the fit violates: the fit stopped at
-// the kink there), the smallest move delta (in the metric of C) that puts
-// the fold back on that dwell, added as a bias term delta delta^T.
-int AddLabelPull(const std::vector<const Sweep*>& fitted, const ParameterVector& estimate,
-                 const std::array<bool, kNumParameters>& fixed, const PenaltyOptions* enforced,
-                 BlockCovariance* c) {
-  int pulled = 0;
-  for (const Sweep* sweep : fitted) {
-    for (const JumpBracket& jump : sweep->jumps) {
-      if (enforced != nullptr && IsEnforced(enforced->bifurcation_range, *sweep, jump)) continue;
-      const DwellPoint& before = sweep->points[jump.index_before];
-      const auto k = ResponseCoefficients<double>::FromParameters(estimate.data(),
-                                                                  before.drive_frequency_rad_s);
-      if (SolveStableRoot(k, before.a_base, before.branch, before.amplitude).status !=
-          RootStatus::kBranchEnd) {
-        continue;
-      }
-      const PenaltyCurvature term{sweep, &jump};
-      const std::unique_ptr<ceres::CostFunction> row(DistanceRow(term, 1.0));
-      const double* blocks[] = {estimate.data()};
-      double distance = 0.0;
-      Eigen::Matrix<double, 1, kNumParameters, Eigen::RowMajor> gradient;
-      double* jacobians[] = {gradient.data()};
-      if (!row->Evaluate(blocks, &distance, jacobians) || !gradient.allFinite() ||
-          std::abs(distance) >= BifurcationRangePenalty::kNoFoldDistance) {
-        continue;
-      }
-      for (int i = 0; i < kNumParameters; ++i) {
-        if (fixed[i]) gradient[i] = 0.0;
-      }
-      const double edge = (jump.control_before - jump.centre()) / jump.half_width();
-      const Eigen::VectorXd cg = c->covariance * gradient.transpose();
-      const double variance = gradient.dot(cg);
-      if (!(variance > 0.0)) continue;
-      const Eigen::VectorXd shift = cg * ((edge - distance) / variance);
-      c->covariance += shift * shift.transpose();
-      ++pulled;
-    }
-  }
-  return pulled;
-}
-
-// The dwells' covariance, with the penalty's sandwich and pull when the fit
-// had the penalty; `u` gets the kind and the penalty terms.
+// The dwells' covariance, with the penalty's curvature at each enforced jump
+// when the fit had the penalty (C = s^2 H^-1); `u` gets the kind and the
+// penalty terms.
 BlockCovariance PenaltyCovariance(const std::vector<const Sweep*>& fitted,
                                   const IdentificationOptions& options,
                                   const ParameterVector& estimate, const FitSummary* summary,
-                                  const BlockCovariance& data_only, Eigen::MatrixXd* sampling,
-                                  ParameterUncertainty* u) {
-  *sampling = data_only.covariance;
+                                  const BlockCovariance& data_only, ParameterUncertainty* u) {
   double weight = 0.0;
   int exponent = 0;
   const bool penalty = PenaltyInFit(options, summary, &weight, &exponent);
@@ -479,58 +354,149 @@ BlockCovariance PenaltyCovariance(const std::vector<const Sweep*>& fitted,
       EnforcedJumps(fitted, options.penalties, weight, exponent, estimate, u);
   if (terms.empty()) return data_only;
   BlockCovariance c = PenalisedCovariance(fitted, options, estimate, noise_variance, terms);
-  if (!c.available || !SandwichCovariance(terms, weight, exponent, data_only, estimate,
-                                          options.fixed, &c, sampling)) {
-    *sampling = data_only.covariance;
+  if (!c.available) {
     u->warnings.push_back(
-        "the penalty's curvature could not be combined with the dwells': the intervals are those "
-        "of the dwells alone");
+        "the penalty's curvature could not be combined with the dwells': the linearised intervals "
+        "are those of the dwells alone");
     return data_only;
   }
-  u->interval_kind = "gauss_newton_sandwich_with_penalty";
+  u->interval_kind = "linearised_with_penalty";
   u->penalty_terms = static_cast<int>(terms.size());
   c.message = data_only.message + StringPrintf(
                                       "; the bifurcation-range penalty's curvature at %d "
-                                      "enforced jump(s) in the sandwich",
+                                      "enforced jump(s) included",
                                       u->penalty_terms);
   return c;
 }
 
-// The covariance `method` asks for; `u` gets the kind, the penalty terms
-// and the label pulls.
-BlockCovariance Covariance(const std::vector<const Sweep*>& fitted,
-                           const IdentificationOptions& options, const ParameterVector& estimate,
-                           const FitSummary* summary, IntervalMethod method,
-                           Eigen::MatrixXd* sampling, ParameterUncertainty* u) {
-  const BlockCovariance data_only = PenalisedCovariance(fitted, options, estimate, 1.0, {});
-  *sampling = data_only.covariance;
-  if (method == IntervalMethod::kDataOnly || !data_only.available) return data_only;
-  BlockCovariance c = PenaltyCovariance(fitted, options, estimate, summary, data_only, sampling, u);
-  // Jumps the penalty holds carry its pull already.
-  const PenaltyOptions* enforced = u->penalty_terms > 0 ? &options.penalties : nullptr;
-  BlockCovariance pulled = c;
-  const int pulls = AddLabelPull(fitted, estimate, options.fixed, enforced, &pulled);
-  if (pulls == 0) return c;
-  if (!SetStandardErrors(&pulled)) {
+// The profile problem of the fit's last stage: its penalties at the weights
+// it used, Delta = q^2 s^2 / 2. False (with a note in `u`) when the last
+// stage is not the vertical error or its penalties are unknown.
+bool MakeProfileProblem(const std::vector<const Sweep*>& fitted,
+                        const IdentificationOptions& options, const FitSummary* summary,
+                        double threshold, int threads, ParameterUncertainty* u,
+                        ProfileProblem* problem) {
+  const bool penalised = options.penalties.bifurcation_range.enabled ||
+                         options.penalties.branch_stability.enabled;
+  const StageSummary* last =
+      summary != nullptr && !summary->stages.empty() ? &summary->stages.back() : nullptr;
+  if (last == nullptr ? penalised : last->residual != ResidualKind::kVertical) {
     u->warnings.push_back(
-        "the move back to the violated branch labels could not be added: the intervals may be "
-        "too narrow");
-    return c;
+        last == nullptr
+            ? "the fit's penalty weights are not known here: the intervals are the linearised ones"
+            : "the fit's last stage is not the vertical error: the intervals are the linearised "
+              "ones of the vertical error at the estimate");
+    return false;
   }
-  u->label_pulls = pulls;
-  pulled.message +=
-      StringPrintf("; widened by the move back to %d branch label(s) the estimate violates", pulls);
-  return pulled;
+  problem->fitted = fitted;
+  problem->fixed = options.fixed;
+  problem->residual = options.residual;
+  if (last != nullptr) problem->penalties = last->penalties;
+  problem->solver = options.solver;
+  problem->omega_ref_rad_s = u->omega_ref_rad_s;
+  problem->threshold = threshold;
+  problem->threads = threads;
+  return problem->threshold > 0.0;
+}
+
+double Width(double low, double high) { return high - low; }
+
+// Replaces the linearised intervals in `u` by the profile's, keeps the
+// linearised ones beside them, and warns where the two differ by more than
+// kIntervalDisagreement or an end is open.
+void UseProfile(const ProfileLikelihood& profile, ParameterUncertainty* u) {
+  u->linearised_ci95_low = u->ci95_low;
+  u->linearised_ci95_high = u->ci95_high;
+  u->effective_nonlinearity_linearised_ci95_low = u->effective_nonlinearity_ci95_low;
+  u->effective_nonlinearity_linearised_ci95_high = u->effective_nonlinearity_ci95_high;
+  u->profile = profile;
+  u->interval_kind = "profile_likelihood";
+  for (int q = 0; q <= kNumParameters; ++q) {
+    const bool effective = q == kNumParameters;
+    const ProfileInterval& interval =
+        effective ? profile.effective_nonlinearity : profile.parameters[q];
+    if (!interval.computed) continue;
+    double& low = effective ? u->effective_nonlinearity_ci95_low : u->ci95_low[q];
+    double& high = effective ? u->effective_nonlinearity_ci95_high : u->ci95_high[q];
+    const char* name = effective ? "alpha_e" : ParameterName(q);
+    const double ratio = Width(low, high) / Width(interval.low, interval.high);
+    if (interval.low_end == ProfileEnd::kOpen || interval.high_end == ProfileEnd::kOpen) {
+      u->warnings.push_back(StringPrintf(
+          "the data do not bound %s: its profile stays below the 95 %% threshold as far as the "
+          "search went (%s side); fix it or add sweeps that determine it",
+          name, interval.low_end == ProfileEnd::kOpen ? "lower" : "upper"));
+    } else if (!(ratio <= kIntervalDisagreement && ratio >= 1.0 / kIntervalDisagreement)) {
+      u->warnings.push_back(StringPrintf(
+          "%s: the linearised 95 %% interval [%.4g, %.4g] and the profile-likelihood one "
+          "[%.4g, %.4g] differ by a factor %.2g in width; the profile is reported",
+          name, low, high, interval.low, interval.high, ratio >= 1.0 ? ratio : 1.0 / ratio));
+    }
+    low = interval.low;
+    high = interval.high;
+  }
+}
+
+// Whether every linearised interval is narrower than kRoundOffShare of its
+// parameter: the data are exact to round-off, and a rise of the cost of
+// q^2 s^2 / 2 is below what its evaluation resolves.
+bool AtRoundOff(const ParameterUncertainty& u, const ParameterVector& estimate) {
+  for (int i = 0; i < kNumParameters; ++i) {
+    const double half_width = u.linearised_ci95_high[i] - estimate[i];
+    if (half_width > kRoundOffShare * std::abs(estimate[i])) return false;
+  }
+  return true;
+}
+
+// The kind `method` asks for, in `u` (which holds the linearised one).
+void ProfileIntervals(const std::vector<const Sweep*>& fitted,
+                      const IdentificationOptions& options, const ParameterVector& estimate,
+                      const FitSummary* summary, const BlockCovariance& c, int threads,
+                      ParameterUncertainty* u) {
+  if (AtRoundOff(*u, estimate)) {
+    u->message_notes.push_back(
+        "the residuals are at round-off (exact data): the linearised intervals are reported");
+    return;
+  }
+  ProfileProblem problem;
+  const double threshold = 0.5 * std::pow(c.interval_quantile * c.noise_sigma, 2);
+  if (!MakeProfileProblem(fitted, options, summary, threshold, threads, u, &problem)) return;
+  UseProfile(ProfileCost(problem, estimate, c.covariance, c.interval_quantile), u);
+}
+
+// Fits the last stage again from `start` with the profile's solve; where
+// that ends below the result's cost, the result moves there (parameters,
+// cost, its last stage's values) and its message says `why`. Returns
+// whether it moved.
+bool MoveToLower(const ProfileProblem& problem, const ParameterVector& start,
+                 const std::string& why, IdentificationResult* result) {
+  ParameterVector p = start;
+  const double cost = RefitProfileProblem(problem, &p);
+  if (!(cost < result->final_cost * (1.0 - kLowerCostTolerance))) return false;
+  result->message += StringPrintf("; %s: the cost fell from %.10g to %.10g", why.c_str(),
+                                  result->final_cost, cost);
+  result->parameters = p;
+  result->final_cost = cost;
+  if (!result->stages.empty()) result->stages.back().values.assign(p.begin(), p.end());
+  return true;
 }
 
 }  // namespace
 
 const char* IntervalMethodName(IntervalMethod method) {
-  return method == IntervalMethod::kDataOnly ? "data_only" : "penalty_sandwich";
+  switch (method) {
+    case IntervalMethod::kDataOnly:
+      return "data_only";
+    case IntervalMethod::kLinearised:
+      return "linearised";
+    case IntervalMethod::kProfile:
+      return "profile";
+  }
+  return "profile";
 }
 
 bool ParseIntervalMethod(const std::string& name, IntervalMethod* method) {
-  for (IntervalMethod candidate : {IntervalMethod::kDataOnly, IntervalMethod::kPenaltySandwich}) {
+  for (IntervalMethod candidate :
+       {IntervalMethod::kDataOnly, IntervalMethod::kLinearised, IntervalMethod::kProfile}) {
     if (name == IntervalMethodName(candidate)) {
       *method = candidate;
       return true;
@@ -542,15 +508,19 @@ bool ParseIntervalMethod(const std::string& name, IntervalMethod* method) {
 ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted,
                                          const IdentificationOptions& options,
                                          const ParameterVector& estimate, double omega_ref_rad_s,
-                                         const FitSummary* summary, IntervalMethod method) {
+                                         const FitSummary* summary, IntervalMethod method,
+                                         int threads) {
   ParameterUncertainty u;
   if (!(omega_ref_rad_s > 0.0)) omega_ref_rad_s = estimate[kNaturalFrequency];
   u.omega_ref_rad_s = omega_ref_rad_s;
   u.effective_nonlinearity = EffectiveNonlinearity(estimate, omega_ref_rad_s);
   if (!std::isfinite(u.effective_nonlinearity)) u.effective_nonlinearity = 0.0;
 
-  Eigen::MatrixXd sampling;  // without the bias terms: the correlations
-  const BlockCovariance c = Covariance(fitted, options, estimate, summary, method, &sampling, &u);
+  const BlockCovariance data_only = PenalisedCovariance(fitted, options, estimate, 1.0, {});
+  const BlockCovariance c =
+      method == IntervalMethod::kDataOnly || !data_only.available
+          ? data_only
+          : PenaltyCovariance(fitted, options, estimate, summary, data_only, &u);
   const std::vector<std::string> own_warnings = u.warnings;
   CopyCounts(c, &u);
   u.warnings.insert(u.warnings.end(), own_warnings.begin(), own_warnings.end());
@@ -566,13 +536,79 @@ ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted
     return Unavailable(u, message);
   }
   CopyIntervals(c, &u);
-  SetCorrelation(c.free, sampling, &u);
   SetEffectiveNonlinearity(&u);
   AddPairAndBoundWarnings(c.free, estimate, &u);
+  u.linearised_ci95_low = u.ci95_low;
+  u.linearised_ci95_high = u.ci95_high;
+  u.effective_nonlinearity_linearised_ci95_low = u.effective_nonlinearity_ci95_low;
+  u.effective_nonlinearity_linearised_ci95_high = u.effective_nonlinearity_ci95_high;
+  if (method == IntervalMethod::kProfile) {
+    ProfileIntervals(fitted, options, estimate, summary, c, threads, &u);
+  }
   u.available = true;
   u.message = c.message;
+  for (const std::string& note : u.message_notes) u.message += "; " + note;
+  if (u.interval_kind == "profile_likelihood") {
+    u.message += StringPrintf("; profile-likelihood intervals from %d constrained fits",
+                              u.profile.fits);
+  }
   if (!u.warnings.empty())
     u.message += StringPrintf("; %d warning(s)", static_cast<int>(u.warnings.size()));
+  return u;
+}
+
+ParameterUncertainty EstimateUncertaintyAtMinimum(const std::vector<const Sweep*>& fitted,
+                                                  const IdentificationOptions& options,
+                                                  double omega_ref_rad_s,
+                                                  IdentificationResult* result, int threads) {
+  ProfileProblem problem;
+  ParameterUncertainty scratch;
+  scratch.omega_ref_rad_s = omega_ref_rad_s > 0.0 ? omega_ref_rad_s : result->parameters[kNaturalFrequency];
+  if (!result->IsSolutionUsable() ||
+      !MakeProfileProblem(fitted, options, result, 1.0, 1, &scratch, &problem)) {
+    return EstimateUncertainty(fitted, options, result->parameters, omega_ref_rad_s, result,
+                               IntervalMethod::kProfile, threads);
+  }
+  // Exact data: nothing to profile (EstimateUncertainty says so).
+  ParameterUncertainty u = EstimateUncertainty(fitted, options, result->parameters,
+                                               omega_ref_rad_s, result, IntervalMethod::kLinearised);
+  if (!u.available || AtRoundOff(u, result->parameters)) {
+    return EstimateUncertainty(fitted, options, result->parameters, omega_ref_rad_s, result,
+                               IntervalMethod::kProfile, threads);
+  }
+  // The profile's own solve from the estimate first: where the staged
+  // solve stopped short of the minimum, one fit instead of a profile.
+  MoveToLower(problem, result->parameters, "the last stage solved again", result);
+  for (int round = 0;; ++round) {
+    u = EstimateUncertainty(fitted, options, result->parameters, omega_ref_rad_s, result,
+                            IntervalMethod::kProfile, threads);
+    if (!u.profile.found_lower) break;
+    if (round == kMaxRefits ||
+        !MoveToLower(problem, u.profile.lower_point, u.profile.lower_while, result)) {
+      // Still not a minimum: say so, whatever the solver's tests said.
+      if (result->status == FitStatus::kConverged) result->status = FitStatus::kNoConvergence;
+      result->converged = false;
+      result->not_minimum = u.profile.lower_while + StringPrintf(" found a lower cost (%.10g)",
+                                                                 u.profile.lower_cost);
+      result->message = "not a minimum: " + result->not_minimum + "; " + result->message;
+      u.warnings.push_back("the reported point is not a minimum of the cost: " +
+                           result->not_minimum);
+      return u;
+    }
+  }
+  // The profiles found no lower cost: the point is a minimum, whatever the
+  // staged solve's own check said of where it ended.
+  if (result->status == FitStatus::kNoConvergence && !result->not_minimum.empty()) {
+    const std::string prefix = "not a minimum: " + result->not_minimum + "; ";
+    if (result->message.compare(0, prefix.size(), prefix) == 0) {
+      result->message = result->message.substr(prefix.size()) + "; the staged solve ended where " +
+                        result->not_minimum;
+    }
+    result->status = FitStatus::kConverged;
+    result->converged = true;
+    result->message += "; no profile found a lower cost: a minimum";
+    result->not_minimum.clear();
+  }
   return u;
 }
 

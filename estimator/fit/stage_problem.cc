@@ -231,6 +231,11 @@ double StageProblem::DataCost() {
 
 double StageProblem::PenaltyCost() { return CostOf(penalty_blocks_, &problem_); }
 
+double StageProblem::TotalCost() {
+  const double data = DataCost();
+  return data + PenaltyCost() + CostOf(caller_blocks_, &problem_);
+}
+
 bool StageProblem::CostGradient(std::vector<double>* gradient) {
   std::vector<ceres::ResidualBlockId> direct = caller_blocks_;
   if (setup_.threaded_evaluation) {

@@ -84,6 +84,10 @@ class StageProblem {
   double DataCost();
   // The cost of the penalties added by AddPenalties (0 without them).
   double PenaltyCost();
+  // The whole cost at the blocks' current values: the dwells, the penalties
+  // and the caller's residual blocks (infinity where some block cannot be
+  // evaluated).
+  double TotalCost();
   // The enforced jumps of `range` (an enabled bifurcation-range penalty)
   // where the model at the blocks' current values has no fold of the
   // jump's kind, each named: "L0.060g/up: no jump_down fold near its

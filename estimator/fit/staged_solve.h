@@ -95,6 +95,11 @@ struct StageSummary {
   // stage started (0 when the stage had no penalties).
   double penalty_unit = 0.0;
   int penalty_exponent = 0;  // n of eq. (3.17) in this stage (0: none)
+  // The penalties this stage minimised, with the weights it used (in the
+  // cost's own units: the configured weights times penalty_unit, and for
+  // the branch-stability penalty divided by the dwells), exponents and
+  // enforced jumps: what the analysis of the fit reads (profile_likelihood.h).
+  PenaltyOptions penalties;
   int residual_blocks = 0;   // dwell points fitted
   int iterations = 0;        // over the stage's solves and valley polishes
   int solves = 0;            // one, and one more per bound held or released and per valley polish
@@ -131,6 +136,10 @@ struct FitSummary {
   double final_cost = 0.0;  // of the last stage
   int iterations = 0;       // over all stages
   bool converged = false;   // status == kConverged
+  // Why the point the fit ended at is not a minimum of its cost (the
+  // minimum check: a step along some entry lowers the cost; status then
+  // kNoConvergence), "" when the check passed.
+  std::string not_minimum;
   // kFailure because a stage's solve could not evaluate its cost (the later
   // stages did not run): the values are where that solve stopped, no fit.
   bool evaluation_failed = false;

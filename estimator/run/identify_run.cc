@@ -79,14 +79,13 @@ constexpr std::size_t kMinDwellsForThreadsAfterFit = 2048;
 // returned as well (and the fit's dwells in FunctorBatch blocks).
 constexpr std::size_t kLargeRunDwells = 100000;
 
-// What the run computes from the estimate once the fit has ended, side by
-// side on the run's threads (solver.num_threads) when there are enough
-// dwells and not too many (kLargeRunDwells), and the fit's last choice of
-// threads did not go to the caller alone, each part in its own variable so that none
-// depends on which thread runs it or when: the covariance into
-// report->uncertainty, the predictions of every sweep into
+// What the run computes from the estimate once the fit has ended and its
+// uncertainty is known: the predictions of every sweep into
 // report->predictions and `predictions_csv`, and the response curves into
-// `curves`. `report` comes without predictions and uncertainty.
+// `curves`, side by side on the run's threads (solver.num_threads) when
+// there are enough dwells and not too many (kLargeRunDwells), and the fit's
+// last choice of threads did not go to the caller alone, each part in its
+// own variable so that none depends on which thread runs it or when.
 void ComputeAfterFit(const ResolvedRun& run, const IdentificationResult& result,
                      IdentificationReport* report, std::string* predictions_csv,
                      RunCurves* curves) {
@@ -94,38 +93,29 @@ void ComputeAfterFit(const ResolvedRun& run, const IdentificationResult& result,
   sweeps.insert(sweeps.end(), run.validation.begin(), run.validation.end());
   std::size_t dwells = 0;
   for (const Sweep* sweep : sweeps) dwells += sweep->points.size();
-  ParameterUncertainty uncertainty;
-  const auto estimate_uncertainty = [&] {
-    uncertainty = EstimateUncertainty(run.fitted, report->options, result.parameters,
-                                      report->omega_ref_rad_s, &result);
-  };
   const auto trace_curves = [&] { *curves = TraceRunCurves(result.parameters, sweeps); };
   const auto predict = [&] {
     report->predictions = PredictSweeps(result.parameters, run.fitted, run.validation);
     *predictions_csv = ReportToPredictionsCsv(*report);
   };
-  // Three parts: more threads would idle.
-  const int threads = std::min(ResolveThreadCount(run.options.solver.num_threads), 3);
+  const int threads = std::min(ResolveThreadCount(run.options.solver.num_threads), 2);
   const bool large = dwells >= kLargeRunDwells;
   // Where the fit's evaluations went to the caller alone (a busy machine),
   // the parts would not gain from threads either.
   const bool threads_lost = ThreadChoiceHistory::LastPreferredWay() == 2;
   if (large) ReturnFreedMemory();
   if (threads == 1 || dwells < kMinDwellsForThreadsAfterFit || large || threads_lost) {
-    estimate_uncertainty();
     trace_curves();
     predict();
   } else {
     tbb::task_arena arena(threads);
     arena.execute([&] {
       tbb::task_group group;
-      group.run(estimate_uncertainty);
       group.run(trace_curves);
       predict();
       group.wait();
     });
   }
-  report->uncertainty = std::move(uncertainty);
 }
 
 }  // namespace
@@ -167,9 +157,16 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
     out << "\n";
   }
 
-  const MultiStartResult multi_start = FitRun(run);
-  const IdentificationResult& result = multi_start.best;
+  MultiStartResult multi_start = FitRun(run);
   CheckUsable(config, multi_start);
+  // The profile intervals; where a profile finds a lower cost the fit goes
+  // on from there, so the best result may change here.
+  IdentificationResult& result = multi_start.best;
+  const double omega_ref_rad_s =
+      config.omega_ref_rad_s.value_or(result.parameters[kNaturalFrequency]);
+  ParameterUncertainty uncertainty =
+      EstimateUncertaintyAtMinimum(run.fitted, run.options, omega_ref_rad_s, &result,
+                                   ResolveThreadCount(run.options.solver.num_threads));
   // The report states the start the best fit came from.
   IdentificationOptions options = run.options;
   options.initial = multi_start.starts[multi_start.best_start];
@@ -177,6 +174,7 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
                                              config.omega_ref_rad_s.value_or(0.0), {}, {});
   outcome->report.initial_guess_steps = run.initial_guess_steps;
   outcome->report.multi_start = multi_start;
+  outcome->report.uncertainty = std::move(uncertainty);
   std::string predictions_csv;
   RunCurves curves;
   ComputeAfterFit(run, result, &outcome->report, &predictions_csv, &curves);

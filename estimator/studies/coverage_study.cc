@@ -9,6 +9,7 @@
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/fit/identification.h"
+#include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
 #include "dwellfit/estimator/run/resolved_run.h"
 #include "dwellfit/estimator/studies/replica_run.h"
 
@@ -47,7 +48,6 @@ void AddReplica(const IdentificationResult& result, const ParameterUncertainty& 
                 const std::vector<int>& rows, std::vector<RowSums>* sums, CoverageStudy* study) {
   study->converged += result.converged;
   study->with_penalty_terms += u.penalty_terms > 0;
-  study->with_label_pulls += u.label_pulls > 0;
   study->kinked += u.dwells_past_branch_end > 0;
   if (u.available) {
     ++study->available;
@@ -112,9 +112,15 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
     // config's jumps applied, selected, the start found from them.
     const ResolvedRun run = ResolveReplicaRun(config, plan, options.relative_noise,
                                               options.first_seed + static_cast<std::uint64_t>(r));
-    const IdentificationResult result = FitRun(run).best;
-    const ParameterUncertainty u = EstimateUncertainty(
-        run.fitted, run.options, result.parameters, study.omega_ref_rad_s, &result, options.method);
+    IdentificationResult result = FitRun(run).best;
+    const double fitted_cost = result.final_cost;
+    const ParameterUncertainty u =
+        options.method == IntervalMethod::kProfile
+            ? EstimateUncertaintyAtMinimum(run.fitted, run.options, study.omega_ref_rad_s, &result,
+                                           ResolveThreadCount(run.options.solver.num_threads))
+            : EstimateUncertainty(run.fitted, run.options, result.parameters,
+                                  study.omega_ref_rad_s, &result, options.method);
+    study.refitted += result.final_cost != fitted_cost;
     if (r == 0) {
       study.degrees_of_freedom = u.degrees_of_freedom;
       study.start_from_data = run.guessed_from_data;
@@ -138,10 +144,10 @@ void PrintCoverageStudy(const CoverageStudy& study, std::ostream& out) {
       study.mean_noise_sigma, RadPerSecondToHz(study.omega_ref_rad_s), study.seconds);
   out << StringPrintf(
       "bifurcation-range penalty %s; intervals: %s (%d replicas with the penalty's curvature in "
-      "the sandwich, %d widened by label pulls); %d replicas with a fitted dwell past its branch "
-      "end\n",
+      "the linearisation, %d fitted again from a lower point their profile found); %d replicas "
+      "with a fitted dwell past its branch end\n",
       study.penalty ? "on" : "off", IntervalMethodName(study.method), study.with_penalty_terms,
-      study.with_label_pulls, study.kinked);
+      study.refitted, study.kinked);
   out << "start: " << (study.start_from_data ? "found from each replica's data" : "the config's")
       << "; replica 0's fitted sweeps:\n";
   for (const std::string& jumps : study.first_replica_jumps) out << "  " << jumps << "\n";

@@ -10,9 +10,9 @@
 // for alpha_e = alpha - (2/3) delta Omega_ref^2 it counts the replicas whose 95 % interval contains
 // the plan's truth, and compares the mean standard error with the empirical standard deviation of
 // the estimates over the replicas (the two agree when the linearised covariance is right).
-// The intervals are those identify reports (IntervalMethod::kPenaltySandwich: with the
-// bifurcation-range penalty's curvature and pull when the config has it), or the dwells'
-// alone (kDataOnly) for comparison; docs/uncertainty.md has the measured table.
+// The intervals are those identify reports (IntervalMethod::kProfile: the profile likelihood of
+// the fitted cost, the fit made a minimum first, EstimateUncertaintyAtMinimum), or a linearised
+// kind for comparison; docs/uncertainty.md has the measured table.
 #ifndef DWELLFIT_ESTIMATOR_STUDIES_COVERAGE_STUDY_H_
 #define DWELLFIT_ESTIMATOR_STUDIES_COVERAGE_STUDY_H_
 
@@ -33,7 +33,7 @@ struct CoverageStudyOptions {
   std::uint64_t first_seed = 1;  // replica r uses seed first_seed + r
   // How the intervals treat the bifurcation-range penalty
   // (parameter_uncertainty.h); identify uses the default.
-  IntervalMethod method = IntervalMethod::kPenaltySandwich;
+  IntervalMethod method = IntervalMethod::kProfile;
 };
 
 // A fit that leaves this many fitted dwells past the end of their branch
@@ -66,10 +66,10 @@ struct CoverageStudy {
   int replicas = 0;
   int converged = 0;  // fits whose last stage converged
   int available = 0;  // replicas with a covariance
-  IntervalMethod method = IntervalMethod::kPenaltySandwich;
+  IntervalMethod method = IntervalMethod::kProfile;
   bool penalty = false;        // the bifurcation-range penalty was on
   int with_penalty_terms = 0;  // replicas with the penalty's curvature in their intervals
-  int with_label_pulls = 0;    // replicas whose intervals were widened by label pulls
+  int refitted = 0;            // replicas fitted again from a lower point their profile found
   int kinked = 0;              // replicas with a fitted dwell past its branch end
   double omega_ref_rad_s = 0.0;
   double mean_noise_sigma = 0.0;      // mean estimated residual sigma

@@ -82,17 +82,21 @@ std::string CsvField(const std::string& text) {
   return out + "\"";
 }
 
+// With `standard_errors` the fit goes the way identify's does
+// (EstimateUncertaintyAtMinimum: made a minimum of its cost where a profile
+// finds a lower one), and the row takes the linearised standard errors.
 void FillEstimates(const IdentifyConfig& config, const ResolvedRun& run,
-                   const IdentificationResult& result, bool standard_errors, FitRow* row) {
+                   IdentificationResult result, bool standard_errors, FitRow* row) {
+  const double omega_ref = config.omega_ref_rad_s.value_or(result.parameters[kNaturalFrequency]);
+  ParameterUncertainty u;
+  if (standard_errors && result.IsSolutionUsable()) {
+    u = EstimateUncertaintyAtMinimum(run.fitted, run.options, omega_ref, &result);
+  }
   row->status = FitStatusName(result.status);
   row->cost = result.final_cost;
   row->iterations = result.iterations;
   row->estimate = result.parameters;
   row->estimate[kNaturalFrequency] = RadPerSecondToHz(result.parameters[kNaturalFrequency]);
-  if (!standard_errors || !result.IsSolutionUsable()) return;
-  const double omega_ref = config.omega_ref_rad_s.value_or(result.parameters[kNaturalFrequency]);
-  const ParameterUncertainty u =
-      EstimateUncertainty(run.fitted, run.options, result.parameters, omega_ref);
   if (!u.available) return;
   row->standard_error = u.standard_error;
   row->standard_error[kNaturalFrequency] = RadPerSecondToHz(u.standard_error[kNaturalFrequency]);

@@ -1,7 +1,8 @@
 // EstimateUncertainty on the chapter's numerical case (datasets/thesis-numerical):
 // tiny intervals on exact data, Student-t intervals from the residual noise,
 // standardised residuals with point sigmas, rank deficiency reported in plain
-// words, fixed parameters kept out, and the coverage of the 95 % intervals
+// words, fixed parameters kept out, the penalty's curvature in the
+// linearisation, and the coverage of the reported (profile) 95 % intervals
 // over 200 noisy replicas.
 #include "dwellfit/estimator/analysis/parameter_uncertainty.h"
 
@@ -72,7 +73,7 @@ class UncertaintyThesisNumerical : public ::testing::Test {
 
   static std::vector<const Sweep*> Fitted(const ResolvedRun& run) { return run.fitted; }
 
-  double CheckSandwichWithPull(std::uint64_t seed) const;
+  void CheckPenalisedLinearisation(std::uint64_t seed) const;
 
   // Both directions of the sweeps with these ids.
   static std::vector<const Sweep*> Named(const ResolvedRun& run,
@@ -115,7 +116,7 @@ TEST_F(UncertaintyThesisNumerical, NoisyFitGivesStudentTIntervalsFromTheResidual
   const std::vector<const Sweep*> fitted = Fitted(noisy);
   const IdentificationResult result = Identify(fitted, config_.identification);
   const ParameterUncertainty u =
-      EstimateUncertainty(fitted, config_.identification, result.parameters, omega_ref_);
+      EstimateUncertainty(fitted, config_.identification, result.parameters, omega_ref_, nullptr, IntervalMethod::kLinearised);
   ASSERT_TRUE(u.available) << u.message;
   ExpectAllFinite(u);
   EXPECT_EQ(u.degrees_of_freedom, 260 - 5);
@@ -152,7 +153,7 @@ TEST_F(UncertaintyThesisNumerical, PointSigmasStandardiseTheResidualsAndUseTheNo
   const std::vector<const Sweep*> fitted = Fitted(noisy);
   const IdentificationResult result = Identify(fitted, config_.identification);
   const ParameterUncertainty estimated =
-      EstimateUncertainty(fitted, config_.identification, result.parameters, omega_ref_);
+      EstimateUncertainty(fitted, config_.identification, result.parameters, omega_ref_, nullptr, IntervalMethod::kLinearised);
   // The true standard deviation of every amplitude: 1 % of it (ln a: 0.01).
   for (Sweep& sweep : noisy.sweeps) {
     for (DwellPoint& point : sweep.points) point.sigma = 0.01 * point.amplitude;
@@ -160,7 +161,7 @@ TEST_F(UncertaintyThesisNumerical, PointSigmasStandardiseTheResidualsAndUseTheNo
   IdentificationOptions options = config_.identification;
   options.residual.use_point_sigma = true;
   const ParameterUncertainty given =
-      EstimateUncertainty(fitted, options, result.parameters, omega_ref_);
+      EstimateUncertainty(fitted, options, result.parameters, omega_ref_, nullptr, IntervalMethod::kLinearised);
   ASSERT_TRUE(given.available) << given.message;
   ExpectAllFinite(given);
   EXPECT_DOUBLE_EQ(given.noise_sigma, 1.0);
@@ -179,7 +180,7 @@ TEST_F(UncertaintyThesisNumerical, PointSigmasStandardiseTheResidualsAndUseTheNo
   // Only some points with a sigma: mixed units, said so.
   for (DwellPoint& point : noisy.sweeps[0].points) point.sigma.reset();
   const ParameterUncertainty mixed =
-      EstimateUncertainty(fitted, options, result.parameters, omega_ref_);
+      EstimateUncertainty(fitted, options, result.parameters, omega_ref_, nullptr, IntervalMethod::kLinearised);
   EXPECT_THAT(mixed.warnings, ::testing::Contains(HasSubstr("only some points have a sigma")));
   // s estimated from the mixed residuals, not assumed to be 1.
   EXPECT_NE(mixed.noise_sigma, 1.0);
@@ -228,7 +229,7 @@ TEST_F(UncertaintyThesisNumerical, FrequencySweepAloneWarnsButKeepsTheEffectiveN
   const std::vector<const Sweep*> fitted = Named(noisy, {"F0.01"});
   const IdentificationResult result = Identify(fitted, config_.identification);
   const ParameterUncertainty u =
-      EstimateUncertainty(fitted, config_.identification, result.parameters, omega_ref_);
+      EstimateUncertainty(fitted, config_.identification, result.parameters, omega_ref_, nullptr, IntervalMethod::kLinearised);
   ASSERT_TRUE(u.available) << u.message;
   ExpectAllFinite(u);
   EXPECT_GT(u.correlation(kDelta, kAlpha), 0.99);
@@ -249,7 +250,7 @@ TEST_F(UncertaintyThesisNumerical, FixedParametersHaveZeroErrorAndStayOutOfWarni
   options.fixed[kDelta] = true;
   const IdentificationResult result = Identify(fitted, options);
   const ParameterUncertainty u =
-      EstimateUncertainty(fitted, options, result.parameters, omega_ref_);
+      EstimateUncertainty(fitted, options, result.parameters, omega_ref_, nullptr, IntervalMethod::kLinearised);
   ASSERT_TRUE(u.available) << u.message;
   ExpectAllFinite(u);
   EXPECT_EQ(u.num_free, 4);
@@ -273,14 +274,14 @@ TEST_F(UncertaintyThesisNumerical, WarnsWhenTheModelsFoldFallsShortOfMeasuredDwe
   // F0.01/up is on the upper branch at 42.2 Hz, 0.015 Hz below the true
   // jump-down fold; 1 % less alpha moves the model's fold below that dwell.
   const ParameterUncertainty at_truth =
-      EstimateUncertainty(Fitted(exact_), config_.identification, kTruth, omega_ref_);
+      EstimateUncertainty(Fitted(exact_), config_.identification, kTruth, omega_ref_, nullptr, IntervalMethod::kLinearised);
   EXPECT_EQ(at_truth.dwells_past_branch_end, 0);
   EXPECT_THAT(at_truth.warnings, ::testing::Each(Not(HasSubstr("past the end of their branch"))));
 
   ParameterVector softer = kTruth;
   softer[kAlpha] *= 0.99;
   const ParameterUncertainty u =
-      EstimateUncertainty(Fitted(exact_), config_.identification, softer, omega_ref_);
+      EstimateUncertainty(Fitted(exact_), config_.identification, softer, omega_ref_, nullptr, IntervalMethod::kLinearised);
   ASSERT_TRUE(u.available) << u.message;
   EXPECT_EQ(u.dwells_past_branch_end, 1);
   EXPECT_THAT(u.warnings, ::testing::Contains(AllOf(HasSubstr("1 fitted dwell(s) lie past"),
@@ -345,18 +346,13 @@ Eigen::VectorXd DistanceGradient(const Sweep& sweep, const JumpBracket& jump,
   return gradient;
 }
 
-// With the bifurcation-range penalty (W u^n, eq. 3.17) on, the covariance is
-// the penalised fit's sandwich plus the penalty's pull, recomputed here in
-// another algebraic form with finite-difference gradients:
-//   C_A = (C_d^-1 + I_p)^-1,  I_p = sum_k (kappa_k / s^2) g_k g_k^T,
+// With the bifurcation-range penalty (W u^n, eq. 3.17) on, the linearised
+// covariance is that of the penalised cost, recomputed here in another
+// algebraic form with finite-difference gradients:
+//   C = (C_d^-1 + I_p)^-1,  I_p = sum_k (kappa_k / s^2) g_k g_k^T,
 //   kappa_k = (1/2) W n (n - 1) u_k^(n - 2),
-//   C = C_A C_d^-1 C_A + beta b b^T,  b = C_d sum_k (W n u_k^(n - 1) / 2) g_k / s^2,
-// with C_d the dwells' own covariance and beta the share of b b^T that is
-// bias rather than b's own noise (V = (C_d I_p) S (C_d I_p)^T, S = C_A C_d^-1 C_A):
-//   beta = max(0, 1 - b^T S^-1 V S^-1 b / (b^T S^-1 b)^2).
-// Checks one noisy replica's penalised covariance against that form; returns
-// the share of b b^T kept.
-double UncertaintyThesisNumerical::CheckSandwichWithPull(std::uint64_t seed) const {
+// with C_d the dwells' own covariance.
+void UncertaintyThesisNumerical::CheckPenalisedLinearisation(std::uint64_t seed) const {
   SCOPED_TRACE("seed " + std::to_string(seed));
   const ResolvedRun noisy = NoisyRun(seed);  // fits that keep every branch label
   IdentificationOptions options = config_.identification;
@@ -366,19 +362,20 @@ double UncertaintyThesisNumerical::CheckSandwichWithPull(std::uint64_t seed) con
   const ParameterVector& p = result.parameters;
   const ParameterUncertainty data =
       EstimateUncertainty(noisy.fitted, options, p, omega_ref_, &result, IntervalMethod::kDataOnly);
-  const ParameterUncertainty u = EstimateUncertainty(noisy.fitted, options, p, omega_ref_, &result);
-  EXPECT_TRUE(data.available) << data.message;
-  EXPECT_TRUE(u.available) << u.message;
-  if (!data.available || !u.available) return -1.0;
+  const ParameterUncertainty u = EstimateUncertainty(noisy.fitted, options, p, omega_ref_, &result,
+                                                     IntervalMethod::kLinearised);
+  ASSERT_TRUE(data.available) << data.message;
+  ASSERT_TRUE(u.available) << u.message;
   EXPECT_EQ(data.interval_kind, "gauss_newton");
-  EXPECT_EQ(u.interval_kind, "gauss_newton_sandwich_with_penalty");
+  EXPECT_EQ(u.interval_kind, "linearised_with_penalty");
   EXPECT_EQ(u.penalty_terms, 2);  // F0.01/up jump_down and A41.5/up jump_up
-  EXPECT_EQ(u.label_pulls, 0);
   EXPECT_THAT(u.message, HasSubstr("penalty's curvature at 2 enforced jump(s)"));
 
   const StageSummary& stage = result.stages.back();
   EXPECT_EQ(stage.penalty_exponent, 10);
+  // The fit hands on the weight it used, in the cost's units.
   const double weight = options.penalties.bifurcation_range.weight * stage.penalty_unit;
+  EXPECT_DOUBLE_EQ(stage.penalties.bifurcation_range.weight, weight);
   const double s2 = data.noise_sigma * data.noise_sigma;
   // Free parameters only (omega is fixed), scaled by their values.
   const std::vector<int> free = {kEtaE, kMu1, kMu2, kDelta, kAlpha};
@@ -391,7 +388,6 @@ double UncertaintyThesisNumerical::CheckSandwichWithPull(std::uint64_t seed) con
     }
   }
   Eigen::MatrixXd penalty_information = Eigen::MatrixXd::Zero(5, 5);
-  Eigen::VectorXd penalty_gradient = Eigen::VectorXd::Zero(5);
   int enforced = 0;
   for (const Sweep* sweep : noisy.fitted) {
     for (const JumpBracket& jump : sweep->jumps) {
@@ -407,51 +403,32 @@ double UncertaintyThesisNumerical::CheckSandwichWithPull(std::uint64_t seed) con
       EXPECT_LT(std::abs(distance), 1.0);  // the fold inside its bracket
       const double kappa = 0.5 * weight * 90.0 * std::pow(distance, 8);
       penalty_information += (kappa / s2) * g * g.transpose();
-      penalty_gradient += 0.5 * weight * 10.0 * std::pow(distance, 9) * g;
     }
   }
   EXPECT_EQ(enforced, 2);
-  const Eigen::MatrixXd data_information = data_cov.inverse();
-  const Eigen::MatrixXd a = (data_information + penalty_information).inverse();
-  const Eigen::VectorXd pull = data_cov * penalty_gradient / s2;
-  const Eigen::MatrixXd sampling = a * data_information * a;
-  // The pull's own noise: b moves by C_d I_p dp as the estimate moves by dp.
-  const Eigen::MatrixXd response = data_cov * penalty_information;
-  const Eigen::MatrixXd pull_variance = response * sampling * response.transpose();
-  const Eigen::MatrixXd sampling_inverse = sampling.inverse();
-  const double along = pull.dot(sampling_inverse * pull);
-  const double share =
-      std::max(0.0, 1.0 - pull.dot(sampling_inverse * pull_variance * sampling_inverse * pull) /
-                              (along * along));
-  const Eigen::MatrixXd expected = sampling + share * pull * pull.transpose();
+  const Eigen::MatrixXd expected = (data_cov.inverse() + penalty_information).inverse();
   for (int k = 0; k < 5; ++k) {
     const int i = free[k];
     EXPECT_NEAR(u.standard_error[i] / scale[k], std::sqrt(expected(k, k)),
                 1e-4 * std::sqrt(expected(k, k)))
         << ParameterName(i);
+    EXPECT_LE(u.standard_error[i], data.standard_error[i] * (1.0 + 1e-9)) << ParameterName(i);
   }
-  // Without the pull, the penalty narrows mu2's interval: the dwells alone
-  // leave out what the enforced folds pin.
-  if (share == 0.0) EXPECT_LT(u.standard_error[kMu2], data.standard_error[kMu2]);
 
   // Without the fit's summary the weight is unknown: the dwells alone, said.
-  const ParameterUncertainty unknown = EstimateUncertainty(noisy.fitted, options, p, omega_ref_);
+  const ParameterUncertainty unknown = EstimateUncertainty(noisy.fitted, options, p, omega_ref_,
+                                                           nullptr, IntervalMethod::kLinearised);
   EXPECT_EQ(unknown.interval_kind, "gauss_newton");
   EXPECT_THAT(unknown.warnings,
               ::testing::Contains(HasSubstr("the fit's penalty weight is not known here")));
   EXPECT_DOUBLE_EQ(unknown.standard_error[kMu2], data.standard_error[kMu2]);
-  return share;
 }
 
-TEST_F(UncertaintyThesisNumerical, PenaltyEntersTheCovarianceAsASandwichWithItsPull) {
-  for (std::uint64_t seed : {1, 2, 4}) {  // replicas that keep every branch label
-    // Here the pull is within its own noise: the sandwich alone.
-    EXPECT_EQ(CheckSandwichWithPull(seed), 0.0);
-  }
+TEST_F(UncertaintyThesisNumerical, PenaltyCurvatureEntersTheLinearisedCovariance) {
+  for (std::uint64_t seed : {1, 2, 4}) CheckPenalisedLinearisation(seed);
 }
 
-// The softening case, where the penalty biases alpha_e by about 0.7 of its
-// spread: some replicas keep part of the pull as a bias.
+// The softening case, where the penalty binds harder.
 class UncertaintySofteningNumerical : public UncertaintyThesisNumerical {
  protected:
   std::string Dataset() const override {
@@ -459,63 +436,8 @@ class UncertaintySofteningNumerical : public UncertaintyThesisNumerical {
   }
 };
 
-TEST_F(UncertaintySofteningNumerical, PenaltyEntersTheCovarianceAsASandwichWithItsPull) {
-  int partly_kept = 0;
-  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
-    const double share = CheckSandwichWithPull(seed);
-    ASSERT_GE(share, 0.0);
-    ASSERT_LE(share, 1.0);
-    if (share > 0.0 && share < 1.0) ++partly_kept;
-  }
-  EXPECT_GE(partly_kept, 4);  // 6 of these 8
-}
-
-// A fit that ends F0.01/up's upper branch before its 42.2 Hz dwell (the
-// label says the fold lies beyond it) has its intervals widened by the move
-// back: C = C_d + delta delta^T, and p + delta puts the fold on that dwell to
-// first order.
-TEST_F(UncertaintyThesisNumerical, ViolatedBranchLabelWidensByTheMoveBackToIt) {
-  // The exact data at the truth with 1 % less alpha: the fold moves below
-  // the 42.2 Hz dwell (as in WarnsWhenTheModelsFoldFallsShortOfMeasuredDwells).
-  ParameterVector soft = kTruth;
-  soft[kAlpha] *= 0.99;
-  const ParameterUncertainty data = EstimateUncertainty(
-      Fitted(exact_), config_.identification, soft, omega_ref_, nullptr, IntervalMethod::kDataOnly);
-  const ParameterUncertainty u =
-      EstimateUncertainty(Fitted(exact_), config_.identification, soft, omega_ref_);
-  ASSERT_TRUE(data.available) << data.message;
-  ASSERT_TRUE(u.available) << u.message;
-  EXPECT_EQ(data.label_pulls, 0);
-  ASSERT_EQ(u.label_pulls, 1);
-  EXPECT_EQ(u.interval_kind, "gauss_newton");
-  EXPECT_THAT(u.message, HasSubstr("widened by the move back to 1 branch label(s)"));
-
-  // The difference is rank one: delta delta^T.
-  const ParameterMatrix difference = u.covariance - data.covariance;
-  ASSERT_GT(difference(kAlpha, kAlpha), 0.0);
-  const Eigen::Matrix<double, kNumParameters, 1> delta =
-      difference.col(kAlpha) / std::sqrt(difference(kAlpha, kAlpha));
-  EXPECT_TRUE(difference.isApprox(delta * delta.transpose(), 1e-9));
-  EXPECT_GT(u.standard_error[kAlpha], data.standard_error[kAlpha]);
-  // The correlations stay those of the dwells: the bias term is left out.
-  EXPECT_TRUE(u.correlation.isApprox(data.correlation, 1e-12));
-
-  // Where the fold sits, in half-widths of the bracket 42.2..42.3 Hz (-1: on
-  // the 42.2 Hz dwell), and its change along delta by finite differences:
-  // to first order delta moves it onto the dwell.
-  const Sweep* up = Named(exact_, {"F0.01"}).front();
-  ASSERT_EQ(up->direction, SweepDirection::kUp);
-  ASSERT_EQ(up->jumps.size(), 1u);
-  double before = 0.0, nudged = 0.0;
-  DistanceGradient(*up, up->jumps[0], soft, &before);
-  EXPECT_LT(before, -1.0);  // past the dwell
-  constexpr double kStep = 1e-4;
-  ParameterVector towards = soft;
-  for (int i = 0; i < kNumParameters; ++i) towards[i] += kStep * delta[i];
-  DistanceGradient(*up, up->jumps[0], towards, &nudged);
-  // delta delta^T fixes delta up to its sign.
-  EXPECT_NEAR(std::abs(nudged - before) / kStep, -1.0 - before, 1e-3 * std::abs(1.0 + before))
-      << before << " -> " << nudged;
+TEST_F(UncertaintySofteningNumerical, PenaltyCurvatureEntersTheLinearisedCovariance) {
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) CheckPenalisedLinearisation(seed);
 }
 
 // The bar: over 200 noisy replicas each free parameter's 95 % interval
@@ -539,11 +461,9 @@ TEST(UncertaintyCoverage, NinetyFivePercentIntervalsCoverTheTruthOnTheThesisCase
     EXPECT_GE(row.Coverage(), 0.90) << row.name;
     EXPECT_LE(row.Coverage(), 0.98) << row.name;
     EXPECT_GT(row.mean_standard_error, 0.75 * row.empirical_std) << row.name;
-    // Two thirds of these fits stop short of a branch label and carry its
-    // pull, a bias term: mu1 and mu2, correlated with the fold, get 1.43.
+    // The linearised standard errors beside the profile intervals.
     EXPECT_LT(row.mean_standard_error, 1.5 * row.empirical_std) << row.name;
   }
-  EXPECT_GT(study.with_label_pulls, study.replicas / 2);
 }
 
 }  // namespace

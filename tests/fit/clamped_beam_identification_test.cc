@@ -144,8 +144,9 @@ TEST_F(ClampedBeamIdentification, SameMinimumWithoutNonmonotonicStepsOrTheAlgebr
 
 // The start stage can lose: a vertical stage run alone from the committed
 // fit's minimum keeps that start (the algebraic residual's minimum lies
-// elsewhere, at a higher vertical cost), says so in its note, and ends at
-// the same cost.
+// elsewhere, at a higher vertical cost), says so in its note, and ends no
+// higher (its penalty is weighed anew where it starts, so the cost is not
+// quite the same function; the valley's floor is uneven at the 1e-4 level).
 TEST_F(ClampedBeamIdentification, AVerticalStageAloneKeepsAGivenStartBetterThanTheStartStages) {
   IdentificationOptions options = config_->identification;
   options.initial = committed_->parameters;
@@ -160,7 +161,8 @@ TEST_F(ClampedBeamIdentification, AVerticalStageAloneKeepsAGivenStartBetterThanT
             0u)
       << fit.stages[1].note;
   EXPECT_TRUE(fit.converged) << fit.message;
-  EXPECT_NEAR(fit.final_cost, committed_->final_cost, 1e-4 * committed_->final_cost);
+  EXPECT_LT(fit.final_cost, (1.0 + 1e-4) * committed_->final_cost);
+  EXPECT_GT(fit.final_cost, (1.0 - 1e-3) * committed_->final_cost);
 }
 
 // The residual blocks are evaluated on threads in fixed chunks and summed by

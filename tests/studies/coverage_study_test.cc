@@ -62,16 +62,15 @@ TEST(CoverageStudy, WithNoInitialGuessesEveryReplicaConvergesWithACovariance) {
   }
 }
 
-// With the bifurcation-range penalty on, the intervals take the penalty's
-// curvature and pull (parameter_uncertainty.h). The dwells alone gave
-// intervals up to 1.6 times the spread of the estimates here (mu2); the
-// sandwich brings the mean standard error within the spread's range.
+// With the bifurcation-range penalty on, the reported intervals are the
+// profile's of the penalised cost, and the linearised standard errors
+// beside them take the penalty's curvature (parameter_uncertainty.h).
 TEST(CoverageStudy, WithThePenaltyTheIntervalsMatchTheSpreadOfTheEstimates) {
   const CoverageStudy study =
       Study(ParseSetFlag("penalties={bifurcation_range: {enabled: true}}", "--test"), 40);
   PrintCoverageStudy(study, std::cout);
   EXPECT_TRUE(study.penalty);
-  EXPECT_EQ(study.method, IntervalMethod::kPenaltySandwich);
+  EXPECT_EQ(study.method, IntervalMethod::kProfile);
   EXPECT_EQ(study.with_penalty_terms, study.replicas);
   EXPECT_EQ(study.available, study.replicas);
   ASSERT_EQ(study.rows.size(), 6u);  // five free parameters and alpha_e
