@@ -224,11 +224,10 @@ TEST_F(HostileInput, ResultFilesAreByteIdenticalAcrossThreadCounts) {
   EXPECT_EQ(files[0], files[1]);
 }
 
-// The measured beam (4096 fitted dwells, 24,226 in all): large enough that
-// the residuals are evaluated on two threads and the covariance, the
-// predictions and the curves may be computed side by side. Whatever the
-// library chooses, every result file must be the same byte for byte as on
-// one thread.
+// The measured beam (4096 fitted dwells, 24,226 in all): large enough for
+// the library to share the fit's residuals, and the covariance, predictions
+// and curves after it, among two threads. Whatever the library chooses,
+// every result file must be the same byte for byte as on one thread.
 TEST_F(HostileInput, MeasuredBeamFilesAreByteIdenticalOnOneAndTwoThreads) {
   const std::string beam = std::string(DWELLFIT_SOURCE_DIR) + "/datasets/clamped-beam-27C";
   std::string files[2];
