@@ -116,8 +116,7 @@ TEST(ConfigOverrides, CreateABlockTheFileLacks) {
   const IdentifyConfig config =
       LoadIdentifyConfig(path, ParseSetFlag("jump_detection.min_ratio=4", "--set"));
   EXPECT_EQ(config.jump_detection.min_ratio, 4.0);
-  EXPECT_EQ(config.jump_detection.min_relative_amplitude,
-            JumpDetectionOptions().min_relative_amplitude);
+  EXPECT_EQ(config.jump_detection.min_relative_amplitude, 0.2);  // config/README.md's default
 }
 
 TEST(ConfigOverrides, FreeRemovesParametersFromFixed) {

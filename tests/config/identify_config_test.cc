@@ -82,7 +82,10 @@ TEST(LoadIdentifyConfig, ValidConfigLandsInTheStructs) {
   EXPECT_TRUE(config.overrides.empty());
 }
 
-TEST(LoadIdentifyConfig, OptionalKeysTakeTheOptionsDefaults) {
+// The defaults of config/README.md's tables, written here rather than read
+// from the options structs, so a changed default fails until the
+// documentation changes with it.
+TEST(LoadIdentifyConfig, OptionalKeysTakeTheDocumentedDefaults) {
   const ConfigDirectory dir;
   const std::string path = dir.WriteConfig(R"(data: sweeps.csv
 fit: [F0.01/up]
@@ -90,17 +93,33 @@ initial_guess: {eta_e: 100, mu1: 0.2, mu2: 300, delta: 1e4, alpha: 9e8, omega_hz
 output_dir: out
 )");
   const IdentifyConfig config = LoadIdentifyConfig(path);
-  const IdentificationOptions defaults;
+  const IdentificationOptions& options = config.identification;
   EXPECT_EQ(config.fit_sweeps[0].direction, SweepDirection::kUp);
   EXPECT_TRUE(config.validate_sweeps.empty());
-  EXPECT_EQ(config.identification.fixed, defaults.fixed);
-  EXPECT_EQ(config.identification.stages, defaults.stages);
-  EXPECT_EQ(config.identification.residual.error, defaults.residual.error);
-  EXPECT_EQ(config.identification.residual.use_point_sigma, defaults.residual.use_point_sigma);
-  EXPECT_EQ(config.identification.solver.max_iterations, defaults.solver.max_iterations);
-  EXPECT_EQ(config.identification.solver.function_tolerance, defaults.solver.function_tolerance);
-  EXPECT_EQ(config.jump_detection.min_ratio, JumpDetectionOptions().min_ratio);
+  for (int i = 0; i < kNumParameters; ++i) EXPECT_FALSE(options.fixed[i]) << i;  // all free
+  EXPECT_THAT(options.stages, ElementsAre(ResidualKind::kAlgebraic, ResidualKind::kVertical));
+  EXPECT_EQ(options.residual.error, ErrorMeasure::kAbsolute);
+  EXPECT_TRUE(options.residual.use_point_sigma);
+  EXPECT_EQ(options.residual.amplitude_floor, 0.0);
+  EXPECT_EQ(options.solver.max_iterations, 200);
+  EXPECT_EQ(options.solver.function_tolerance, 1e-8);
+  EXPECT_EQ(options.solver.start_function_tolerance, 1e-5);
+  EXPECT_EQ(options.solver.gradient_tolerance, 1e-30);
+  EXPECT_EQ(options.solver.parameter_tolerance, 1e-20);
+  EXPECT_EQ(options.solver.num_threads, 0);
+  EXPECT_FALSE(options.solver.nonmonotonic_steps);
+  EXPECT_TRUE(options.solver.valley_polish);
+  EXPECT_EQ(config.multi_start.starts, 1);
+  EXPECT_EQ(config.multi_start.spread, 3.0);
+  EXPECT_EQ(config.multi_start.seed, 1u);
+  EXPECT_EQ(config.multi_start.threads, 2);
+  EXPECT_EQ(config.jump_detection.min_ratio, 1.07);
+  EXPECT_EQ(config.jump_detection.min_relative_amplitude, 0.2);
+  EXPECT_EQ(config.jump_detection.noise_multiple, 6.0);
+  EXPECT_EQ(config.jump_detection.min_candidate_steps, 5);
+  EXPECT_TRUE(config.jump_overrides.empty());
   EXPECT_FALSE(config.omega_ref_rad_s.has_value());
+  EXPECT_FALSE(config.model_selection.has_value());
 }
 
 TEST(LoadIdentifyConfig, PathsAreRelativeToTheConfigFileNotTheWorkingDirectory) {
@@ -160,7 +179,7 @@ TEST(LoadIdentifyConfig, StartFunctionToleranceIsReadAndShown) {
   ASSERT_NE(text.find(line), std::string::npos);
   const std::string path = dir.WriteConfig(text);
   EXPECT_EQ(LoadIdentifyConfig(path).identification.solver.start_function_tolerance,
-            SolverSettings{}.start_function_tolerance);
+            1e-5);  // config/README.md's default
   text.replace(text.find(line), line.size(), line + "  start_function_tolerance: 1e-3\n");
   const IdentifyConfig config = LoadIdentifyConfig(dir.WriteConfig(text));
   EXPECT_EQ(config.identification.solver.start_function_tolerance, 1e-3);
@@ -218,12 +237,11 @@ TEST(ConfigReadme, AnnotatedExampleLoads) {
   EXPECT_EQ(config.identification.solver.max_iterations, 200);
   EXPECT_TRUE(config.identification.penalties.bifurcation_range.enabled);
   EXPECT_FALSE(config.identification.penalties.branch_stability.enabled);
-  // The example spells out the jump-detection defaults.
-  const JumpDetectionOptions defaults;
-  EXPECT_EQ(config.jump_detection.min_ratio, defaults.min_ratio);
-  EXPECT_EQ(config.jump_detection.min_relative_amplitude, defaults.min_relative_amplitude);
-  EXPECT_EQ(config.jump_detection.noise_multiple, defaults.noise_multiple);
-  EXPECT_EQ(config.jump_detection.min_candidate_steps, defaults.min_candidate_steps);
+  // The example spells out the jump-detection defaults of the README's table.
+  EXPECT_EQ(config.jump_detection.min_ratio, 1.07);
+  EXPECT_EQ(config.jump_detection.min_relative_amplitude, 0.2);
+  EXPECT_EQ(config.jump_detection.noise_multiple, 6.0);
+  EXPECT_EQ(config.jump_detection.min_candidate_steps, 5);
   ASSERT_EQ(config.jump_overrides.size(), 2u);
   EXPECT_EQ(config.jump_overrides[0].sweep, "F0.01/down");
   EXPECT_TRUE(config.jump_overrides[1].none);
