@@ -2,6 +2,7 @@
 #include "dwellfit/estimator/studies/model_selection.h"
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -114,7 +115,7 @@ TEST_F(ModelSelectionTest, TableIsConsistentWithItsFits) {
   }
   const std::string csv = ModelSelectionCsv(report);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3);
-  EXPECT_THAT(csv, HasSubstr(",true,true\n"));  // the recommended row
+  EXPECT_THAT(csv, HasSubstr(",true,true,"));  // the recommended row
 }
 
 // Threads change nothing: the same tables from one thread and from three.
@@ -156,26 +157,103 @@ TEST_F(ModelSelectionTest, PoolSweepNotInTheDataIsAnInputError) {
   }
 }
 
-// The committed beam-selected.yaml: with the validate sweeps as the only
-// held-out data (no cross-validation, to keep the test short), the study
-// recommends delta = 0, whose median jump-down error over the ten validate
-// levels is within the 2 % bar, and better than delta free's.
-TEST(ModelSelectionBeam, CommittedSelectedConfigRecommendsDeltaZeroWithinTwoPercent) {
-  const IdentifyConfig config = LoadIdentifyConfig(
-      std::string(DWELLFIT_SOURCE_DIR) + "/datasets/clamped-beam-27C/beam-selected.yaml",
-      ParseSetFlag("model_selection.cross_validation=none", "--test"));
+// The committed beam-selected.yaml, its full leave-one-level-out study
+// (delta free or 0, mu2 0; 2 x 3 fits from six starts, a few seconds on two
+// threads). delta = 0 predicts the held-out jump-downs best (1.60 %) but
+// the upper branches 40 % low; delta free is within 2.6 % on the
+// jump-downs and 10 % on the amplitudes, and best on the jump-ups: the rule
+// recommends it. Its leave-one-level-out 95 % prediction intervals of the
+// jump-down frequency hold the measured bracket centre at 9 or more of the
+// 12 levels.
+TEST(ModelSelectionBeam, CommittedSelectedConfigRecommendsAVariantRightOnJumpsAndAmplitudes) {
+  const IdentifyConfig config = LoadIdentifyConfig(std::string(DWELLFIT_SOURCE_DIR) +
+                                                   "/datasets/clamped-beam-27C/beam-selected.yaml");
   const ModelSelectionReport report = RunModelSelection(config, 2);
   ASSERT_EQ(report.variants.size(), 2u);
-  ASSERT_EQ(report.recommended, 1);
-  const VariantResult& chosen = report.variants[1];
-  EXPECT_EQ(chosen.variant.Name(), "delta 0, mu2 0, w free");
-  ASSERT_EQ(chosen.validation.jump_down_percent.size(), 10u);
-  const double median = MedianOf(chosen.validation.jump_down_percent);
-  std::cout << "delta 0: validate median jump-down error " << median << " %\n";
-  EXPECT_LE(median, 2.0);
-  EXPECT_LT(median, MedianOf(report.variants[0].validation.jump_down_percent));
-  // Lower cost is not better prediction: delta free fits far better.
-  EXPECT_LT(report.variants[0].fits[0].final_cost, 0.2 * chosen.fits[0].final_cost);
+  ASSERT_GE(report.recommended, 0) << report.verdict;
+  const VariantResult& chosen = report.variants[report.recommended];
+  std::cout << report.verdict << "\n";
+  EXPECT_EQ(chosen.variant.Name(), "delta free, mu2 0, w free");
+  EXPECT_LE(chosen.upper_branch_percent, 10.0);
+  EXPECT_LE(chosen.jump_down_percent, 2.6);
+  ASSERT_EQ(chosen.cross_validation.upper_branch_percent.size(), 12u);  // every level's up-sweep
+  ASSERT_EQ(chosen.cross_validation.jump_down_percent.size(), 12u);
+  // The other variant: better on jump-downs, 40 % off on the upper branches.
+  const VariantResult& zero = report.variants[1 - report.recommended];
+  EXPECT_LT(zero.jump_down_percent, chosen.jump_down_percent);
+  EXPECT_GT(zero.upper_branch_percent, 30.0);
+  // Prediction intervals of every held-out level's jump-down.
+  EXPECT_EQ(chosen.jump_down_coverage.total, 12);
+  EXPECT_GE(chosen.jump_down_coverage.inside, 9);
+  EXPECT_GT(chosen.jump_down_coverage.median_half_width, 0.0);
+  std::cout << "jump-down intervals: " << chosen.jump_down_coverage.inside << " / 12 inside, "
+            << "median half-width " << chosen.jump_down_coverage.median_half_width << " Hz\n";
+  // recommended.yaml loads as a config of that variant.
+  const ConfigDirectory directory;
+  const std::string path =
+      directory.WriteFile("recommended.yaml", RecommendedConfigYaml(config, report));
+  const IdentifyConfig recommended = LoadIdentifyConfig(path);
+  EXPECT_FALSE(recommended.identification.fixed[kDelta]);
+  EXPECT_TRUE(recommended.identification.fixed[kMu2]);
+  EXPECT_EQ(recommended.identification.initial[kMu2], 0.0);
+  EXPECT_EQ(recommended.fit_sweeps.size(), config.fit_sweeps.size());
+  EXPECT_THAT(ModelSelectionMarkdown(report), HasSubstr("Rule: candidates:"));
+}
+
+// The prediction intervals' rule on made-up folds: s_m is the prediction
+// times the RMS relative error of the same quantity at the other levels,
+// the half-width 1.96 sqrt(s_p^2 + s_m^2).
+TEST(PredictionIntervals, ModelErrorComesFromTheOtherLevels) {
+  VariantResult result;
+  const double measured[3] = {100.0, 200.0, 300.0};
+  const double predicted[3] = {110.0, 190.0, 300.0};  // relative errors +0.1, -0.05, 0
+  for (int level = 0; level < 3; ++level) {
+    CrossValidationFold fold;
+    HeldOutPrediction p;
+    p.sweep = "L" + std::to_string(level) + "/up";
+    p.quantity = HeldOutQuantity::kJumpDown;
+    p.measured = measured[level];
+    p.predicted = predicted[level];
+    p.parameter_sd = level == 2 ? 3.0 : 0.0;
+    fold.predictions.push_back(p);
+    result.folds.push_back(fold);
+  }
+  AddPredictionIntervals(&result);
+  const auto& at = [&](int level) { return result.folds[level].predictions[0]; };
+  // Level 0: others' errors -0.05 and 0: RMS 0.0354; s_m = 110 x 0.0354 = 3.89.
+  EXPECT_NEAR(at(0).model_sd, 110.0 * std::sqrt((0.0025 + 0.0) / 2.0), 1e-9);
+  EXPECT_NEAR(at(0).half_width, 1.959964 * at(0).model_sd, 1e-5);
+  EXPECT_FALSE(at(0).inside);  // 10 off, half-width 7.6
+  // Level 1: others' +0.1 and 0: s_m = 190 x 0.0707 = 13.4; 10 off: inside.
+  EXPECT_NEAR(at(1).model_sd, 190.0 * std::sqrt(0.01 / 2.0), 1e-9);
+  EXPECT_TRUE(at(1).inside);
+  // Level 2: s_p = 3 and s_m = 300 x RMS(0.1, -0.05) combine in quadrature.
+  const double s_m = 300.0 * std::sqrt((0.01 + 0.0025) / 2.0);
+  EXPECT_NEAR(at(2).half_width, 1.959964 * std::hypot(3.0, s_m), 1e-4);
+  EXPECT_TRUE(at(2).inside);
+  EXPECT_EQ(result.jump_down_coverage.inside, 2);
+  EXPECT_EQ(result.jump_down_coverage.total, 3);
+  EXPECT_EQ(result.upper_branch_coverage.total, 0);
+}
+
+// A missing prediction (the model lacks the fold) has no interval and
+// counts outside.
+TEST(PredictionIntervals, AMissingFoldCountsOutside) {
+  VariantResult result;
+  for (int level = 0; level < 2; ++level) {
+    CrossValidationFold fold;
+    HeldOutPrediction p;
+    p.quantity = HeldOutQuantity::kJumpUp;
+    p.measured = 100.0;
+    p.predicted = level == 0 ? std::numeric_limits<double>::quiet_NaN() : 101.0;
+    fold.predictions.push_back(p);
+    result.folds.push_back(fold);
+  }
+  AddPredictionIntervals(&result);
+  EXPECT_FALSE(result.folds[0].predictions[0].inside);
+  EXPECT_TRUE(std::isnan(result.folds[0].predictions[0].half_width));
+  EXPECT_EQ(result.jump_up_coverage.total, 2);
+  EXPECT_EQ(result.jump_up_coverage.inside, 0);  // level 1: no other level's error, s_m = 0
 }
 
 }  // namespace
