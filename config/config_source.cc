@@ -149,10 +149,11 @@ YAML::Node ListWith(const YAML::Node& list, const YAML::Node& to_add,
   return FlowList(entries);
 }
 
-// A block written as the single word `auto` (`initial_guess: auto`): every
-// key of it auto, the same as a block that gives none.
-bool StandsForEmptyBlock(const YAML::Node& node) {
-  return node.IsScalar() && node.Scalar() == "auto";
+// `initial_guess: auto`, the block written as the single word `auto`: every
+// key of it auto, the same as a block that gives none (the one block of the
+// schema that may be written so).
+bool StandsForEmptyBlock(const std::string& path, const YAML::Node& node) {
+  return path == "initial_guess" && node.IsScalar() && node.Scalar() == "auto";
 }
 
 // The value of `key` in `map`; a null node when the key is absent.
@@ -332,7 +333,7 @@ YAML::Node ConfigSource::WalkToParent(const ConfigOverride& override_value,
     if (child.IsNull()) {
       next.reset(Rebind(&map, segments[i], YAML::Node(YAML::NodeType::Map)));
       set_paths_.push_back(SetPath{walked, index});
-    } else if (StandsForEmptyBlock(child)) {
+    } else if (StandsForEmptyBlock(walked, child)) {
       // `initial_guess: auto` is the block with every key auto: setting one
       // key opens it into a block holding that key (the others stay auto).
       next.reset(Rebind(&map, segments[i], YAML::Node(YAML::NodeType::Map)));
