@@ -3,7 +3,8 @@
 // amplitudes and the stability of their parameters over leave-one-level-out
 // cross-validation (the rule: estimator/studies/model_selection.h), and
 // names the recommended variant. Writes model_selection.csv,
-// model_selection.md and recommended.yaml (the recommended variant's config,
+// model_selection.md, model_selection_levels.csv (every held-out prediction
+// with its 95 % interval) and recommended.yaml (the recommended variant's config,
 // ready for `identify --config`) into <output_dir>/model_selection (all or
 // nothing), and prints the Markdown.
 //
@@ -12,6 +13,8 @@
 // failed): the tables are written all the same, to show why.
 #include <iostream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/common/input_error.h"
@@ -53,11 +56,13 @@ int main(int argc, char** argv) {
     const std::string markdown = dwellfit::ModelSelectionMarkdown(report);
     std::vector<std::pair<std::string, std::string>> files = {
         {"model_selection.csv", dwellfit::ModelSelectionCsv(report)},
-        {"model_selection.md", markdown}};
+        {"model_selection.md", markdown},
+        {"model_selection_levels.csv", dwellfit::ModelSelectionLevelsCsv(report)}};
     const std::string recommended = dwellfit::RecommendedConfigYaml(config, report);
     if (!recommended.empty()) files.push_back({"recommended.yaml", recommended});
     dwellfit::WriteFilesAtomically(directory, files);
-    std::cout << markdown << "\nwrote " << directory << "/model_selection.{csv,md}";
+    std::cout << markdown << "\nwrote " << directory
+              << "/model_selection.{csv,md}, model_selection_levels.csv";
     if (!recommended.empty()) {
       std::cout << " and " << directory << "/recommended.yaml (run it: identify --config "
                 << directory << "/recommended.yaml)";

@@ -85,8 +85,13 @@ inline void QuietLibraryLogging(const char* tool) {
        ++severity) {
     google::SetLogDestination(severity, "");  // an empty name: no log file
   }
-  static ToolLogSink sink(tool);  // lives as long as the program
-  google::AddLogSink(&sink);
+  // Added once, however often this is called; lives as long as the program.
+  static ToolLogSink* const sink = [tool] {
+    auto* added = new ToolLogSink(tool);
+    google::AddLogSink(added);
+    return added;
+  }();
+  (void)sink;
 }
 
 // False, after a message on stderr naming the flag, when argv gives one of

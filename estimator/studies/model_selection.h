@@ -227,6 +227,11 @@ ModelSelectionReport RunModelSelection(const IdentifyConfig& config, int threads
 // per-level cross-validation errors and the recommendation.
 std::string ModelSelectionCsv(const ModelSelectionReport& report);
 std::string ModelSelectionMarkdown(const ModelSelectionReport& report);
+// model_selection_levels.csv: one row per held-out prediction of every
+// variant (level, sweep, quantity, measured, predicted, error in the unit
+// -- Hz, or the data's for amplitudes -- and in %, the 95 % interval's
+// half-width and its two parts, inside); no rows without cross-validation.
+std::string ModelSelectionLevelsCsv(const ModelSelectionReport& report);
 
 // The config of the recommended variant, ready for `identify --config`: the
 // config in effect (ConfigToYaml: absolute paths) with the variant's free and

@@ -199,6 +199,26 @@ std::string ModelSelectionCsv(const ModelSelectionReport& report) {
   return out.str();
 }
 
+std::string ModelSelectionLevelsCsv(const ModelSelectionReport& report) {
+  std::ostringstream out;
+  out << "variant,level,trained_on,sweep,quantity,unit,measured,predicted,error,error_pct,"
+         "half_width_95,parameter_sd,model_sd,inside\n";
+  for (const VariantResult& v : report.variants) {
+    for (const CrossValidationFold& fold : v.folds) {
+      for (const HeldOutPrediction& p : fold.predictions) {
+        const bool amplitude = p.quantity == HeldOutQuantity::kUpperBranchAmplitude;
+        out << "\"" << v.variant.Name() << "\"," << fold.held_out_level << ",\""
+            << Joined(v.fits[fold.fit].fitted_sweeps) << "\"," << p.sweep << ","
+            << HeldOutQuantityName(p.quantity) << "," << (amplitude ? "data" : "Hz")
+            << StringPrintf(",%.10g,%.10g,%.10g,%.6g,%.10g,%.10g,%.10g,%s\n", p.measured,
+                            p.predicted, p.predicted - p.measured, p.ErrorPercent(), p.half_width,
+                            p.parameter_sd, p.model_sd, p.inside ? "true" : "false");
+      }
+    }
+  }
+  return out.str();
+}
+
 std::string ModelSelectionMarkdown(const ModelSelectionReport& report) {
   std::ostringstream out;
   out << "# Model selection\n\nConfig: `" << report.config_path
