@@ -555,7 +555,8 @@ TEST(IdentifyConfigErrors, AFixedParameterWithoutAnInitialGuessIsAnError) {
                                  "fixed: [omega]", "fixed: [omega, delta]"));
   error = LoadError(path);
   ExpectAt(error, path, 12, "fixed");
-  EXPECT_THAT(error.what(), HasSubstr("add initial_guess.delta, or do not fix 'delta'"));
+  EXPECT_THAT(error.what(), HasSubstr("add initial_guess.delta (on the command line: --set "
+                                      "initial_guess.delta=VALUE), or do not fix 'delta'"));
 }
 
 TEST(IdentifyConfigErrors, TenThousandNestedListsSayTheYamlIsNestedTooDeeply) {
