@@ -517,7 +517,9 @@ int Choose(ModelSelectionReport* report, const std::vector<int>& candidates) {
   return chosen;
 }
 
-void Recommend(ModelSelectionReport* report) {
+}  // namespace
+
+void RecommendVariant(ModelSelectionReport* report) {
   std::vector<int> eligible, stable;
   for (int i = 0; i < static_cast<int>(report->variants.size()); ++i) {
     const VariantResult& v = report->variants[i];
@@ -556,8 +558,6 @@ void Recommend(ModelSelectionReport* report) {
       chosen.bic);
   for (const std::string& warning : report->warnings) report->verdict += "; WARNING: " + warning;
 }
-
-}  // namespace
 
 IdentifyConfig WithVariant(const IdentifyConfig& config, const ModelVariant& variant) {
   IdentifyConfig copy = config;
@@ -632,7 +632,7 @@ ModelSelectionReport RunModelSelection(const IdentifyConfig& config, int threads
     report.variants.push_back(
         Assemble(config, variants[v], plan, tasks, static_cast<int>(v) * sets));
   }
-  Recommend(&report);
+  RecommendVariant(&report);
   return report;
 }
 

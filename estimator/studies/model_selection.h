@@ -242,6 +242,12 @@ std::string RecommendedConfigYaml(const IdentifyConfig& config, const ModelSelec
 // The config with `variant` applied (free, or fixed at its value).
 IdentifyConfig WithVariant(const IdentifyConfig& config, const ModelVariant& variant);
 
+// Applies the rule (above) to report->variants (their eligible, unstable,
+// scores, BIC and own fits' mu1): sets recommended, near_best, the
+// tolerances, rule, verdict and warnings. Part of RunModelSelection;
+// exposed for tests.
+void RecommendVariant(ModelSelectionReport* report);
+
 // Fills every fold's predictions' model_sd, half_width and inside, and the
 // variant's coverage (see above). Part of RunModelSelection; exposed for tests.
 void AddPredictionIntervals(VariantResult* result);

@@ -200,6 +200,95 @@ TEST(ModelSelectionBeam, CommittedSelectedConfigRecommendsAVariantRightOnJumpsAn
   EXPECT_THAT(ModelSelectionMarkdown(report), HasSubstr("Rule: candidates:"));
 }
 
+// The rule on made-up scores. Each variant: its jump-down and jump-up
+// median errors [Hz], upper-branch amplitude error [%], BIC, and mu1 of its
+// own fit (the jump tolerance is the median of mu1 / pi over the candidates).
+VariantResult Scored(const std::string& name, double down_hz, double up_hz, double amplitude,
+                     double bic, double mu1 = M_PI) {
+  VariantResult v;
+  v.variant.delta.text = name;
+  v.variant.mu2.text = "0";
+  v.variant.omega.text = "free";
+  v.eligible = true;
+  v.jump_down_hz = down_hz;
+  v.jump_up_hz = up_hz;
+  v.upper_branch_percent = amplitude;
+  v.bic = bic;
+  VariantFit fit;
+  fit.parameters[kMu1] = mu1;  // width mu1 / pi = 1 Hz
+  v.fits.push_back(fit);
+  return v;
+}
+
+TEST(ModelSelectionRule, NearBestOnMostScoresWinsOverBestJumpDownAlone) {
+  // The beam's shape: "zero" best on jump-downs by more than the 1 Hz width,
+  // "free" best on jump-ups and amplitudes.
+  ModelSelectionReport report;
+  report.variants = {Scored("free", 4.0, 2.3, 4.7, -1536.0),
+                     Scored("zero", 2.9, 5.6, 40.1, 6765.0)};
+  RecommendVariant(&report);
+  EXPECT_DOUBLE_EQ(report.jump_tolerance_hz, 1.0);
+  EXPECT_NEAR(report.amplitude_tolerance_percent, 0.25 * 4.7, 1e-12);
+  EXPECT_EQ(report.variants[0].near_best, 2);
+  EXPECT_EQ(report.variants[1].near_best, 1);
+  EXPECT_EQ(report.recommended, 0);
+  EXPECT_TRUE(report.warnings.empty());
+  // Within the width on jump-downs, "free" is near-best on all three.
+  report.variants[0].jump_down_hz = 3.85;
+  report.variants[1].jump_down_hz = 2.9;
+  report.recommended = -1;
+  report.warnings.clear();
+  RecommendVariant(&report);
+  EXPECT_EQ(report.variants[0].near_best, 3);
+}
+
+TEST(ModelSelectionRule, ATieGoesToTheLowerBic) {
+  ModelSelectionReport report;
+  report.variants = {Scored("free", 0.03, 0.03, 0.1, -2500.0),
+                     Scored("zero", 0.02, 0.04, 0.12, -2560.0)};
+  RecommendVariant(&report);
+  EXPECT_EQ(report.variants[0].near_best, 3);
+  EXPECT_EQ(report.variants[1].near_best, 3);  // amplitude tolerance: at least 1 point
+  EXPECT_EQ(report.recommended, 1);
+}
+
+TEST(ModelSelectionRule, MuchWorseAmplitudesAndInstabilityAreSaid) {
+  // "zero" wins both jump scores but is 40 % off on amplitudes: recommended,
+  // with the warning.
+  ModelSelectionReport report;
+  report.variants = {Scored("free", 5.0, 5.0, 4.0, 0.0), Scored("zero", 1.0, 1.0, 40.0, 10.0)};
+  RecommendVariant(&report);
+  ASSERT_EQ(report.recommended, 1);
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_THAT(report.warnings[0], HasSubstr("much worse on amplitudes"));
+  EXPECT_THAT(report.verdict, HasSubstr("WARNING"));
+  // An unstable variant is no candidate while a stable one exists.
+  ModelSelectionReport unstable;
+  unstable.variants = {Scored("free", 5.0, 5.0, 4.0, 0.0), Scored("zero", 1.0, 1.0, 1.0, 10.0)};
+  unstable.variants[1].unstable = true;
+  unstable.variants[1].stability = "w ranges over 104..135 Hz";
+  RecommendVariant(&unstable);
+  EXPECT_EQ(unstable.recommended, 0);
+  EXPECT_EQ(unstable.variants[1].near_best, -1);
+  // All unstable: all are candidates, and the verdict says so.
+  unstable.variants[0].unstable = true;
+  unstable.variants[0].stability = "mu1 ranges over 1..9";
+  unstable.recommended = -1;
+  unstable.warnings.clear();
+  RecommendVariant(&unstable);
+  EXPECT_EQ(unstable.recommended, 1);
+  EXPECT_THAT(unstable.verdict, HasSubstr("unstable"));
+}
+
+TEST(ModelSelectionRule, NothingRecommendedWithoutAConvergedVariant) {
+  ModelSelectionReport report;
+  report.variants = {Scored("free", 1.0, 1.0, 1.0, 0.0)};
+  report.variants[0].eligible = false;
+  RecommendVariant(&report);
+  EXPECT_EQ(report.recommended, -1);
+  EXPECT_THAT(report.verdict, HasSubstr("no variant qualifies"));
+}
+
 // The prediction intervals' rule on made-up folds: s_m is the prediction
 // times the RMS relative error of the same quantity at the other levels,
 // the half-width 1.96 sqrt(s_p^2 + s_m^2).
