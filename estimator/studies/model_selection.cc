@@ -444,15 +444,19 @@ double Best(const ModelSelectionReport& report, const std::vector<int>& candidat
 }
 
 std::string RuleText(const ModelSelectionReport& report) {
+  // Without a candidate there is no fit to take the width from.
+  const std::string width = std::isfinite(report.jump_tolerance_hz)
+                                ? StringPrintf(" = %.3g Hz", report.jump_tolerance_hz)
+                                : std::string(" (no candidate to take it from)");
   return StringPrintf(
       "candidates: the variants whose every fit converged, the stable ones first (w's range "
       "over a variant's fits within %.0f %% of its median, eta_e's, mu1's and alpha_e's within "
       "%.0f %%); on each of the median held-out jump-down error, jump-up error (Hz) and "
       "upper-branch amplitude error (%%), a candidate is near-best within a tolerance of the "
-      "best candidate's score: the resonance's half-power width mu1/pi = %.3g Hz for the jumps, "
+      "best candidate's score: the resonance's half-power width mu1/pi%s for the jumps, "
       "%.2g percentage points (a quarter of the best, at least %.0f) for the amplitudes; the "
       "candidate near-best on the most scores wins, the lowest BIC among those tied",
-      100.0 * kUnstableFrequencyRange, 100.0 * kUnstableScaleRange, report.jump_tolerance_hz,
+      100.0 * kUnstableFrequencyRange, 100.0 * kUnstableScaleRange, width.c_str(),
       report.amplitude_tolerance_percent, kAmplitudeToleranceFloorPercent);
 }
 

@@ -18,6 +18,7 @@ namespace dwellfit {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 // The thesis case with delta = 0 (a Duffing oscillator with quadratic
 // damping), five frequency sweeps at base levels 0.004-0.012, up and down,
@@ -287,6 +288,7 @@ TEST(ModelSelectionRule, NothingRecommendedWithoutAConvergedVariant) {
   RecommendVariant(&report);
   EXPECT_EQ(report.recommended, -1);
   EXPECT_THAT(report.verdict, HasSubstr("no variant qualifies"));
+  EXPECT_THAT(report.rule, Not(HasSubstr("nan Hz")));  // not "mu1/pi = nan Hz"
 }
 
 // The prediction intervals' rule on made-up folds: s_m is the prediction
