@@ -149,6 +149,13 @@ YAML::Node ListWith(const YAML::Node& list, const YAML::Node& to_add,
   return FlowList(entries);
 }
 
+// `initial_guess: auto`, the block written as the single word `auto`: every
+// key of it auto, the same as a block that gives none (the one block of the
+// schema that may be written so).
+bool StandsForEmptyBlock(const std::string& path, const YAML::Node& node) {
+  return path == "initial_guess" && node.IsScalar() && node.Scalar() == "auto";
+}
+
 // The value of `key` in `map`; a null node when the key is absent.
 YAML::Node Get(const YAML::Node& map, const std::string& key) {
   const YAML::Node value = map[key];  // const access adds no key
@@ -326,6 +333,10 @@ YAML::Node ConfigSource::WalkToParent(const ConfigOverride& override_value,
     if (child.IsNull()) {
       next.reset(Rebind(&map, segments[i], YAML::Node(YAML::NodeType::Map)));
       set_paths_.push_back(SetPath{walked, index});
+    } else if (StandsForEmptyBlock(walked, child)) {
+      // `initial_guess: auto` is the block with every key auto: setting one
+      // key opens it into a block holding that key (the others stay auto).
+      next.reset(Rebind(&map, segments[i], YAML::Node(YAML::NodeType::Map)));
     } else if (!child.IsMap()) {
       throw InputError(override_value.origin, 0, override_value.key_path,
                        "'" + walked + "' holds a " + NodeKindName(child) +

@@ -30,7 +30,8 @@ class ConfigSource {
 
   // Applies `overrides` in order to the tree (see ConfigOverride). Throws
   // InputError naming the override's origin when its value is empty or not
-  // YAML, its key path runs through a value that is not a block of keys, or
+  // YAML, its key path runs through a value that is not a block of keys
+  // (`initial_guess: auto` counts as the empty block it stands for), or
   // it changes a key another override changes too (only --fix and --free
   // may both touch one list, with different names). A block on the way to
   // the key is copied before it is written, so a YAML alias of it elsewhere

@@ -259,7 +259,8 @@ std::array<bool, kNumParameters> ReadFixed(const ConfigValue& value, const Confi
                        "parameter '" + name +
                            "' is fixed but has no initial guess, and a fixed parameter is held "
                            "at the value the config gives: add initial_guess." +
-                           key + ", or do not fix '" + name + "'");
+                           key + " (on the command line: --set initial_guess." + key +
+                           "=VALUE), or do not fix '" + name + "'");
     }
     fixed[index] = true;
   }

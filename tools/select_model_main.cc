@@ -1,14 +1,20 @@
 // select_model: compares model variants of a config (its `model_selection:`
-// block, or the defaults) by fitted cost, AIC, BIC and leave-one-level-out
-// cross-validation, and names the recommended variant. Writes
-// model_selection.csv and model_selection.md into <output_dir>/model_selection
-// (all or nothing), and prints the Markdown.
+// block, or the defaults) by their held-out jump frequencies, upper-branch
+// amplitudes and the stability of their parameters over leave-one-level-out
+// cross-validation (the rule: estimator/studies/model_selection.h), and
+// names the recommended variant. Writes model_selection.csv,
+// model_selection.md, model_selection_levels.csv (every held-out prediction
+// with its 95 % interval) and recommended.yaml (the recommended variant's config,
+// ready for `identify --config`) into <output_dir>/model_selection (all or
+// nothing), and prints the Markdown.
 //
 // Exit codes: 0 a variant is recommended; 1 bad input (config, data, flags);
 // 2 no variant qualifies (every variant has a fit that did not converge or
 // failed): the tables are written all the same, to show why.
 #include <iostream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/common/input_error.h"
@@ -29,7 +35,6 @@ DEFINE_string(output_dir, "",
 
 int main(int argc, char** argv) {
   dwellfit::KeepFreedMemoryForReuse();
-  FLAGS_logtostderr = true;
   google::InitGoogleLogging(argv[0]);
   gflags::SetUsageMessage(
       "compares model variants by cost, AIC, BIC and cross-validation.\n"
@@ -49,10 +54,20 @@ int main(int argc, char** argv) {
     const dwellfit::ModelSelectionReport report =
         dwellfit::RunModelSelection(config, FLAGS_threads);
     const std::string markdown = dwellfit::ModelSelectionMarkdown(report);
-    dwellfit::WriteFilesAtomically(directory,
-                                   {{"model_selection.csv", dwellfit::ModelSelectionCsv(report)},
-                                    {"model_selection.md", markdown}});
-    std::cout << markdown << "\nwrote " << directory << "/model_selection.{csv,md}\n";
+    std::vector<std::pair<std::string, std::string>> files = {
+        {"model_selection.csv", dwellfit::ModelSelectionCsv(report)},
+        {"model_selection.md", markdown},
+        {"model_selection_levels.csv", dwellfit::ModelSelectionLevelsCsv(report)}};
+    const std::string recommended = dwellfit::RecommendedConfigYaml(config, report);
+    if (!recommended.empty()) files.push_back({"recommended.yaml", recommended});
+    dwellfit::WriteFilesAtomically(directory, files);
+    std::cout << markdown << "\nwrote " << directory
+              << "/model_selection.{csv,md}, model_selection_levels.csv";
+    if (!recommended.empty()) {
+      std::cout << " and " << directory << "/recommended.yaml (run it: identify --config "
+                << directory << "/recommended.yaml)";
+    }
+    std::cout << "\n";
     if (report.recommended < 0) {
       std::cerr << "select_model: " << report.verdict << "\n";
       return 2;

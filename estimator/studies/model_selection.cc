@@ -10,15 +10,18 @@
 #include <thread>
 #include <utility>
 
+#include "dwellfit/estimator/analysis/parameter_uncertainty.h"
 #include "dwellfit/estimator/analysis/sweep_prediction.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/run/resolved_run.h"
+#include "dwellfit/estimator/studies/model_selection_predictions.h"
 
 namespace dwellfit {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Holds `index` at the choice's value, or frees it.
 void ApplyChoice(const ParameterChoice& choice, ParameterIndex index, IdentifyConfig* config) {
@@ -32,10 +35,7 @@ void ApplyChoice(const ParameterChoice& choice, ParameterIndex index, IdentifyCo
 // sweeps (the study predicts what it needs) and fits on one thread each.
 IdentifyConfig VariantConfig(const IdentifyConfig& config, const ModelVariant& variant,
                              const std::vector<SweepSelection>& fit) {
-  IdentifyConfig copy = config;
-  ApplyChoice(variant.delta, kDelta, &copy);
-  ApplyChoice(variant.mu2, kMu2, &copy);
-  ApplyChoice(variant.omega, kNaturalFrequency, &copy);
+  IdentifyConfig copy = WithVariant(config, variant);
   copy.fit_sweeps = fit;
   copy.validate_sweeps.clear();
   copy.identification.solver.num_threads = 1;
@@ -48,30 +48,24 @@ bool SelectedByAny(const Sweep& sweep, const std::vector<SweepSelection>& select
                      [&](const SweepSelection& s) { return s.Selects(sweep); });
 }
 
-// The errors of one held-out sweep under `parameters`; with no usable fit,
-// every measured jump counts 100 % and the amplitude error is left out.
-PredictionErrors SweepErrors(const Sweep& sweep, const ParameterVector& parameters, bool usable) {
+// One held-out sweep predicted: its predictions (with their parameter
+// uncertainty when `covariance` is given) and errors; with no usable fit,
+// every measured jump and upper branch counts 100 % and the relative RMS
+// is left out.
+struct SweepResult {
   PredictionErrors errors;
-  const bool frequency = sweep.kind == SweepKind::kFrequency;
-  if (!usable) {
-    for (const JumpBracket& jump : sweep.jumps) {
-      if (!frequency) continue;
-      (jump.kind == JumpKind::kJumpDown ? errors.jump_down_percent : errors.jump_up_percent)
-          .push_back(100.0);
-    }
-    return errors;
-  }
-  const SweepPrediction prediction = PredictSweep(parameters, sweep, /*fitted=*/false);
-  errors.relative_rms.push_back(prediction.relative_rms_error);
-  if (!frequency) return errors;
-  for (const PredictedJump& jump : prediction.jumps) {
-    if (!jump.measured) continue;
-    const double measured = jump.bracket.centre();
-    const double error = jump.exists ? 100.0 * std::abs(jump.control - measured) / measured : 100.0;
-    (jump.kind == JumpKind::kJumpDown ? errors.jump_down_percent : errors.jump_up_percent)
-        .push_back(error);
-  }
-  return errors;
+  std::vector<HeldOutPrediction> predictions;
+};
+
+SweepResult PredictHeldOutSweep(const Sweep& sweep, const ParameterVector& parameters, bool usable,
+                                const ParameterMatrix* covariance,
+                                const std::array<bool, kNumParameters>& fixed) {
+  SweepResult result;
+  result.predictions = PredictHeldOut(sweep, parameters, usable, covariance, fixed);
+  const double relative_rms =
+      usable ? PredictSweep(parameters, sweep, /*fitted=*/false).relative_rms_error : kNaN;
+  result.errors = ErrorsOf(result.predictions, relative_rms);
+  return result;
 }
 
 // The cross-validation plan, the same for every variant: training sets
@@ -195,7 +189,7 @@ Plan MakePlan(const IdentifyConfig& config, const ModelSelectionConfig& selectio
 // One fit of the study and its predictions, keyed by sweep name.
 struct TaskResult {
   VariantFit fit;
-  std::map<std::string, PredictionErrors> predicted;
+  std::map<std::string, SweepResult> predicted;
   std::exception_ptr error;  // an InputError of the config's own fit
 };
 
@@ -219,22 +213,39 @@ void DemoteImplausibleFit(IdentificationResult* result) {
       "counted as failed by the study: " + reason + " (solver: " + result->message + ")";
 }
 
+bool Predicts(const Plan& plan, int set, const Sweep& sweep) {
+  const auto& names = plan.predicts[set];
+  return std::find(names.begin(), names.end(), sweep.Name()) != names.end();
+}
+
+// The covariance of a fit's predictions (PredictionCovariance); none when
+// the fit's dwells-alone covariance is not available.
+std::optional<ParameterMatrix> FitCovariance(const ResolvedRun& run,
+                                             const IdentificationResult& result) {
+  if (!result.IsSolutionUsable()) return std::nullopt;
+  const ParameterUncertainty uncertainty = EstimateUncertainty(
+      run.fitted, run.options, result.parameters, 0.0, nullptr, IntervalMethod::kDataOnly);
+  if (!uncertainty.available) return std::nullopt;
+  return PredictionCovariance(uncertainty.covariance, run.fitted, run.options, result.parameters);
+}
+
 TaskResult RunTask(const IdentifyConfig& config, const ModelVariant& variant,
                    const std::vector<Sweep>& sweeps, const Plan& plan, int set) {
   TaskResult task;
   task.fit.fitted_sweeps.clear();
   for (const SweepSelection& s : plan.training[set]) task.fit.fitted_sweeps.push_back(s.Name());
+  const IdentifyConfig variant_config = VariantConfig(config, variant, plan.training[set]);
+  const std::array<bool, kNumParameters>& fixed = variant_config.identification.fixed;
   ResolvedRun run;
   try {
-    run = ResolveRun(VariantConfig(config, variant, plan.training[set]), sweeps);
+    run = ResolveRun(variant_config, sweeps);
   } catch (const InputError& error) {
     if (set == 0) task.error = std::current_exception();
     task.fit.status = FitStatus::kFailure;
     task.fit.message = std::string("could not start: ") + error.what();
     for (const Sweep& sweep : sweeps) {
-      const auto& names = plan.predicts[set];
-      if (std::find(names.begin(), names.end(), sweep.Name()) == names.end()) continue;
-      task.predicted[sweep.Name()] = SweepErrors(sweep, {}, false);
+      if (!Predicts(plan, set, sweep)) continue;
+      task.predicted[sweep.Name()] = PredictHeldOutSweep(sweep, {}, false, nullptr, fixed);
     }
     return task;
   }
@@ -247,10 +258,15 @@ TaskResult RunTask(const IdentifyConfig& config, const ModelVariant& variant,
   task.fit.dwells = result.residual_blocks;
   task.fit.iterations = result.iterations;
   task.fit.parameters = result.parameters;
+  // The intervals are for the cross-validation's held-out levels.
+  const bool held_out_levels = !plan.fold_training.empty();
+  const std::optional<ParameterMatrix> covariance =
+      held_out_levels ? FitCovariance(run, result) : std::nullopt;
   for (const Sweep& sweep : run.sweeps) {
-    const auto& names = plan.predicts[set];
-    if (std::find(names.begin(), names.end(), sweep.Name()) == names.end()) continue;
-    task.predicted[sweep.Name()] = SweepErrors(sweep, result.parameters, result.IsSolutionUsable());
+    if (!Predicts(plan, set, sweep)) continue;
+    task.predicted[sweep.Name()] =
+        PredictHeldOutSweep(sweep, result.parameters, result.IsSolutionUsable(),
+                            covariance ? &*covariance : nullptr, fixed);
   }
   return task;
 }
@@ -290,6 +306,89 @@ void Criteria(VariantResult* result) {
   result->bic = minus_two_log_likelihood + result->free_parameters * std::log(n);
 }
 
+ParameterSpread SpreadOf(const std::string& name, ParameterIndex index,
+                         const std::vector<double>& values) {
+  ParameterSpread spread;
+  spread.name = name;
+  spread.index = index;
+  spread.min = *std::min_element(values.begin(), values.end());
+  spread.max = *std::max_element(values.begin(), values.end());
+  spread.median = MedianOf(values);
+  spread.relative_range = spread.median != 0.0 ? (spread.max - spread.min) / std::abs(spread.median)
+                                               : (spread.max > spread.min ? kInf : 0.0);
+  return spread;
+}
+
+// Every free parameter's spread over the usable fits (w in Hz), alpha_e's
+// when alpha is free.
+std::vector<ParameterSpread> Spreads(const IdentifyConfig& config,
+                                     const std::array<bool, kNumParameters>& fixed,
+                                     const std::vector<const VariantFit*>& usable) {
+  std::vector<ParameterSpread> spreads;
+  std::vector<double> w;
+  for (const VariantFit* fit : usable) w.push_back(fit->parameters[kNaturalFrequency]);
+  const double omega_ref = config.omega_ref_rad_s.value_or(MedianOf(w));
+  for (int j = 0; j < kNumParameters; ++j) {
+    if (fixed[j]) continue;
+    const bool frequency = j == kNaturalFrequency;
+    std::vector<double> values;
+    for (const VariantFit* fit : usable) {
+      values.push_back(frequency ? RadPerSecondToHz(fit->parameters[j]) : fit->parameters[j]);
+    }
+    spreads.push_back(
+        SpreadOf(frequency ? "w [Hz]" : ParameterName(j), static_cast<ParameterIndex>(j), values));
+    if (j != kAlpha) continue;
+    std::vector<double> effective;
+    for (const VariantFit* fit : usable) {
+      const ParameterVector& p = fit->parameters;
+      effective.push_back(p[kAlpha] - 2.0 / 3.0 * p[kDelta] * omega_ref * omega_ref);
+    }
+    spreads.push_back(SpreadOf("alpha_e", kAlpha, effective));
+  }
+  return spreads;
+}
+
+// The spreads of the variant's usable fits, and whether it is unstable
+// (kUnstableFrequencyRange, kUnstableScaleRange).
+void Stability(const IdentifyConfig& config, VariantResult* result) {
+  std::vector<const VariantFit*> usable;
+  for (const VariantFit& fit : result->fits) {
+    if (fit.status == FitStatus::kConverged || fit.status == FitStatus::kNoConvergence) {
+      usable.push_back(&fit);
+    }
+  }
+  if (usable.size() < 2) return;
+  result->spread =
+      Spreads(config, WithVariant(config, result->variant).identification.fixed, usable);
+  for (const ParameterSpread& spread : result->spread) {
+    const bool frequency = spread.index == kNaturalFrequency;
+    const bool scale = spread.name == "eta_e" || spread.name == "mu1" || spread.name == "alpha_e";
+    const double limit = frequency ? kUnstableFrequencyRange : kUnstableScaleRange;
+    if (!(frequency || scale) || !(spread.relative_range > limit)) continue;
+    result->unstable = true;
+    result->stability +=
+        (result->stability.empty() ? "" : "; ") +
+        StringPrintf(
+            "%s ranges over %.4g..%.4g across its %zu fits (%.0f %% of its median, "
+            "above %.0f %%)",
+            spread.name.c_str(), spread.min, spread.max, usable.size(),
+            100.0 * spread.relative_range, 100.0 * limit);
+  }
+}
+
+// The rule's scores: from the cross-validation when it scored a jump-down,
+// else from the validate sweeps.
+void Scores(VariantResult* result) {
+  const PredictionErrors& errors = !result->cross_validation.jump_down_percent.empty()
+                                       ? result->cross_validation
+                                       : result->validation;
+  result->jump_down_hz = MedianOf(errors.jump_down_hz);
+  result->jump_down_percent = MedianOf(errors.jump_down_percent);
+  result->jump_up_hz = MedianOf(errors.jump_up_hz);
+  result->jump_up_percent = MedianOf(errors.jump_up_percent);
+  result->upper_branch_percent = MedianOf(errors.upper_branch_percent);
+}
+
 VariantResult Assemble(const IdentifyConfig& config, const ModelVariant& variant, const Plan& plan,
                        const std::vector<TaskResult>& tasks, int first_task) {
   VariantResult result;
@@ -304,87 +403,173 @@ VariantResult Assemble(const IdentifyConfig& config, const ModelVariant& variant
   result.eligible = result.fits_not_converged == 0 && result.fits_failed == 0;
   Criteria(&result);
   for (const std::string& name : plan.validation) {
-    result.validation.Add(tasks[first_task].predicted.at(name));
+    result.validation.Add(tasks[first_task].predicted.at(name).errors);
   }
   for (std::size_t level = 0; level < plan.fold_training.size(); ++level) {
     CrossValidationFold fold;
     fold.held_out_level = plan.levels[level];
     fold.fit = plan.fold_training[level];
     for (const std::string& name : plan.fold_sweeps[level]) {
-      fold.errors.Add(tasks[first_task + fold.fit].predicted.at(name));
+      const SweepResult& predicted = tasks[first_task + fold.fit].predicted.at(name);
+      fold.errors.Add(predicted.errors);
+      fold.predictions.insert(fold.predictions.end(), predicted.predictions.begin(),
+                              predicted.predictions.end());
     }
     result.cross_validation.Add(fold.errors);
     result.folds.push_back(fold);
   }
+  AddPredictionIntervals(&result);
+  Stability(config, &result);
+  Scores(&result);
   return result;
 }
 
-// What the rule ranks by (lower is better): the median held-out jump-down
-// error of the cross-validation when it scored any jump-down, else of the
-// validate sweeps, else BIC. Which jumps are scored does not depend on the
-// variant (a missing fold counts 100 %), so every variant ranks by the same.
-enum class Ranking { kCrossValidated, kValidation, kBic };
-
-Ranking RankingOf(const ModelSelectionReport& report) {
-  if (report.variants.empty()) return Ranking::kBic;
-  const VariantResult& any = report.variants[0];
-  if (!any.cross_validation.jump_down_percent.empty()) return Ranking::kCrossValidated;
-  if (!any.validation.jump_down_percent.empty()) return Ranking::kValidation;
-  return Ranking::kBic;
+// The resonance's half-power width mu1 / pi Hz (2 mu1 rad/s: the model's
+// damping term is 2 mu1 u'), median over the candidates' own fits.
+double ResonanceWidthHz(const ModelSelectionReport& report, const std::vector<int>& candidates) {
+  std::vector<double> widths;
+  for (int i : candidates) widths.push_back(report.variants[i].fits[0].parameters[kMu1] / M_PI);
+  return MedianOf(widths);
 }
 
-double Score(Ranking ranking, const VariantResult& result) {
-  switch (ranking) {
-    case Ranking::kCrossValidated:
-      return MedianOf(result.cross_validation.jump_down_percent);
-    case Ranking::kValidation:
-      return MedianOf(result.validation.jump_down_percent);
-    case Ranking::kBic:
-      return result.bic;
-  }
-  return kNaN;
-}
-
-void Recommend(ModelSelectionReport* report) {
-  const Ranking ranking = RankingOf(*report);
-  const double tolerance = ranking == Ranking::kBic ? 0.0 : kTieTolerancePercent;
-  report->rule =
-      std::string("among the variants whose every fit converged, the lowest ") +
-      (ranking == Ranking::kCrossValidated
-           ? "median cross-validated (leave-one-level-out) held-out jump-down error"
-       : ranking == Ranking::kValidation
-           ? "median jump-down error over the config's validate sweeps"
-           : "BIC (no held-out jump-down to score)") +
-      (ranking == Ranking::kBic
-           ? std::string()
-           : StringPrintf("; errors within %.2g percentage points tie, and the lowest BIC "
-                          "among them wins",
-                          kTieTolerancePercent));
+// The best (lowest) of `score` over `candidates`; NaN when none is finite.
+template <typename Score>
+double Best(const ModelSelectionReport& report, const std::vector<int>& candidates, Score score) {
   double best = kNaN;
-  for (const VariantResult& v : report->variants) {
-    const double score = Score(ranking, v);
-    if (v.eligible && std::isfinite(score) && !(score >= best)) best = score;
+  for (int i : candidates) {
+    const double value = score(report.variants[i]);
+    if (std::isfinite(value) && !(value >= best)) best = value;
   }
-  for (int i = 0; i < static_cast<int>(report->variants.size()); ++i) {
-    const VariantResult& v = report->variants[i];
-    const double score = Score(ranking, v);
-    if (!v.eligible || !std::isfinite(score) || score > best + tolerance) continue;
-    if (report->recommended < 0 || v.bic < report->variants[report->recommended].bic) {
-      report->recommended = i;
+  return best;
+}
+
+std::string RuleText(const ModelSelectionReport& report) {
+  // Without a candidate there is no fit to take the width from.
+  const std::string width = std::isfinite(report.jump_tolerance_hz)
+                                ? StringPrintf(" = %.3g Hz", report.jump_tolerance_hz)
+                                : std::string(" (no candidate to take it from)");
+  return StringPrintf(
+      "candidates: the variants whose every fit converged, the stable ones first (w's range "
+      "over a variant's fits within %.0f %% of its median, eta_e's, mu1's and alpha_e's within "
+      "%.0f %%); on each of the median held-out jump-down error, jump-up error (Hz) and "
+      "upper-branch amplitude error (%%), a candidate is near-best within a tolerance of the "
+      "best candidate's score: the resonance's half-power width mu1/pi%s for the jumps, "
+      "%.2g percentage points (a quarter of the best, at least %.0f) for the amplitudes; the "
+      "candidate near-best on the most scores wins, the lowest BIC among those tied",
+      100.0 * kUnstableFrequencyRange, 100.0 * kUnstableScaleRange, width.c_str(),
+      report.amplitude_tolerance_percent, kAmplitudeToleranceFloorPercent);
+}
+
+// Step 2 of the rule: how many scores each candidate is near-best on.
+void CountNearBest(ModelSelectionReport* report, const std::vector<int>& candidates) {
+  const double tolerances[3] = {report->jump_tolerance_hz, report->jump_tolerance_hz,
+                                report->amplitude_tolerance_percent};
+  const auto score = [](const VariantResult& v, int s) {
+    return s == 0 ? v.jump_down_hz : s == 1 ? v.jump_up_hz : v.upper_branch_percent;
+  };
+  for (int s = 0; s < 3; ++s) {
+    const double best =
+        Best(*report, candidates, [&](const VariantResult& v) { return score(v, s); });
+    for (int i : candidates) {
+      const double value = score(report->variants[i], s);
+      if (std::isfinite(best) && std::isfinite(value) && value <= best + tolerances[s]) {
+        ++report->variants[i].near_best;
+      }
     }
   }
-  if (report->recommended < 0) {
+}
+
+// What the user must know about the chosen variant: amplitudes much worse
+// than the best candidate's, or unstable.
+void WarnAbout(ModelSelectionReport* report, const std::vector<int>& candidates, bool any_stable) {
+  const VariantResult& chosen = report->variants[report->recommended];
+  const double best_amplitude =
+      Best(*report, candidates, [](const VariantResult& v) { return v.upper_branch_percent; });
+  if (std::isfinite(best_amplitude) &&
+      chosen.upper_branch_percent > kMuchWorseFactor * best_amplitude &&
+      chosen.upper_branch_percent > best_amplitude + report->amplitude_tolerance_percent) {
+    report->warnings.push_back(StringPrintf(
+        "its held-out upper-branch amplitudes are off by a median %.1f %%, against %.1f %% for "
+        "the best variant: much worse on amplitudes",
+        chosen.upper_branch_percent, best_amplitude));
+  }
+  if (chosen.unstable) {
+    report->warnings.push_back("its parameters are unstable across the cross-validation fits: " +
+                               chosen.stability);
+  }
+  if (!any_stable) {
+    report->warnings.push_back(
+        "every variant is unstable across its fits, so the candidates are all of them");
+  }
+}
+
+// Steps 1 and 3 of the rule: the candidates, and the one near-best on the
+// most scores (the lowest BIC among those tied).
+int Choose(ModelSelectionReport* report, const std::vector<int>& candidates) {
+  int chosen = -1;
+  for (int i : candidates) {
+    const VariantResult& v = report->variants[i];
+    if (chosen < 0) {
+      chosen = i;
+      continue;
+    }
+    const VariantResult& so_far = report->variants[chosen];
+    if (v.near_best > so_far.near_best || (v.near_best == so_far.near_best && v.bic < so_far.bic)) {
+      chosen = i;
+    }
+  }
+  return chosen;
+}
+
+}  // namespace
+
+void RecommendVariant(ModelSelectionReport* report) {
+  std::vector<int> eligible, stable;
+  for (int i = 0; i < static_cast<int>(report->variants.size()); ++i) {
+    const VariantResult& v = report->variants[i];
+    if (!v.eligible) continue;
+    eligible.push_back(i);
+    if (!v.unstable) stable.push_back(i);
+  }
+  const std::vector<int>& candidates = stable.empty() ? eligible : stable;
+  for (int i = 0; i < static_cast<int>(report->variants.size()); ++i) {
+    const bool candidate = std::find(candidates.begin(), candidates.end(), i) != candidates.end();
+    report->variants[i].near_best = candidate ? 0 : -1;
+  }
+  report->jump_tolerance_hz = ResonanceWidthHz(*report, candidates);
+  const double best_amplitude =
+      Best(*report, candidates, [](const VariantResult& v) { return v.upper_branch_percent; });
+  report->amplitude_tolerance_percent =
+      std::isfinite(best_amplitude)
+          ? std::max(kAmplitudeToleranceFloorPercent, kAmplitudeToleranceShare * best_amplitude)
+          : kAmplitudeToleranceFloorPercent;
+  report->rule = RuleText(*report);
+  if (candidates.empty()) {
     report->verdict =
         "no variant qualifies: every variant has a fit that did not converge or failed (see "
         "the table); fix the config's fit first";
     return;
   }
+  CountNearBest(report, candidates);
+  report->recommended = Choose(report, candidates);
+  WarnAbout(report, candidates, !stable.empty());
   const VariantResult& chosen = report->variants[report->recommended];
-  report->verdict = StringPrintf("recommended: %s (score %.4g, BIC %.6g)",
-                                 chosen.variant.Name().c_str(), Score(ranking, chosen), chosen.bic);
+  report->verdict = StringPrintf(
+      "recommended: %s (near-best on %d of 3 scores; held-out jump-down %.2f %% (%.3g Hz), "
+      "jump-up %.2f %% (%.3g Hz), upper-branch amplitude %.1f %%; BIC %.6g)",
+      chosen.variant.Name().c_str(), chosen.near_best, chosen.jump_down_percent,
+      chosen.jump_down_hz, chosen.jump_up_percent, chosen.jump_up_hz, chosen.upper_branch_percent,
+      chosen.bic);
+  for (const std::string& warning : report->warnings) report->verdict += "; WARNING: " + warning;
 }
 
-}  // namespace
+IdentifyConfig WithVariant(const IdentifyConfig& config, const ModelVariant& variant) {
+  IdentifyConfig copy = config;
+  ApplyChoice(variant.delta, kDelta, &copy);
+  ApplyChoice(variant.mu2, kMu2, &copy);
+  ApplyChoice(variant.omega, kNaturalFrequency, &copy);
+  return copy;
+}
 
 std::string ModelVariant::Name() const {
   return "delta " + delta.text + ", mu2 " + mu2.text + ", w " +
@@ -417,6 +602,10 @@ void PredictionErrors::Add(const PredictionErrors& other) {
   jump_up_percent.insert(jump_up_percent.end(), other.jump_up_percent.begin(),
                          other.jump_up_percent.end());
   relative_rms.insert(relative_rms.end(), other.relative_rms.begin(), other.relative_rms.end());
+  jump_down_hz.insert(jump_down_hz.end(), other.jump_down_hz.begin(), other.jump_down_hz.end());
+  jump_up_hz.insert(jump_up_hz.end(), other.jump_up_hz.begin(), other.jump_up_hz.end());
+  upper_branch_percent.insert(upper_branch_percent.end(), other.upper_branch_percent.begin(),
+                              other.upper_branch_percent.end());
 }
 
 double MedianOf(std::vector<double> values) {
@@ -447,7 +636,7 @@ ModelSelectionReport RunModelSelection(const IdentifyConfig& config, int threads
     report.variants.push_back(
         Assemble(config, variants[v], plan, tasks, static_cast<int>(v) * sets));
   }
-  Recommend(&report);
+  RecommendVariant(&report);
   return report;
 }
 

@@ -6,6 +6,7 @@
 //     every level predicted by a fit that did not see it.
 // Every fit is the one pipeline of `identify` (ResolveRun, FitRun) on a copy
 // of the config with the variant's fixed parameters and the fold's sweeps.
+// docs/model-selection.md states all of the below with the beam's numbers.
 //
 // Likelihood: the residuals of the last stage (vertical: a_i - a_model, or
 // ln(a_i/a_model) with `residual.error: relative`, over sigma when given)
@@ -18,17 +19,57 @@
 // correlated, so on measured data these criteria overstate the evidence
 // for the larger model; cross-validation does not rely on that assumption.
 //
-// Prediction errors of a held-out frequency sweep: each measured jump's
-// error |f_model - f_measured| / f_measured in percent (f_measured the
-// bracket's centre; a fold the model lacks counts 100 %), jump-downs and
-// jump-ups apart (PredictJumps), and the sweep's relative RMS amplitude error
-// (PredictSweep).
+// Prediction errors of a held-out frequency sweep (PredictJumps,
+// PredictSweep):
+//   - each measured jump: e = |f_model - f_measured| / f_measured in percent
+//     and |f_model - f_measured| in Hz (f_measured the bracket's centre; a
+//     fold the model lacks counts 100 %), jump-downs and jump-ups apart;
+//   - the upper-branch amplitude of an up-sweep with a measured jump-down:
+//     the mean measured amplitude A of its dwells before the jump whose
+//     amplitude exceeds half the sweep's peak, against the mean of the
+//     model's amplitudes on that branch at the same dwells, A_model:
+//     e = 100 (A_model - A) / A (signed; scored as |e|);
+//   - the sweep's relative RMS amplitude error (every dwell).
 //
-// Recommended variant: among the variants whose every fit converged, the
-// lowest median held-out jump-down error (cross-validated; without
-// cross-validation: over the config's validate sweeps; without those: the
-// lowest BIC); errors within kTieTolerancePercent of the lowest tie, and
-// the lowest BIC among the tied wins. None when no variant qualifies.
+// Stability: over the variant's usable fits (its own and every
+// cross-validation fit), each free parameter's relative range
+// (max - min) / |median|, and that of the effective nonlinearity
+// alpha_e = alpha - (2/3) delta Omega_ref^2 (Omega_ref the config's
+// reference, else the fits' median w): with delta free, alpha and delta
+// trade off along a valley and only alpha_e is determined. A variant is
+// unstable when w's range exceeds kUnstableFrequencyRange or eta_e's, mu1's
+// or alpha_e's exceeds kUnstableScaleRange.
+//
+// Recommended variant (the rule, also in ModelSelectionReport::rule):
+//   1. candidates: the variants whose every fit converged; the stable ones
+//      when any is stable (else all, said in the verdict);
+//   2. on each of three scores -- the median held-out jump-down error and
+//      jump-up error (in Hz) and the median held-out upper-branch amplitude
+//      error (in %) -- a candidate is near-best when within the tolerance of
+//      the best candidate's score: for the jumps the resonance's half-power
+//      width mu1/pi Hz (2 mu1 rad/s, median over the candidates' own fits),
+//      for the amplitudes a quarter of the best score and at least one
+//      percentage point;
+//   3. the candidate near-best on the most scores wins; among those tied,
+//      the lowest BIC (so the smaller model wins a tie).
+//   The verdict says when the recommended variant is much worse than the
+//   best on amplitudes (more than twice its error and beyond the tolerance)
+//   or unstable. Scores come from cross-validation when it scored any
+//   jump-down, else from the config's validate sweeps; with neither, the
+//   lowest BIC.
+//
+// 95 % prediction intervals of every held-out level (cross-validation only):
+// for a predicted quantity q (a jump's frequency in Hz, the upper-branch
+// amplitude), q_model +/- 1.96 sqrt(s_p^2 + s_m^2), with
+//   - s_p^2 = g^T C g: the fold's parameter uncertainty by the delta method,
+//     C the dwells-alone covariance of the fold's fit (EstimateUncertainty,
+//     IntervalMethod::kDataOnly), g = dq/dp by central differences;
+//   - s_m = q_model x the RMS of the relative errors (q_model - q) / q of the
+//     same quantity at every other held-out level: the model error the
+//     cross-validation shows, none of it from the level itself (the
+//     training levels' own jump-downs are held in their brackets by the
+//     penalty, so their errors say nothing of the model's).
+// The report counts how often the measured value falls inside.
 //
 // Fits run on `threads` threads, each fit's residuals on one; the report
 // does not depend on the thread count.
@@ -44,8 +85,16 @@
 
 namespace dwellfit {
 
-// Percentage points within which two median errors count as a tie.
-inline constexpr double kTieTolerancePercent = 0.05;
+// Stability thresholds (see above): relative ranges over a variant's fits.
+inline constexpr double kUnstableFrequencyRange = 0.10;
+inline constexpr double kUnstableScaleRange = 1.0;
+// The amplitude score's tolerance: this share of the best score, at least
+// kAmplitudeToleranceFloorPercent points.
+inline constexpr double kAmplitudeToleranceShare = 0.25;
+inline constexpr double kAmplitudeToleranceFloorPercent = 1.0;
+// "Much worse on amplitudes": more than this multiple of the best score (and
+// beyond the tolerance).
+inline constexpr double kMuchWorseFactor = 2.0;
 
 struct ModelVariant {
   ParameterChoice delta, mu2, omega;
@@ -56,11 +105,33 @@ struct ModelVariant {
 // Every combination of the block's choices, delta slowest, omega fastest.
 std::vector<ModelVariant> ModelVariants(const ModelSelectionConfig& selection);
 
+// What a held-out prediction is of.
+enum class HeldOutQuantity { kJumpDown, kJumpUp, kUpperBranchAmplitude };
+const char* HeldOutQuantityName(HeldOutQuantity quantity);  // "jump-down", ...
+
+// One predicted quantity of a held-out sweep, with its 95 % prediction
+// interval (see above).
+struct HeldOutPrediction {
+  std::string sweep;  // its name, "L0.070g/up"
+  HeldOutQuantity quantity = HeldOutQuantity::kJumpDown;
+  double measured = 0.0;      // Hz (the bracket's centre), or the amplitude (data's unit)
+  double predicted = 0.0;     // the same; NaN: no usable fit, or the model lacks the fold
+  double parameter_sd = 0.0;  // s_p, the same unit; 0 when the fit has no covariance
+  double model_sd = 0.0;      // s_m, the same unit
+  double half_width = 0.0;    // 1.96 sqrt(s_p^2 + s_m^2); NaN without a prediction
+  bool inside = false;        // measured within predicted +/- half_width
+  // 100 (predicted - measured) / measured; NaN without a prediction.
+  double ErrorPercent() const;
+};
+
 // Errors of predicted sweeps (see above), pooled over the sweeps scored.
 struct PredictionErrors {
   std::vector<double> jump_down_percent;  // one per measured jump-down
+  std::vector<double> jump_down_hz;       // the same in Hz
   std::vector<double> jump_up_percent;
-  std::vector<double> relative_rms;  // one per sweep
+  std::vector<double> jump_up_hz;
+  std::vector<double> upper_branch_percent;  // |e|, one per up-sweep with a jump-down
+  std::vector<double> relative_rms;          // one per sweep
   void Add(const PredictionErrors& other);
 };
 // Median of `values`; NaN when empty.
@@ -79,9 +150,27 @@ struct VariantFit {
 };
 
 struct CrossValidationFold {
-  std::string held_out_level;  // sweep id
-  int fit = 0;                 // index into VariantResult::fits
-  PredictionErrors errors;     // of the level's pool sweeps
+  std::string held_out_level;                  // sweep id
+  int fit = 0;                                 // index into VariantResult::fits
+  PredictionErrors errors;                     // of the level's pool sweeps
+  std::vector<HeldOutPrediction> predictions;  // of the level's pool sweeps
+};
+
+// How often the held-out measurements of one quantity fall inside their
+// 95 % prediction intervals.
+struct IntervalCoverage {
+  int inside = 0;
+  int total = 0;                   // measured quantities (missing predictions count outside)
+  double median_half_width = 0.0;  // Hz or the amplitude's unit; NaN when none
+  double median_half_width_percent = 0.0;  // of the predicted value
+};
+
+// A free parameter's spread over a variant's usable fits (or alpha_e's).
+struct ParameterSpread {
+  std::string name;  // "eta_e", ..., "w [Hz]" (values in Hz), "alpha_e"
+  ParameterIndex index = kEtaE;
+  double min = 0.0, median = 0.0, max = 0.0;  // physical units (w in rad/s)
+  double relative_range = 0.0;                // (max - min) / |median|; inf when median is 0
 };
 
 struct VariantResult {
@@ -93,10 +182,21 @@ struct VariantResult {
   double aic = 0.0, bic = 0.0;  // of fits[0]; NaN unless its solution is usable
   PredictionErrors validation;  // the config's validate sweeps, from fits[0]
   std::vector<CrossValidationFold> folds;
-  PredictionErrors cross_validation;  // every fold's held-out sweeps
-  int fits_not_converged = 0;         // over `fits`
-  int fits_failed = 0;                // not usable (failed, invalid, or could not start)
-  bool eligible = false;              // every fit converged
+  PredictionErrors cross_validation;    // every fold's held-out sweeps
+  int fits_not_converged = 0;           // over `fits`
+  int fits_failed = 0;                  // not usable (failed, invalid, or could not start)
+  bool eligible = false;                // every fit converged
+  std::vector<ParameterSpread> spread;  // every free parameter, over the usable fits
+  bool unstable = false;                // see kUnstableFrequencyRange
+  std::string stability;                // why unstable, in words; empty when stable
+  // The scores of the rule (NaN when nothing was scored): medians over the
+  // held-out jumps (Hz, and % for the tables) and upper-branch amplitudes.
+  double jump_down_hz = 0.0, jump_down_percent = 0.0;
+  double jump_up_hz = 0.0, jump_up_percent = 0.0;
+  double upper_branch_percent = 0.0;
+  int near_best = 0;  // scores on which it is near-best (rule step 2); -1: not a candidate
+  // The prediction intervals' coverage (cross-validation only).
+  IntervalCoverage jump_down_coverage, jump_up_coverage, upper_branch_coverage;
 };
 
 struct ModelSelectionReport {
@@ -107,6 +207,13 @@ struct ModelSelectionReport {
   int recommended = -1;  // index into variants; -1: none qualifies
   std::string rule;      // the rule applied, in words
   std::string verdict;   // why the recommended variant, or why none
+  // The tolerances the rule used: the resonance's half-power width [Hz] and
+  // the amplitude score's [percentage points].
+  double jump_tolerance_hz = 0.0;
+  double amplitude_tolerance_percent = 0.0;
+  // What the user must know about the recommendation (much worse on
+  // amplitudes, unstable, ...): also in the verdict.
+  std::vector<std::string> warnings;
 };
 
 // Runs the study of config.model_selection (its defaults when unset).
@@ -120,6 +227,30 @@ ModelSelectionReport RunModelSelection(const IdentifyConfig& config, int threads
 // per-level cross-validation errors and the recommendation.
 std::string ModelSelectionCsv(const ModelSelectionReport& report);
 std::string ModelSelectionMarkdown(const ModelSelectionReport& report);
+// model_selection_levels.csv: one row per held-out prediction of every
+// variant (level, sweep, quantity, measured, predicted, error in the unit
+// -- Hz, or the data's for amplitudes -- and in %, the 95 % interval's
+// half-width and its two parts, inside); no rows without cross-validation.
+std::string ModelSelectionLevelsCsv(const ModelSelectionReport& report);
+
+// The config of the recommended variant, ready for `identify --config`: the
+// config in effect (ConfigToYaml: absolute paths) with the variant's free and
+// fixed parameters (a fixed one at its value in initial_guess), under a
+// header saying where it came from. Empty when nothing is recommended.
+std::string RecommendedConfigYaml(const IdentifyConfig& config, const ModelSelectionReport& report);
+
+// The config with `variant` applied (free, or fixed at its value).
+IdentifyConfig WithVariant(const IdentifyConfig& config, const ModelVariant& variant);
+
+// Applies the rule (above) to report->variants (their eligible, unstable,
+// scores, BIC and own fits' mu1): sets recommended, near_best, the
+// tolerances, rule, verdict and warnings. Part of RunModelSelection;
+// exposed for tests.
+void RecommendVariant(ModelSelectionReport* report);
+
+// Fills every fold's predictions' model_sd, half_width and inside, and the
+// variant's coverage (see above). Part of RunModelSelection; exposed for tests.
+void AddPredictionIntervals(VariantResult* result);
 
 }  // namespace dwellfit
 

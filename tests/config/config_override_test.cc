@@ -301,8 +301,8 @@ TEST(ConfigOverrideErrors, ErrorsAboutAnAddedEntryNameTheFlagAndAboutTheFileItsL
   });
   EXPECT_STREQ(error.what(),
                "--fix: field 'fixed': parameter 'delta' is fixed but has no initial guess, and a "
-               "fixed parameter is held at the value the config gives: add initial_guess.delta, "
-               "or do not fix 'delta'");
+               "fixed parameter is held at the value the config gives: add initial_guess.delta "
+               "(on the command line: --set initial_guess.delta=VALUE), or do not fix 'delta'");
 }
 
 TEST(ConfigOverrideErrors, AnEmptyFlagValueSaysSo) {
@@ -352,6 +352,57 @@ TEST(ConfigOverrides, SetOnAnAliasedBlockChangesOnlyTheNamedPath) {
   EXPECT_EQ(error.file(), bad);
   EXPECT_EQ(error.line(), 28);
   EXPECT_THAT(error.what(), HasSubstr("expected true or false, got 'maybe'"));
+}
+
+// `initial_guess: auto` is the block with every key auto: --set of one key
+// gives that key, the others stay auto. Before: "'initial_guess' holds a
+// single value".
+TEST(ConfigOverrides, SetOfOneGuessOnAnAutoInitialGuess) {
+  const ConfigDirectory dir;
+  const std::string text = Replace(kValidConfig, "fixed: [omega]\n", "fixed: []\n");
+  const std::string::size_type begin = text.find("initial_guess:");
+  const std::string::size_type end = text.find("fixed:");
+  ASSERT_NE(begin, std::string::npos);
+  ASSERT_LT(begin, end);
+  const std::string auto_path = dir.WriteFile(
+      "auto.yaml", text.substr(0, begin) + "initial_guess: auto\n" + text.substr(end));
+  const IdentifyConfig config =
+      LoadIdentifyConfig(auto_path, ParseSetFlag("initial_guess.delta=0", "--set"));
+  EXPECT_TRUE(config.initial_guess[kDelta].has_value());
+  EXPECT_EQ(*config.initial_guess[kDelta], 0.0);
+  for (ParameterIndex index : {kEtaE, kMu1, kMu2, kAlpha, kNaturalFrequency}) {
+    EXPECT_FALSE(config.initial_guess[index].has_value()) << ParameterName(index);
+  }
+  // Two keys at once, omega in Hz.
+  const IdentifyConfig two = LoadIdentifyConfig(
+      auto_path, ParseSetFlag("initial_guess.delta=5,initial_guess.omega_hz=41", "--set"));
+  EXPECT_EQ(*two.initial_guess[kDelta], 5.0);
+  EXPECT_DOUBLE_EQ(*two.initial_guess[kNaturalFrequency], HzToRadPerSecond(41.0));
+}
+
+// --fix of a parameter the config leaves to the data takes its value from
+// --set initial_guess.X=V (what select_model's recommendation needs, e.g.
+// `--fix delta,mu2 --set initial_guess.delta=0,initial_guess.mu2=0`).
+TEST(ConfigOverrides, FixTakesItsValueFromSetOnAnAutoInitialGuess) {
+  const ConfigDirectory dir;
+  const std::string text = Replace(kValidConfig, "fixed: [omega]\n", "fixed: []\n");
+  const std::string::size_type begin = text.find("initial_guess:");
+  const std::string::size_type end = text.find("fixed:");
+  const std::string path = dir.WriteFile(
+      "auto.yaml", text.substr(0, begin) + "initial_guess: auto\n" + text.substr(end));
+  std::vector<ConfigOverride> overrides =
+      ParseSetFlag("initial_guess.delta=0,initial_guess.mu2=0", "--set");
+  overrides.push_back(ListFlagOverride("fixed", "delta,mu2", "--fix", OverrideAction::kAddToList));
+  const IdentifyConfig config = LoadIdentifyConfig(path, overrides);
+  EXPECT_THAT(config.identification.fixed, ElementsAre(false, false, true, true, false, false));
+  EXPECT_EQ(config.identification.initial[kDelta], 0.0);
+  EXPECT_EQ(config.identification.initial[kMu2], 0.0);
+  // Without the --set, the error says how to give the value.
+  const InputError error = ErrorOf([&] {
+    LoadIdentifyConfig(path,
+                       {ListFlagOverride("fixed", "delta", "--fix", OverrideAction::kAddToList)});
+  });
+  EXPECT_THAT(error.what(), HasSubstr("--set initial_guess.delta=VALUE"));
 }
 
 TEST(ConfigOverrides, SetOnAnAliasedValueChangesOnlyThatKey) {

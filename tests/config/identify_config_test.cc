@@ -567,12 +567,14 @@ TEST(IdentifyConfigErrors, AFixedParameterWithoutAnInitialGuessIsAnError) {
   EXPECT_THAT(error.what(),
               HasSubstr("parameter 'omega' is fixed but has no initial guess, and a fixed "
                         "parameter is held at the value the config gives: add "
-                        "initial_guess.omega_hz, or do not fix 'omega'"));
+                        "initial_guess.omega_hz (on the command line: --set "
+                        "initial_guess.omega_hz=VALUE), or do not fix 'omega'"));
   path = dir.WriteConfig(Replace(Replace(kValidConfig, "  delta: 1.3e4", "  delta: auto"),
                                  "fixed: [omega]", "fixed: [omega, delta]"));
   error = LoadError(path);
   ExpectAt(error, path, 12, "fixed");
-  EXPECT_THAT(error.what(), HasSubstr("add initial_guess.delta, or do not fix 'delta'"));
+  EXPECT_THAT(error.what(), HasSubstr("add initial_guess.delta (on the command line: --set "
+                                      "initial_guess.delta=VALUE), or do not fix 'delta'"));
 }
 
 TEST(IdentifyConfigErrors, TenThousandNestedListsSayTheYamlIsNestedTooDeeply) {

@@ -2,6 +2,7 @@
 #include "dwellfit/estimator/studies/model_selection.h"
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,7 @@ namespace dwellfit {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 // The thesis case with delta = 0 (a Duffing oscillator with quadratic
 // damping), five frequency sweeps at base levels 0.004-0.012, up and down,
@@ -114,7 +116,7 @@ TEST_F(ModelSelectionTest, TableIsConsistentWithItsFits) {
   }
   const std::string csv = ModelSelectionCsv(report);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3);
-  EXPECT_THAT(csv, HasSubstr(",true,true\n"));  // the recommended row
+  EXPECT_THAT(csv, HasSubstr(",true,true,"));  // the recommended row
 }
 
 // Threads change nothing: the same tables from one thread and from three.
@@ -156,26 +158,193 @@ TEST_F(ModelSelectionTest, PoolSweepNotInTheDataIsAnInputError) {
   }
 }
 
-// The committed beam-selected.yaml: with the validate sweeps as the only
-// held-out data (no cross-validation, to keep the test short), the study
-// recommends delta = 0, whose median jump-down error over the ten validate
-// levels is within the 2 % bar, and better than delta free's.
-TEST(ModelSelectionBeam, CommittedSelectedConfigRecommendsDeltaZeroWithinTwoPercent) {
-  const IdentifyConfig config = LoadIdentifyConfig(
-      std::string(DWELLFIT_SOURCE_DIR) + "/datasets/clamped-beam-27C/beam-selected.yaml",
-      ParseSetFlag("model_selection.cross_validation=none", "--test"));
+// The committed beam-selected.yaml, its full leave-one-level-out study
+// (delta free or 0, mu2 0; 2 x 3 fits from six starts, a few seconds on two
+// threads). delta = 0 predicts the held-out jump-downs best (1.60 %) but
+// the upper branches 40 % low; delta free is within 2.6 % on the
+// jump-downs and 10 % on the amplitudes, and best on the jump-ups: the rule
+// recommends it. Its leave-one-level-out 95 % prediction intervals of the
+// jump-down frequency hold the measured bracket centre at 9 or more of the
+// 12 levels.
+TEST(ModelSelectionBeam, CommittedSelectedConfigRecommendsAVariantRightOnJumpsAndAmplitudes) {
+  const IdentifyConfig config = LoadIdentifyConfig(std::string(DWELLFIT_SOURCE_DIR) +
+                                                   "/datasets/clamped-beam-27C/beam-selected.yaml");
   const ModelSelectionReport report = RunModelSelection(config, 2);
   ASSERT_EQ(report.variants.size(), 2u);
+  ASSERT_GE(report.recommended, 0) << report.verdict;
+  const VariantResult& chosen = report.variants[report.recommended];
+  std::cout << report.verdict << "\n";
+  EXPECT_EQ(chosen.variant.Name(), "delta free, mu2 0, w free");
+  EXPECT_LE(chosen.upper_branch_percent, 10.0);
+  EXPECT_LE(chosen.jump_down_percent, 2.6);
+  ASSERT_EQ(chosen.cross_validation.upper_branch_percent.size(), 12u);  // every level's up-sweep
+  ASSERT_EQ(chosen.cross_validation.jump_down_percent.size(), 12u);
+  // The other variant: better on jump-downs, 40 % off on the upper branches.
+  const VariantResult& zero = report.variants[1 - report.recommended];
+  EXPECT_LT(zero.jump_down_percent, chosen.jump_down_percent);
+  EXPECT_GT(zero.upper_branch_percent, 30.0);
+  // Prediction intervals of every held-out level's jump-down.
+  EXPECT_EQ(chosen.jump_down_coverage.total, 12);
+  EXPECT_GE(chosen.jump_down_coverage.inside, 9);
+  EXPECT_GT(chosen.jump_down_coverage.median_half_width, 0.0);
+  std::cout << "jump-down intervals: " << chosen.jump_down_coverage.inside << " / 12 inside, "
+            << "median half-width " << chosen.jump_down_coverage.median_half_width << " Hz\n";
+  // recommended.yaml loads as a config of that variant.
+  const ConfigDirectory directory;
+  const std::string path =
+      directory.WriteFile("recommended.yaml", RecommendedConfigYaml(config, report));
+  const IdentifyConfig recommended = LoadIdentifyConfig(path);
+  EXPECT_FALSE(recommended.identification.fixed[kDelta]);
+  EXPECT_TRUE(recommended.identification.fixed[kMu2]);
+  EXPECT_EQ(recommended.identification.initial[kMu2], 0.0);
+  EXPECT_EQ(recommended.fit_sweeps.size(), config.fit_sweeps.size());
+  EXPECT_THAT(ModelSelectionMarkdown(report), HasSubstr("Rule: candidates:"));
+}
+
+// The rule on made-up scores. Each variant: its jump-down and jump-up
+// median errors [Hz], upper-branch amplitude error [%], BIC, and mu1 of its
+// own fit (the jump tolerance is the median of mu1 / pi over the candidates).
+VariantResult Scored(const std::string& name, double down_hz, double up_hz, double amplitude,
+                     double bic, double mu1 = M_PI) {
+  VariantResult v;
+  v.variant.delta.text = name;
+  v.variant.mu2.text = "0";
+  v.variant.omega.text = "free";
+  v.eligible = true;
+  v.jump_down_hz = down_hz;
+  v.jump_up_hz = up_hz;
+  v.upper_branch_percent = amplitude;
+  v.bic = bic;
+  VariantFit fit;
+  fit.parameters[kMu1] = mu1;  // width mu1 / pi = 1 Hz
+  v.fits.push_back(fit);
+  return v;
+}
+
+TEST(ModelSelectionRule, NearBestOnMostScoresWinsOverBestJumpDownAlone) {
+  // The beam's shape: "zero" best on jump-downs by more than the 1 Hz width,
+  // "free" best on jump-ups and amplitudes.
+  ModelSelectionReport report;
+  report.variants = {Scored("free", 4.0, 2.3, 4.7, -1536.0),
+                     Scored("zero", 2.9, 5.6, 40.1, 6765.0)};
+  RecommendVariant(&report);
+  EXPECT_DOUBLE_EQ(report.jump_tolerance_hz, 1.0);
+  EXPECT_NEAR(report.amplitude_tolerance_percent, 0.25 * 4.7, 1e-12);
+  EXPECT_EQ(report.variants[0].near_best, 2);
+  EXPECT_EQ(report.variants[1].near_best, 1);
+  EXPECT_EQ(report.recommended, 0);
+  EXPECT_TRUE(report.warnings.empty());
+  // Within the width on jump-downs, "free" is near-best on all three.
+  report.variants[0].jump_down_hz = 3.85;
+  report.variants[1].jump_down_hz = 2.9;
+  report.recommended = -1;
+  report.warnings.clear();
+  RecommendVariant(&report);
+  EXPECT_EQ(report.variants[0].near_best, 3);
+}
+
+TEST(ModelSelectionRule, ATieGoesToTheLowerBic) {
+  ModelSelectionReport report;
+  report.variants = {Scored("free", 0.03, 0.03, 0.1, -2500.0),
+                     Scored("zero", 0.02, 0.04, 0.12, -2560.0)};
+  RecommendVariant(&report);
+  EXPECT_EQ(report.variants[0].near_best, 3);
+  EXPECT_EQ(report.variants[1].near_best, 3);  // amplitude tolerance: at least 1 point
+  EXPECT_EQ(report.recommended, 1);
+}
+
+TEST(ModelSelectionRule, MuchWorseAmplitudesAndInstabilityAreSaid) {
+  // "zero" wins both jump scores but is 40 % off on amplitudes: recommended,
+  // with the warning.
+  ModelSelectionReport report;
+  report.variants = {Scored("free", 5.0, 5.0, 4.0, 0.0), Scored("zero", 1.0, 1.0, 40.0, 10.0)};
+  RecommendVariant(&report);
   ASSERT_EQ(report.recommended, 1);
-  const VariantResult& chosen = report.variants[1];
-  EXPECT_EQ(chosen.variant.Name(), "delta 0, mu2 0, w free");
-  ASSERT_EQ(chosen.validation.jump_down_percent.size(), 10u);
-  const double median = MedianOf(chosen.validation.jump_down_percent);
-  std::cout << "delta 0: validate median jump-down error " << median << " %\n";
-  EXPECT_LE(median, 2.0);
-  EXPECT_LT(median, MedianOf(report.variants[0].validation.jump_down_percent));
-  // Lower cost is not better prediction: delta free fits far better.
-  EXPECT_LT(report.variants[0].fits[0].final_cost, 0.2 * chosen.fits[0].final_cost);
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_THAT(report.warnings[0], HasSubstr("much worse on amplitudes"));
+  EXPECT_THAT(report.verdict, HasSubstr("WARNING"));
+  // An unstable variant is no candidate while a stable one exists.
+  ModelSelectionReport unstable;
+  unstable.variants = {Scored("free", 5.0, 5.0, 4.0, 0.0), Scored("zero", 1.0, 1.0, 1.0, 10.0)};
+  unstable.variants[1].unstable = true;
+  unstable.variants[1].stability = "w ranges over 104..135 Hz";
+  RecommendVariant(&unstable);
+  EXPECT_EQ(unstable.recommended, 0);
+  EXPECT_EQ(unstable.variants[1].near_best, -1);
+  // All unstable: all are candidates, and the verdict says so.
+  unstable.variants[0].unstable = true;
+  unstable.variants[0].stability = "mu1 ranges over 1..9";
+  unstable.recommended = -1;
+  unstable.warnings.clear();
+  RecommendVariant(&unstable);
+  EXPECT_EQ(unstable.recommended, 1);
+  EXPECT_THAT(unstable.verdict, HasSubstr("unstable"));
+}
+
+TEST(ModelSelectionRule, NothingRecommendedWithoutAConvergedVariant) {
+  ModelSelectionReport report;
+  report.variants = {Scored("free", 1.0, 1.0, 1.0, 0.0)};
+  report.variants[0].eligible = false;
+  RecommendVariant(&report);
+  EXPECT_EQ(report.recommended, -1);
+  EXPECT_THAT(report.verdict, HasSubstr("no variant qualifies"));
+  EXPECT_THAT(report.rule, Not(HasSubstr("nan Hz")));  // not "mu1/pi = nan Hz"
+}
+
+// The prediction intervals' rule on made-up folds: s_m is the prediction
+// times the RMS relative error of the same quantity at the other levels,
+// the half-width 1.96 sqrt(s_p^2 + s_m^2).
+TEST(PredictionIntervals, ModelErrorComesFromTheOtherLevels) {
+  VariantResult result;
+  const double measured[3] = {100.0, 200.0, 300.0};
+  const double predicted[3] = {110.0, 190.0, 300.0};  // relative errors +0.1, -0.05, 0
+  for (int level = 0; level < 3; ++level) {
+    CrossValidationFold fold;
+    HeldOutPrediction p;
+    p.sweep = "L" + std::to_string(level) + "/up";
+    p.quantity = HeldOutQuantity::kJumpDown;
+    p.measured = measured[level];
+    p.predicted = predicted[level];
+    p.parameter_sd = level == 2 ? 3.0 : 0.0;
+    fold.predictions.push_back(p);
+    result.folds.push_back(fold);
+  }
+  AddPredictionIntervals(&result);
+  const auto& at = [&](int level) { return result.folds[level].predictions[0]; };
+  // Level 0: others' errors -0.05 and 0: RMS 0.0354; s_m = 110 x 0.0354 = 3.89.
+  EXPECT_NEAR(at(0).model_sd, 110.0 * std::sqrt((0.0025 + 0.0) / 2.0), 1e-9);
+  EXPECT_NEAR(at(0).half_width, 1.959964 * at(0).model_sd, 1e-5);
+  EXPECT_FALSE(at(0).inside);  // 10 off, half-width 7.6
+  // Level 1: others' +0.1 and 0: s_m = 190 x 0.0707 = 13.4; 10 off: inside.
+  EXPECT_NEAR(at(1).model_sd, 190.0 * std::sqrt(0.01 / 2.0), 1e-9);
+  EXPECT_TRUE(at(1).inside);
+  // Level 2: s_p = 3 and s_m = 300 x RMS(0.1, -0.05) combine in quadrature.
+  const double s_m = 300.0 * std::sqrt((0.01 + 0.0025) / 2.0);
+  EXPECT_NEAR(at(2).half_width, 1.959964 * std::hypot(3.0, s_m), 1e-4);
+  EXPECT_TRUE(at(2).inside);
+  EXPECT_EQ(result.jump_down_coverage.inside, 2);
+  EXPECT_EQ(result.jump_down_coverage.total, 3);
+  EXPECT_EQ(result.upper_branch_coverage.total, 0);
+}
+
+// A missing prediction (the model lacks the fold) has no interval and
+// counts outside.
+TEST(PredictionIntervals, AMissingFoldCountsOutside) {
+  VariantResult result;
+  for (int level = 0; level < 2; ++level) {
+    CrossValidationFold fold;
+    HeldOutPrediction p;
+    p.quantity = HeldOutQuantity::kJumpUp;
+    p.measured = 100.0;
+    p.predicted = level == 0 ? std::numeric_limits<double>::quiet_NaN() : 101.0;
+    fold.predictions.push_back(p);
+    result.folds.push_back(fold);
+  }
+  AddPredictionIntervals(&result);
+  EXPECT_FALSE(result.folds[0].predictions[0].inside);
+  EXPECT_TRUE(std::isnan(result.folds[0].predictions[0].half_width));
+  EXPECT_EQ(result.jump_up_coverage.total, 2);
+  EXPECT_EQ(result.jump_up_coverage.inside, 0);  // level 1: no other level's error, s_m = 0
 }
 
 }  // namespace
