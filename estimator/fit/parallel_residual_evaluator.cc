@@ -4,8 +4,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
-#include <chrono>
 #include <cmath>
 #include <thread>
 #include <utility>
@@ -16,17 +14,6 @@
 #include "tbb/parallel_for.h"
 
 namespace dwellfit {
-
-namespace {
-
-// Residuals (dwells) each thread gets at the least (fewer threads below that).
-constexpr int kMinRowsPerThread = 256;
-
-// Whether a threaded evaluation has run in this process (the first starts
-// TBB's worker threads, and its time says nothing about the ways).
-std::atomic<bool> workers_started{false};
-
-}  // namespace
 
 int ResolveThreadCount(int num_threads) {
   if (num_threads > 0) return num_threads;
@@ -267,11 +254,11 @@ class ParallelResidualEvaluator::CompressedCostFunction : public ceres::CostFunc
 };
 
 ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads,
-                                                     int kind)
+                                                     int min_rows_per_thread)
     : blocks_(std::move(blocks)),
       num_threads_(num_threads),
-      arena_(num_threads),
-      choice_(&ThreadChoiceHistory::ForKind(kind)) {
+      min_rows_per_thread_(min_rows_per_thread),
+      arena_(num_threads) {
   CHECK(!blocks_.empty());
   for (const Block& block : blocks_) {
     CHECK(block.values != nullptr);
@@ -280,12 +267,14 @@ ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, 
     size_ += block.size;
   }
   CHECK_GE(num_threads, 1);
+  CHECK_GE(min_rows_per_thread, 1);
   CopyToPoint(BlockValues(), &iterate_);  // sized once: IterateEntry hands out pointers into it
 }
 
 ParallelResidualEvaluator::ParallelResidualEvaluator(const double* parameters, int size,
-                                                     int num_threads, int kind)
-    : ParallelResidualEvaluator(std::vector<Block>{{parameters, size}}, num_threads, kind) {}
+                                                     int num_threads, int min_rows_per_thread)
+    : ParallelResidualEvaluator(std::vector<Block>{{parameters, size}}, num_threads,
+                                min_rows_per_thread) {}
 
 ParallelResidualEvaluator::~ParallelResidualEvaluator() = default;
 
@@ -353,10 +342,8 @@ void ParallelResidualEvaluator::PrecomputeAll() {
   const int chunks = static_cast<int>(chunk_ends_.size());
   const int units = chunks + static_cast<int>(wrappers_.size()) - compressed_;
   // Handing work to a thread costs microseconds: threads only for enough rows.
-  const int threads = std::max(1, std::min({num_threads_, units, rows_ / kMinRowsPerThread}));
-  const bool threaded = threads > 1 && choice_.Next();
-  const auto start = std::chrono::steady_clock::now();
-  if (!threaded) {
+  const int threads = std::max(1, std::min({num_threads_, units, rows_ / min_rows_per_thread_}));
+  if (threads == 1) {
     for (int unit = 0; unit < units; ++unit) PrecomputeUnit(unit, copy);
   } else {
     // Idle workers sleep, and the units are split down to single ones that
@@ -372,21 +359,6 @@ void ParallelResidualEvaluator::PrecomputeAll() {
     });
   }
   if (chunks > 0) CombineChunks();
-  if (threads == 1) return;
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // The process's first threaded evaluation starts TBB's workers: not timed.
-  const bool first_threaded =
-      threaded && !workers_started.exchange(true, std::memory_order_relaxed);
-  // Nor is a point some residual failed at: its rows stop early (on the
-  // beam the algebraic stage's first trial step, 0.02 ms against 0.18).
-  if (!first_threaded && EveryUnitEvaluated()) choice_.Record(threaded, seconds);
-}
-
-bool ParallelResidualEvaluator::EveryUnitEvaluated() const {
-  if (!chunk_ends_.empty() && !compressed_ok_) return false;
-  return std::all_of(wrappers_.begin() + compressed_, wrappers_.end(),
-                     [](const ReplayingCostFunction* wrapper) { return wrapper->ok(); });
 }
 
 void ParallelResidualEvaluator::PrecomputeUnit(int unit, const double* point) {

@@ -8,19 +8,21 @@
 // of one-row blocks) it was also no faster (the measured-beam fit: 0.78 s on
 // two threads, 0.76 s on one). Here Ceres runs on one thread and this class,
 // its EvaluationCallback, evaluates every wrapped cost function at each new
-// point on a TBB arena of `num_threads` threads (the caller's among them):
-// idle workers sleep rather than spin, and the blocks are shared out by work
-// stealing, so a worker the machine is slow to run leaves its share to the
-// others instead of holding the evaluation up. Each block's residual and
-// Jacobian come from the same code whatever the thread count and whichever
-// thread runs it, and Ceres sums them in block order, so the solve does not
-// depend on the number of threads. Below 256 residuals per thread the
-// caller evaluates alone (handing work over costs microseconds), and above
-// it each evaluation runs on the threads or in the caller alone, as trials
-// of the other way, against the evaluations just before them, find faster
-// (ThreadChoice, which wants the threads clearly faster). On a machine whose
-// other cores are busy the evaluations run in the caller alone, as on one
-// thread.
+// point, as Ceres' ParallelFor does, on `num_threads` threads (the caller's
+// among them; Solver::Options::num_threads, 0 meaning one per processor
+// available) or, below a size, inline on the caller. The work is split into
+// units fixed by the wrappers' order whatever the thread count (a chunk of
+// compressed wrappers, or one other wrapper), each unit writes only its own
+// values, and they are combined in unit order: each block's residual and
+// Jacobian come from the same code whichever thread runs it, and Ceres sums
+// them in block order, so the solve does not depend on the number of
+// threads. The units go to the threads one at a time by TBB's work stealing
+// in an arena of the evaluator's own (idle workers sleep rather than spin):
+// a thread the machine is slow to run, with another program on its core,
+// holds up at most the unit it is in while the others take the rest. Fewer
+// than 2 * kMinRowsPerThread residuals, or fewer than two units, run inline
+// (handing work over costs microseconds; kMinRowsPerThread says what was
+// measured). No timing, no state outside the evaluator.
 //
 // Compress() stands the wrappers made so far (a stage's dwells) in for one
 // residual block of a few rows: with the wrappers' rows stacked as
@@ -64,7 +66,6 @@
 #include "Eigen/Core"
 #include "ceres/cost_function.h"
 #include "ceres/evaluation_callback.h"
-#include "dwellfit/estimator/fit/thread_choice.h"
 #include "tbb/task_arena.h"
 
 namespace dwellfit {
@@ -81,13 +82,23 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
     int size = 0;
   };
 
+  // Residuals per thread at the least: an evaluation of fewer than twice
+  // this many runs inline on the caller. Measured on two cores with
+  // BM_CompressedDwellEvaluation (identification_benchmark; the measured
+  // beam's vertical residuals, compressed, one evaluation with Jacobians per
+  // point, min_rows_per_thread 1; ms on 1 / 2 threads): MEASURE
+  // Two chunks of kCompressedChunkRows are the least work that splits, and
+  // already gain.
+  static constexpr int kMinRowsPerThread = 256;
+
   // `blocks`: every parameter block a wrapped cost function reads, distinct.
-  // `num_threads` >= 1. `kind` (0 <= kind < ThreadChoiceHistory::kKinds):
-  // evaluators whose evaluations cost alike (the dwells' residual kind) go
-  // on from what the last of them found about the threads (ThreadChoice).
-  ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads, int kind = 0);
+  // `num_threads` >= 1 (ResolveThreadCount). `min_rows_per_thread` >= 1:
+  // kMinRowsPerThread but where a benchmark measures the threads on less.
+  ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads,
+                            int min_rows_per_thread = kMinRowsPerThread);
   // One block of `size` doubles that every wrapped cost function reads.
-  ParallelResidualEvaluator(const double* parameters, int size, int num_threads, int kind = 0);
+  ParallelResidualEvaluator(const double* parameters, int size, int num_threads,
+                            int min_rows_per_thread = kMinRowsPerThread);
   ~ParallelResidualEvaluator() override;
 
   // Takes ownership of `cost_function`, whose parameter blocks are
@@ -152,8 +163,6 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   void FactorChunk(int chunk);
   // The chunks' R, stacked, into compressed_r_.
   void CombineChunks();
-  // Whether every wrapper's values came out at last_point_.
-  bool EveryUnitEvaluated() const;
   // CompressedCostFunction::Evaluate.
   bool EvaluateCompressed(double const* const* parameters, double* residuals, double** jacobians);
   // Whether the watched blocks' values, block b's at values(b) (the blocks'
@@ -172,6 +181,7 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   std::vector<int> offsets_;  // of each block in a point
   int size_ = 0;              // of a point
   const int num_threads_;
+  const int min_rows_per_thread_;
   tbb::task_arena arena_;  // at most num_threads_ threads, the caller's included
   std::vector<ReplayingCostFunction*> wrappers_;  // owned by the problem
   int rows_ = 0;                                  // residuals over the wrappers
@@ -195,8 +205,6 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   std::vector<char> chunk_ok_;
   Eigen::MatrixXd compressed_r_;
   bool compressed_ok_ = false;
-  // PrecomputeAll on the threads or in the caller alone.
-  ThreadChoice choice_;
 };
 
 }  // namespace dwellfit
