@@ -16,11 +16,12 @@
 // values, and they are combined in unit order: each block's residual and
 // Jacobian come from the same code whichever thread runs it, and Ceres sums
 // them in block order, so the solve does not depend on the number of
-// threads. The units go to the threads one at a time by TBB's work stealing
-// in an arena of the evaluator's own: a thread the machine is slow to run,
-// with another program on its core, holds up at most the unit it is in
-// while the others take the rest (but for as long as the scheduler keeps
-// it off the core: docs/performance.md has the figures). Fewer
+// threads. The units go one at a time to whichever thread asks next, the
+// caller among them, so a thread the machine is slow to run leaves the
+// rest to the others. The other threads are the evaluator's own
+// (num_threads - 1, started with its first threaded evaluation, joined
+// with it), and sleep as soon as their units are done (Workers, in the .cc,
+// says why not TBB's). Fewer
 // than 2 * kMinRowsPerThread residuals, or fewer than two units, run inline
 // (handing work over costs microseconds; kMinRowsPerThread says what was
 // measured). No timing, no state outside the evaluator.
@@ -67,7 +68,6 @@
 #include "Eigen/Core"
 #include "ceres/cost_function.h"
 #include "ceres/evaluation_callback.h"
-#include "tbb/task_arena.h"
 
 namespace dwellfit {
 
@@ -151,6 +151,7 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
  private:
   class ReplayingCostFunction;
   class CompressedCostFunction;
+  class Workers;
 
   // Rows of the compressed wrappers' chunks, at the least (the last may
   // have fewer).
@@ -185,7 +186,9 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   int size_ = 0;              // of a point
   const int num_threads_;
   const int min_rows_per_thread_;
-  tbb::task_arena arena_;  // at most num_threads_ threads, the caller's included
+  // num_threads_ - 1 threads beside the caller's, started with the first
+  // evaluation that runs threaded.
+  std::unique_ptr<Workers> workers_;
   std::vector<ReplayingCostFunction*> wrappers_;  // owned by the problem
   int rows_ = 0;                                  // residuals over the wrappers
   // Every wrapper's values at last_point_, contiguous per wrapper, in order
