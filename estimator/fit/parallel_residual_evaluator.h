@@ -21,10 +21,10 @@
 // rest to the others. The other threads are the evaluator's own
 // (num_threads - 1, started with its first threaded evaluation, joined
 // with it), and sleep as soon as their units are done (Workers, in the .cc,
-// says why not TBB's). Fewer
-// than 2 * kMinRowsPerThread residuals, or fewer than two units, run inline
-// (handing work over costs microseconds; kMinRowsPerThread says what was
-// measured). No timing, no state outside the evaluator.
+// says why not TBB's). Fewer than 2 * kMinRowsPerThread residuals, or fewer
+// than two units, run inline (waking a thread costs tens of microseconds;
+// kMinRowsPerThread says what was measured). No timing, no state outside
+// the evaluator.
 //
 // Compress() stands the wrappers made so far (a stage's dwells) in for one
 // residual block of a few rows: with the wrappers' rows stacked as
@@ -87,12 +87,12 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   // this many runs inline on the caller. Measured on two cores with
   // BM_CompressedDwellEvaluation (identification_benchmark; the measured
   // beam's vertical residuals, compressed, one evaluation with Jacobians per
-  // point, min_rows_per_thread 1; us on 1 / 2 threads, medians of five):
-  // 512 dwells 105 / 81, 1024 dwells 252 / 171, 2048 dwells 421 / 341,
-  // 4096 dwells 847 / 548.
-  // Two chunks of kCompressedChunkRows are the least work that splits, and
-  // already gain.
-  static constexpr int kMinRowsPerThread = 256;
+  // point, min_rows_per_thread 1; us on 1 / 2 threads, medians of five, two
+  // runs): 512 dwells 99 / 92-97, 1024 dwells 244-260 / 174-193, 2048
+  // dwells 417-420 / 328-345, 4096 dwells 839-864 / 643-667. Two chunks of
+  // kCompressedChunkRows break even (waking a thread costs some 50-100 us on
+  // that machine); four gain 1.35x.
+  static constexpr int kMinRowsPerThread = 512;
 
   // `blocks`: every parameter block a wrapped cost function reads, distinct.
   // `num_threads` >= 1 (ResolveThreadCount). `min_rows_per_thread` >= 1:

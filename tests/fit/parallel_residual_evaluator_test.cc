@@ -188,7 +188,8 @@ class SqrtCost : public ceres::SizedCostFunction<1, 1> {
 };
 
 // The threads the other tests rely on are really used: one thread (the
-// caller's) when asked for one or below 256 residuals per thread, two when
+// caller's) when asked for one or below kMinRowsPerThread residuals per
+// thread, two when
 // asked for two with enough residuals, or with fewer where the evaluator is
 // told a lower threshold.
 TEST(ParallelResidualEvaluator, PrecomputesOnTheRequestedThreads) {
