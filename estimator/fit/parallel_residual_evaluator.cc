@@ -39,7 +39,7 @@ int ResolveThreadCount(int num_threads) {
 // (TBB's workers look for work for a while before they sleep; on two cores
 // with one kept busy by another process, that program then preempted them
 // in the middle of a unit, and the caller waited milliseconds for it: the
-// beam fit took 16-29 % longer than on one thread, 1-18 % shorter with
+// beam fit took 16-29 % longer than on one thread, 1-33 % shorter with
 // these threads; docs/performance.md.) A thread that wakes late finds the
 // units taken and sleeps again; it never touches an evaluation that has
 // ended.
