@@ -24,6 +24,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/fit/identification.h"
 #include "dwellfit/estimator/fit/mapped_cost_function.h"
+#include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
 #include "dwellfit/estimator/fit/problem_builder.h"
 #include "dwellfit/estimator/fit/staged_solve.h"
 #include "dwellfit/estimator/run/identify_run.h"
@@ -128,6 +129,49 @@ void BM_MappedVerticalResidualWithJacobianPerPoint(benchmark::State& state) {
 }
 BENCHMARK(BM_MappedVerticalResidualWithJacobianPerPoint)->Unit(benchmark::kMicrosecond);
 
+// One evaluation with Jacobians of the first state.range(0) fitted dwells
+// of the measured beam (the vertical residual, one wrapper per dwell,
+// compressed as the fit compresses them), alternating between the start and
+// a point 0.1 % away, on state.range(1) threads with the evaluator's
+// threshold lowered to one residual per thread: what
+// ParallelResidualEvaluator::kMinRowsPerThread is measured with (below two
+// chunks of ParallelResidualEvaluator's 256 rows nothing splits).
+void BM_CompressedDwellEvaluation(benchmark::State& state) {
+  const ResolvedRun& beam = ClampedBeam();
+  const size_t dwells = static_cast<size_t>(state.range(0));
+  const ParameterVector start = beam.options.initial;
+  ParameterVector moved = start;
+  for (double& value : moved) value *= 1.001;
+  ParameterVector point = start;
+  ProblemBuilder builder(ProblemBuilderOptions{});
+  ParallelResidualEvaluator evaluator(point.data(), kNumParameters,
+                                      static_cast<int>(state.range(1)), 1);
+  std::vector<std::unique_ptr<ceres::CostFunction>> wrappers;
+  for (const Sweep* sweep : beam.fitted) {
+    for (const DwellPoint& dwell : sweep->points) {
+      if (wrappers.size() < dwells)
+        wrappers.emplace_back(evaluator.Wrap(builder.MakeResidual(dwell)));
+    }
+  }
+  if (wrappers.size() < dwells) {
+    state.SkipWithError("the beam has fewer fitted dwells");
+    return;
+  }
+  const std::unique_ptr<ceres::CostFunction> compressed(evaluator.Compress());
+  bool moved_now = false;
+  for (auto _ : state) {
+    point = moved_now ? moved : start;
+    moved_now = !moved_now;
+    evaluator.PrepareForEvaluation(true, true);
+  }
+  state.counters["dwells"] = static_cast<double>(dwells);
+}
+BENCHMARK(BM_CompressedDwellEvaluation)
+    ->ArgNames({"dwells", "threads"})
+    ->ArgsProduct({{512, 1024, 2048, 4096}, {1, 2}})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+
 // The whole default fit (algebraic stage, then vertical) from the config's start.
 void BM_ThesisNumericalWholeFit(benchmark::State& state) { RunConfiguredFit(state, Thesis()); }
 BENCHMARK(BM_ThesisNumericalWholeFit)
@@ -153,7 +197,10 @@ BENCHMARK(BM_ClampedBeamFit)
 
 // The same on a busy machine: `busy` other processes spin for the whole run,
 // each keeping one core occupied, as other jobs do on a shared machine. The
-// default (threads:0) must not be slower than one thread here either.
+// bar (docs/performance.md): idle, threads:0 at least 1.5x faster than
+// threads:1 on two cores; one core busy, at most 10 % slower. One run
+// measures both: --benchmark_filter='ClampedBeamFit' with
+// --benchmark_enable_random_interleaving=true.
 void BM_ClampedBeamFitBusy(benchmark::State& state) {
   std::vector<pid_t> load;
   for (int64_t i = 0; i < state.range(1); ++i) {

@@ -11,7 +11,6 @@
 #include "Eigen/SVD"
 #include "boost/math/distributions/normal.hpp"
 #include "boost/math/distributions/students_t.hpp"
-#include "ceres/context.h"
 #include "ceres/covariance.h"
 #include "ceres/normal_prior.h"
 #include "dwellfit/estimator/common/string_printf.h"
@@ -187,17 +186,6 @@ bool CheckCollinearity(const FitDescription& fit, const Eigen::MatrixXd& r_norma
   return false;
 }
 
-// The context of every covariance's problem. Ceres' covariance makes sure
-// its problem's context holds a pool of options.num_threads (here one)
-// threads before it computes the one block inline; on each problem's own
-// context that was a thread started and joined per covariance, with a malloc
-// arena of its own (two per run on the beam). Shared, the pool's one thread
-// is started once per process. Ceres' thread pool locks its own resizing.
-ceres::Context* CovarianceContext() {
-  static ceres::Context* const context = ceres::Context::Create();
-  return context;
-}
-
 // (J^T J)^-1 by ceres::Covariance, in physical units, into c->covariance
 // (times `factor`). Its problem holds a copy x of every described entry
 // (ambient order), stepping in the normalised units (ScaledSubsetManifold:
@@ -222,9 +210,9 @@ bool ComputeCovariance(const FitDescription& fit, double factor,
   }
   std::vector<double> x = c->values;
   const ceres::Vector x0 = Eigen::Map<const ceres::Vector>(c->values.data(), n);
-  ceres::Problem::Options problem_options;
-  problem_options.context = CovarianceContext();
-  ceres::Problem problem(problem_options);
+  // The problem's own context: Ceres' covariance starts its one thread
+  // there (options.num_threads), joined with the problem.
+  ceres::Problem problem;
   problem.AddParameterBlock(x.data(), n, new ScaledSubsetManifold(unit, fixed));
   problem.AddResidualBlock(new ceres::NormalPrior(m, x0), nullptr, x.data());
 

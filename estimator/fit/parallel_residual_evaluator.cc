@@ -5,28 +5,18 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
-#include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <mutex>
 #include <thread>
 #include <utility>
 
 #include "Eigen/QR"
 #include "glog/logging.h"
-#include "tbb/blocked_range.h"
-#include "tbb/parallel_for.h"
 
 namespace dwellfit {
-
-namespace {
-
-// Residuals (dwells) each thread gets at the least (fewer threads below that).
-constexpr int kMinRowsPerThread = 256;
-
-// Whether a threaded evaluation has run in this process (the first starts
-// TBB's worker threads, and its time says nothing about the ways).
-std::atomic<bool> workers_started{false};
-
-}  // namespace
 
 int ResolveThreadCount(int num_threads) {
   if (num_threads > 0) return num_threads;
@@ -39,6 +29,102 @@ int ResolveThreadCount(int num_threads) {
   if (sched_getaffinity(0, sizeof(allowed), &allowed) == 0) return std::max(1, CPU_COUNT(&allowed));
   return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 }
+
+// The threads beside the caller's that run an evaluation's units with it:
+// each unit goes to whichever thread asks next (an atomic counter), and the
+// caller returns once every unit has run. A thread without work sleeps on a
+// condition variable at once, without spinning: woken for the next
+// evaluation, it gets the processor back at once from a program that shares
+// its core, and runs its units before that program's turn comes again.
+// (TBB's workers look for work for a while before they sleep; on two cores
+// with one kept busy by another process, that program then preempted them
+// in the middle of a unit, and the caller waited milliseconds for it: the
+// beam fit took 16-29 % longer than on one thread, 1-33 % shorter with
+// these threads; docs/performance.md.) A thread that wakes late finds the
+// units taken and sleeps again; it never touches an evaluation that has
+// ended.
+class ParallelResidualEvaluator::Workers {
+ public:
+  explicit Workers(int threads) {
+    for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { Serve(); });
+  }
+  ~Workers() {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    for (std::thread& thread : threads_) thread.join();
+  }
+
+  // run(unit) for every unit in [0, units), each once, on the caller and
+  // the threads; returns when every unit has run.
+  void Run(int units, const std::function<void(int)>& run) {
+    auto batch = std::make_shared<Batch>();
+    batch->units = units;
+    batch->run = &run;
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      batch_ = batch;
+      ++generation_;
+    }
+    wake_.notify_all();
+    Work(batch.get());
+    // The units still running on the threads: waited for on the processor
+    // (an idle machine's thread ends its unit within some 50 us), then,
+    // after about a millisecond, asleep.
+    int spins = 0;
+    while (batch->done.load() < units && ++spins < kCallerSpins) {
+    }
+    std::unique_lock<std::mutex> lock(batch->mutex);
+    batch->finished.wait(lock, [&] { return batch->done.load() == units; });
+  }
+
+ private:
+  // One evaluation's units: the next to hand out, and those that have run.
+  struct Batch {
+    std::atomic<int> next{0};
+    std::atomic<int> done{0};
+    int units = 0;
+    const std::function<void(int)>* run = nullptr;  // called only while units remain
+    std::mutex mutex;
+    std::condition_variable finished;
+  };
+
+  static void Work(Batch* batch) {
+    for (int unit = batch->next++; unit < batch->units; unit = batch->next++) {
+      (*batch->run)(unit);
+      if (++batch->done == batch->units) {
+        const std::lock_guard<std::mutex> lock(batch->mutex);
+        batch->finished.notify_all();
+      }
+    }
+  }
+
+  void Serve() {
+    std::uint64_t seen = 0;
+    for (;;) {
+      std::shared_ptr<Batch> batch;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
+        if (stop_) return;
+        seen = generation_;
+        batch = batch_;
+      }
+      Work(batch.get());
+    }
+  }
+
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::shared_ptr<Batch> batch_;  // the last evaluation's
+  std::uint64_t generation_ = 0;  // evaluations handed out
+  bool stop_ = false;
+  // Checks of the units done before the caller sleeps.
+  static constexpr int kCallerSpins = 1000000;
+  std::vector<std::thread> threads_;
+};
 
 // Owns one wrapped cost function. The values it had at the last point the
 // evaluator saw live in the evaluator's storage_, contiguous per wrapper and
@@ -267,11 +353,11 @@ class ParallelResidualEvaluator::CompressedCostFunction : public ceres::CostFunc
 };
 
 ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads,
-                                                     int kind)
+                                                     int min_rows_per_thread)
     : blocks_(std::move(blocks)),
       num_threads_(num_threads),
-      arena_(num_threads),
-      choice_(&ThreadChoiceHistory::ForKind(kind)) {
+      min_rows_per_thread_(min_rows_per_thread),
+      workers_(nullptr) {
   CHECK(!blocks_.empty());
   for (const Block& block : blocks_) {
     CHECK(block.values != nullptr);
@@ -280,12 +366,14 @@ ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, 
     size_ += block.size;
   }
   CHECK_GE(num_threads, 1);
+  CHECK_GE(min_rows_per_thread, 1);
   CopyToPoint(BlockValues(), &iterate_);  // sized once: IterateEntry hands out pointers into it
 }
 
 ParallelResidualEvaluator::ParallelResidualEvaluator(const double* parameters, int size,
-                                                     int num_threads, int kind)
-    : ParallelResidualEvaluator(std::vector<Block>{{parameters, size}}, num_threads, kind) {}
+                                                     int num_threads, int min_rows_per_thread)
+    : ParallelResidualEvaluator(std::vector<Block>{{parameters, size}}, num_threads,
+                                min_rows_per_thread) {}
 
 ParallelResidualEvaluator::~ParallelResidualEvaluator() = default;
 
@@ -353,40 +441,17 @@ void ParallelResidualEvaluator::PrecomputeAll() {
   const int chunks = static_cast<int>(chunk_ends_.size());
   const int units = chunks + static_cast<int>(wrappers_.size()) - compressed_;
   // Handing work to a thread costs microseconds: threads only for enough rows.
-  const int threads = std::max(1, std::min({num_threads_, units, rows_ / kMinRowsPerThread}));
-  const bool threaded = threads > 1 && choice_.Next();
-  const auto start = std::chrono::steady_clock::now();
-  if (!threaded) {
+  const int threads = std::max(1, std::min({num_threads_, units, rows_ / min_rows_per_thread_}));
+  if (threads == 1) {
     for (int unit = 0; unit < units; ++unit) PrecomputeUnit(unit, copy);
   } else {
     // Idle workers sleep, and the units are split down to single ones that
     // an idle thread steals: a worker the machine is slow to run holds up
     // at most the unit it is in.
-    arena_.execute([&] {
-      tbb::parallel_for(
-          tbb::blocked_range<int>(0, units, 1),
-          [&](const tbb::blocked_range<int>& range) {
-            for (int unit = range.begin(); unit < range.end(); ++unit) PrecomputeUnit(unit, copy);
-          },
-          tbb::simple_partitioner());
-    });
+    if (workers_ == nullptr) workers_ = std::make_unique<Workers>(num_threads_ - 1);
+    workers_->Run(units, [this, copy](int unit) { PrecomputeUnit(unit, copy); });
   }
   if (chunks > 0) CombineChunks();
-  if (threads == 1) return;
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // The process's first threaded evaluation starts TBB's workers: not timed.
-  const bool first_threaded =
-      threaded && !workers_started.exchange(true, std::memory_order_relaxed);
-  // Nor is a point some residual failed at: its rows stop early (on the
-  // beam the algebraic stage's first trial step, 0.02 ms against 0.18).
-  if (!first_threaded && EveryUnitEvaluated()) choice_.Record(threaded, seconds);
-}
-
-bool ParallelResidualEvaluator::EveryUnitEvaluated() const {
-  if (!chunk_ends_.empty() && !compressed_ok_) return false;
-  return std::all_of(wrappers_.begin() + compressed_, wrappers_.end(),
-                     [](const ReplayingCostFunction* wrapper) { return wrapper->ok(); });
 }
 
 void ParallelResidualEvaluator::PrecomputeUnit(int unit, const double* point) {

@@ -8,19 +8,23 @@
 // of one-row blocks) it was also no faster (the measured-beam fit: 0.78 s on
 // two threads, 0.76 s on one). Here Ceres runs on one thread and this class,
 // its EvaluationCallback, evaluates every wrapped cost function at each new
-// point on a TBB arena of `num_threads` threads (the caller's among them):
-// idle workers sleep rather than spin, and the blocks are shared out by work
-// stealing, so a worker the machine is slow to run leaves its share to the
-// others instead of holding the evaluation up. Each block's residual and
-// Jacobian come from the same code whatever the thread count and whichever
-// thread runs it, and Ceres sums them in block order, so the solve does not
-// depend on the number of threads. Below 256 residuals per thread the
-// caller evaluates alone (handing work over costs microseconds), and above
-// it each evaluation runs on the threads or in the caller alone, as trials
-// of the other way, against the evaluations just before them, find faster
-// (ThreadChoice, which wants the threads clearly faster). On a machine whose
-// other cores are busy the evaluations run in the caller alone, as on one
-// thread.
+// point, as Ceres' ParallelFor does, on `num_threads` threads (the caller's
+// among them; Solver::Options::num_threads, 0 meaning one per processor
+// available) or, below a size, inline on the caller. The work is split into
+// units fixed by the wrappers' order whatever the thread count (a chunk of
+// compressed wrappers, or one other wrapper), each unit writes only its own
+// values, and they are combined in unit order: each block's residual and
+// Jacobian come from the same code whichever thread runs it, and Ceres sums
+// them in block order, so the solve does not depend on the number of
+// threads. The units go one at a time to whichever thread asks next, the
+// caller among them, so a thread the machine is slow to run leaves the
+// rest to the others. The other threads are the evaluator's own
+// (num_threads - 1, started with its first threaded evaluation, joined
+// with it), and sleep as soon as their units are done (Workers, in the .cc,
+// says why not TBB's). Fewer than 2 * kMinRowsPerThread residuals, or fewer
+// than two units, run inline (waking a thread costs tens of microseconds;
+// kMinRowsPerThread says what was measured). No timing, no state outside
+// the evaluator.
 //
 // Compress() stands the wrappers made so far (a stage's dwells) in for one
 // residual block of a few rows: with the wrappers' rows stacked as
@@ -64,8 +68,6 @@
 #include "Eigen/Core"
 #include "ceres/cost_function.h"
 #include "ceres/evaluation_callback.h"
-#include "dwellfit/estimator/fit/thread_choice.h"
-#include "tbb/task_arena.h"
 
 namespace dwellfit {
 
@@ -81,13 +83,25 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
     int size = 0;
   };
 
+  // Residuals per thread at the least: an evaluation of fewer than twice
+  // this many runs inline on the caller. Measured on two cores with
+  // BM_CompressedDwellEvaluation (identification_benchmark; the measured
+  // beam's vertical residuals, compressed, one evaluation with Jacobians per
+  // point, min_rows_per_thread 1; us on 1 / 2 threads, medians of five, two
+  // runs): 512 dwells 99 / 92-97, 1024 dwells 244-260 / 174-193, 2048
+  // dwells 417-420 / 328-345, 4096 dwells 839-864 / 643-667. Two chunks of
+  // kCompressedChunkRows break even (waking a thread costs some 50-100 us on
+  // that machine); four gain 1.35x.
+  static constexpr int kMinRowsPerThread = 512;
+
   // `blocks`: every parameter block a wrapped cost function reads, distinct.
-  // `num_threads` >= 1. `kind` (0 <= kind < ThreadChoiceHistory::kKinds):
-  // evaluators whose evaluations cost alike (the dwells' residual kind) go
-  // on from what the last of them found about the threads (ThreadChoice).
-  ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads, int kind = 0);
+  // `num_threads` >= 1 (ResolveThreadCount). `min_rows_per_thread` >= 1:
+  // kMinRowsPerThread but where a benchmark measures the threads on less.
+  ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads,
+                            int min_rows_per_thread = kMinRowsPerThread);
   // One block of `size` doubles that every wrapped cost function reads.
-  ParallelResidualEvaluator(const double* parameters, int size, int num_threads, int kind = 0);
+  ParallelResidualEvaluator(const double* parameters, int size, int num_threads,
+                            int min_rows_per_thread = kMinRowsPerThread);
   ~ParallelResidualEvaluator() override;
 
   // Takes ownership of `cost_function`, whose parameter blocks are
@@ -137,6 +151,7 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
  private:
   class ReplayingCostFunction;
   class CompressedCostFunction;
+  class Workers;
 
   // Rows of the compressed wrappers' chunks, at the least (the last may
   // have fewer).
@@ -152,8 +167,6 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   void FactorChunk(int chunk);
   // The chunks' R, stacked, into compressed_r_.
   void CombineChunks();
-  // Whether every wrapper's values came out at last_point_.
-  bool EveryUnitEvaluated() const;
   // CompressedCostFunction::Evaluate.
   bool EvaluateCompressed(double const* const* parameters, double* residuals, double** jacobians);
   // Whether the watched blocks' values, block b's at values(b) (the blocks'
@@ -172,7 +185,10 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   std::vector<int> offsets_;  // of each block in a point
   int size_ = 0;              // of a point
   const int num_threads_;
-  tbb::task_arena arena_;  // at most num_threads_ threads, the caller's included
+  const int min_rows_per_thread_;
+  // num_threads_ - 1 threads beside the caller's, started with the first
+  // evaluation that runs threaded.
+  std::unique_ptr<Workers> workers_;
   std::vector<ReplayingCostFunction*> wrappers_;  // owned by the problem
   int rows_ = 0;                                  // residuals over the wrappers
   // Every wrapper's values at last_point_, contiguous per wrapper, in order
@@ -195,8 +211,6 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   std::vector<char> chunk_ok_;
   Eigen::MatrixXd compressed_r_;
   bool compressed_ok_ = false;
-  // PrecomputeAll on the threads or in the caller alone.
-  ThreadChoice choice_;
 };
 
 }  // namespace dwellfit

@@ -59,8 +59,7 @@ StageProblem::StageProblem(const FitDescription& fit, const StageSetup& setup)
       eta_e_entries_(fit.EntriesHolding(kEtaE)),
       damping_entries_(fit.EntriesHolding(kMu1)),
       fixed_(fit.FixedEntries()),
-      evaluator_(EvaluatedBlocks(fit), setup.num_threads,
-                 static_cast<int>(setup.residuals.residual)),
+      evaluator_(EvaluatedBlocks(fit), setup.num_threads),
       problem_(ProblemOptions(&evaluator_, setup.threaded_evaluation)),
       dwell_problem_(ProblemOptions(nullptr, false)) {
   const std::vector<bool> mu2 = fit.EntriesHolding(kMu2);

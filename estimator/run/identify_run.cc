@@ -10,7 +10,6 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
-#include "dwellfit/estimator/fit/thread_choice.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/run/run_figures.h"
 #include "glog/logging.h"
@@ -83,9 +82,8 @@ constexpr std::size_t kLargeRunDwells = 100000;
 // uncertainty is known: the predictions of every sweep into
 // report->predictions and `predictions_csv`, and the response curves into
 // `curves`, side by side on the run's threads (solver.num_threads) when
-// there are enough dwells and not too many (kLargeRunDwells), and the fit's
-// last choice of threads did not go to the caller alone, each part in its
-// own variable so that none depends on which thread runs it or when.
+// there are enough dwells and not too many (kLargeRunDwells), each part in
+// its own variable so that none depends on which thread runs it or when.
 void ComputeAfterFit(const ResolvedRun& run, const IdentificationResult& result,
                      IdentificationReport* report, std::string* predictions_csv,
                      RunCurves* curves) {
@@ -100,11 +98,8 @@ void ComputeAfterFit(const ResolvedRun& run, const IdentificationResult& result,
   };
   const int threads = std::min(ResolveThreadCount(run.options.solver.num_threads), 2);
   const bool large = dwells >= kLargeRunDwells;
-  // Where the fit's evaluations went to the caller alone (a busy machine),
-  // the parts would not gain from threads either.
-  const bool threads_lost = ThreadChoiceHistory::LastPreferredWay() == 2;
   if (large) ReturnFreedMemory();
-  if (threads == 1 || dwells < kMinDwellsForThreadsAfterFit || large || threads_lost) {
+  if (threads == 1 || dwells < kMinDwellsForThreadsAfterFit || large) {
     trace_curves();
     predict();
   } else {

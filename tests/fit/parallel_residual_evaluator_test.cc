@@ -153,20 +153,13 @@ class ThreadRecordingCost : public ceres::SizedCostFunction<1, 3> {
 // The distinct threads that evaluate `blocks` wrapped blocks in one
 // CostGradient with `num_threads` threads, the blocks waiting for
 // `wait_for` of them.
-int ThreadsUsed(int blocks, int num_threads, size_t wait_for) {
+int ThreadsUsed(int blocks, int num_threads, size_t wait_for,
+                int min_rows_per_thread = ParallelResidualEvaluator::kMinRowsPerThread) {
   const std::vector<Sample> data = SyntheticData(blocks);
   ThreadRecordingCost::Record record;
   record.wait_for = wait_for;
   Parameters parameters = kStart;
-  // A history of its own (no residual kind's, no other test's) that prefers
-  // the threads: what other evaluations found on this machine does not
-  // decide.
-  constexpr int kKind = 6;
-  ThreadChoiceHistory& history = ThreadChoiceHistory::ForKind(kKind);
-  history.preferred_way = 1;
-  history.trial_interval = ThreadChoice::kMaxTrialInterval;
-  history.since_trial = 0;
-  ParallelResidualEvaluator evaluator(parameters.data(), 3, num_threads, kKind);
+  ParallelResidualEvaluator evaluator(parameters.data(), 3, num_threads, min_rows_per_thread);
   std::vector<std::unique_ptr<ceres::CostFunction>> wrappers;
   for (const Sample& sample : data) {
     wrappers.emplace_back(evaluator.Wrap(new ThreadRecordingCost(sample, &record)));
@@ -195,12 +188,16 @@ class SqrtCost : public ceres::SizedCostFunction<1, 1> {
 };
 
 // The threads the other tests rely on are really used: one thread (the
-// caller's) when asked for one or below 256 residuals per thread, two when
-// asked for two with enough residuals.
+// caller's) when asked for one or below kMinRowsPerThread residuals per
+// thread, two when
+// asked for two with enough residuals, or with fewer where the evaluator is
+// told a lower threshold.
 TEST(ParallelResidualEvaluator, PrecomputesOnTheRequestedThreads) {
   EXPECT_EQ(ThreadsUsed(kNumSamples, 1, 1), 1);
   EXPECT_EQ(ThreadsUsed(300, 3, 1), 1);
+  EXPECT_EQ(ThreadsUsed(2 * ParallelResidualEvaluator::kMinRowsPerThread - 1, 2, 1), 1);
   EXPECT_EQ(ThreadsUsed(kNumSamples, 2, 2), 2);
+  EXPECT_EQ(ThreadsUsed(300, 2, 2, 100), 2);
 }
 
 // The solve does not depend on the number of threads: the final parameters
@@ -525,29 +522,6 @@ TEST(ParallelResidualEvaluator, FailureOfAWrappedFunctionIsReplayed) {
       problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr));
   EXPECT_NEAR(cost, 0.5 * (2.0 * (kBlocks - 1) + 1.0), 1e-9);
   EXPECT_EQ(evaluator.evaluated_directly(), 0);
-}
-
-// A point some residual fails at is not timed for the choice of threads
-// (its rows stop early, so its time says nothing of the next evaluation's):
-// only evaluations that came out reach the evaluators' shared history.
-TEST(ParallelResidualEvaluator, AFailedEvaluationIsNotTimed) {
-  constexpr int kKind = 7;  // no residual kind's, no other test's
-  ThreadChoiceHistory& history = ThreadChoiceHistory::ForKind(kKind);
-  history.timed = 0;
-  double x = 0.0;
-  ParallelResidualEvaluator evaluator(&x, 1, 2, kKind);
-  std::vector<std::unique_ptr<ceres::CostFunction>> wrappers;
-  for (int i = 0; i < 1000; ++i) wrappers.emplace_back(evaluator.Wrap(new SqrtCost(0.0)));
-  for (int i = 1; i <= 8; ++i) {  // every SqrtCost fails below 0
-    x = -i;
-    evaluator.PrepareForEvaluation(true, true);
-  }
-  EXPECT_EQ(history.timed.load(), 0);
-  for (int i = 1; i <= 3; ++i) {  // the first a choice sees is not timed
-    x = i;
-    evaluator.PrepareForEvaluation(true, true);
-  }
-  EXPECT_EQ(history.timed.load(), 2);
 }
 
 // Two residuals of {b, c} alone: the cosine's residual and its square.
