@@ -137,10 +137,10 @@ struct PenaltyCurvature {
 // the penalty is off or no stage had it.
 bool PenaltyInFit(const IdentificationOptions& options, const FitSummary* summary, double* weight,
                   int* exponent) {
-  if (!options.penalties.bifurcation_range.enabled || summary == nullptr) return false;
+  if (!options.solve.penalties.bifurcation_range.enabled || summary == nullptr) return false;
   for (auto stage = summary->stages.rbegin(); stage != summary->stages.rend(); ++stage) {
     if (stage->penalty_exponent <= 0) continue;
-    *weight = options.penalties.bifurcation_range.weight * stage->penalty_unit;
+    *weight = options.solve.penalties.bifurcation_range.weight * stage->penalty_unit;
     *exponent = stage->penalty_exponent;
     return *weight > 0.0 && std::isfinite(*weight);
   }
@@ -329,7 +329,7 @@ BlockCovariance PenalisedCovariance(const std::vector<const Sweep*>& fitted,
       }
     };
   }
-  return EstimateBlockCovariance(fit, options.residual);
+  return EstimateBlockCovariance(fit, options.solve.residual);
 }
 
 // Re-derives standard errors and intervals from c->covariance.
@@ -467,7 +467,7 @@ BlockCovariance PenaltyCovariance(const std::vector<const Sweep*>& fitted,
   double weight = 0.0;
   int exponent = 0;
   const bool penalty = PenaltyInFit(options, summary, &weight, &exponent);
-  if (options.penalties.bifurcation_range.enabled && !penalty) {
+  if (options.solve.penalties.bifurcation_range.enabled && !penalty) {
     u->warnings.push_back(
         "the bifurcation-range penalty was on, but the fit's penalty weight is not known here: "
         "the intervals are those of the dwells alone and too wide where the penalty constrains "
@@ -476,7 +476,7 @@ BlockCovariance PenaltyCovariance(const std::vector<const Sweep*>& fitted,
   const double noise_variance = data_only.noise_sigma * data_only.noise_sigma;
   if (!penalty || !(noise_variance > 0.0)) return data_only;
   const std::vector<PenaltyCurvature> terms =
-      EnforcedJumps(fitted, options.penalties, weight, exponent, estimate, u);
+      EnforcedJumps(fitted, options.solve.penalties, weight, exponent, estimate, u);
   if (terms.empty()) return data_only;
   BlockCovariance c = PenalisedCovariance(fitted, options, estimate, noise_variance, terms);
   if (!c.available || !SandwichCovariance(terms, weight, exponent, data_only, estimate,
@@ -507,7 +507,7 @@ BlockCovariance Covariance(const std::vector<const Sweep*>& fitted,
   if (method == IntervalMethod::kDataOnly || !data_only.available) return data_only;
   BlockCovariance c = PenaltyCovariance(fitted, options, estimate, summary, data_only, sampling, u);
   // Jumps the penalty holds carry its pull already.
-  const PenaltyOptions* enforced = u->penalty_terms > 0 ? &options.penalties : nullptr;
+  const PenaltyOptions* enforced = u->penalty_terms > 0 ? &options.solve.penalties : nullptr;
   BlockCovariance pulled = c;
   const int pulls = AddLabelPull(fitted, estimate, options.fixed, enforced, &pulled);
   if (pulls == 0) return c;

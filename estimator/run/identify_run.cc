@@ -105,7 +105,7 @@ void ComputeAfterFit(const ResolvedRun& run, const IdentificationResult& result,
     *predictions_csv = ReportToPredictionsCsv(*report);
   };
   // Three parts: more threads would idle.
-  const int threads = std::min(ResolveThreadCount(run.options.solver.num_threads), 3);
+  const int threads = std::min(ResolveThreadCount(run.options.solve.solver.num_threads), 3);
   const bool large = dwells >= kLargeRunDwells;
   // Where the fit's evaluations went to the caller alone (a busy machine),
   // the parts would not gain from threads either.

@@ -86,7 +86,7 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
   CoverageStudy study;
   study.replicas = options.replicas;
   study.method = options.method;
-  study.penalty = config.identification.penalties.bifurcation_range.enabled;
+  study.penalty = config.identification.solve.penalties.bifurcation_range.enabled;
   study.omega_ref_rad_s =
       config.omega_ref_rad_s ? *config.omega_ref_rad_s : plan.truth[kNaturalFrequency];
 
