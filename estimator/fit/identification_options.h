@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "dwellfit/residuals/functors/vertical_error_residual.h"
+#include "dwellfit/residuals/functors/error_measure.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 
 namespace dwellfit {
