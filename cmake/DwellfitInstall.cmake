@@ -3,8 +3,7 @@
 #   <prefix>/include/dwellfit/...    the public headers (DWELLFIT_PUBLIC_HEADERS)
 #   <prefix>/lib/libdwellfit_<stage>.a (one archive per stage of the data path)
 #   <prefix>/lib/cmake/dwellfit/dwellfit{Config,ConfigVersion,Targets}.cmake
-#   <prefix>/bin/dwellfit-identify, dwellfit-simulate-dwell, dwellfit-simulate-rig,
-#   dwellfit-process-traces
+#   <prefix>/bin/dwellfit-<tool>     every command-line tool (tools/*_main.cc)
 #
 # Outside code: find_package(dwellfit) and link dwellfit::dwellfit. It
 # includes the public headers as "dwellfit/estimator/...", "dwellfit/residuals/...";
@@ -76,13 +75,17 @@ install(FILES
   ${PROJECT_BINARY_DIR}/dwellfitConfigVersion.cmake
   DESTINATION ${DWELLFIT_INSTALL_CMAKEDIR})
 
-# The command-line tools keep their build names (build/tools/identify) but are
-# installed with a dwellfit- prefix: ImageMagick already installs `identify`.
-foreach(tool identify simulate_dwell simulate_rig process_traces)
-  if(TARGET ${tool})
+# The command-line tools (every tools/*_main.cc) keep their build names
+# (build/tools/identify) but are installed with a dwellfit- prefix, '_' as '-':
+# ImageMagick already installs `identify`.
+if(DWELLFIT_BUILD_TOOLS)
+  file(GLOB tool_mains CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/tools/*_main.cc)
+  foreach(main_source IN LISTS tool_mains)
+    get_filename_component(tool "${main_source}" NAME_WE)
+    string(REGEX REPLACE "_main$" "" tool "${tool}")
     string(REPLACE "_" "-" installed_name "dwellfit-${tool}")
     install(PROGRAMS $<TARGET_FILE:${tool}>
       DESTINATION ${CMAKE_INSTALL_BINDIR}
       RENAME ${installed_name})
-  endif()
-endforeach()
+  endforeach()
+endif()

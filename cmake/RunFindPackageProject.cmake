@@ -13,7 +13,8 @@
 # Optional: PROGRAM (the program to run, default embed_dwellfit), ARGS (its
 # arguments, a ;-list), NAME (in messages, default find_package_project),
 # MAX_HEADERS (fail when more headers are installed, or any outside
-# include/dwellfit/), GENERATOR, CXX_COMPILER, BUILD_TYPE,
+# include/dwellfit/), TOOLS (a ;-list of programs that must be installed in
+# <prefix>/bin), GENERATOR, CXX_COMPILER, BUILD_TYPE,
 # and CXX_FLAGS and LINKER_FLAGS (the sanitizer flags of a DWELLFIT_SANITIZE
 # build: an instrumented library links only into an instrumented program).
 cmake_minimum_required(VERSION 3.16)
@@ -35,6 +36,7 @@ endif()
 
 # Lists come comma-separated (a ';' would split the ctest command's argument).
 string(REPLACE "," ";" ARGS "${ARGS}")
+string(REPLACE "," ";" TOOLS "${TOOLS}")
 
 function(run_step name)
   list(JOIN ARGN " " command_line)
@@ -51,7 +53,7 @@ run_step(install
   "${CMAKE_COMMAND}" --install "${DWELLFIT_BINARY_DIR}" --prefix "${PREFIX}"
   --config "${BUILD_TYPE}")
 
-# What the install put in the prefix: the public headers only.
+# What the install put in the prefix: the public headers only, every tool.
 if(MAX_HEADERS)
   file(GLOB_RECURSE headers RELATIVE "${PREFIX}/include" "${PREFIX}/include/*")
   list(LENGTH headers header_count)
@@ -67,6 +69,16 @@ if(MAX_HEADERS)
                           "include/dwellfit/ or is not a header")
     endif()
   endforeach()
+endif()
+foreach(tool IN LISTS TOOLS)
+  find_program(installed_${tool} ${tool} PATHS "${PREFIX}/bin" NO_DEFAULT_PATH)
+  if(NOT installed_${tool})
+    message(FATAL_ERROR "${NAME}: the tool ${tool} is not installed in ${PREFIX}/bin")
+  endif()
+endforeach()
+if(TOOLS)
+  list(LENGTH TOOLS tool_count)
+  message(STATUS "${NAME}: all ${tool_count} tools installed in ${PREFIX}/bin")
 endif()
 
 set(configure_args -S "${PROJECT_SOURCE}" -B "${WORK_DIR}"
