@@ -71,8 +71,8 @@ IdentificationOptions GrowthOptions(int threads) {
   IdentificationOptions options;
   options.initial = {130.0, 0.14, 390.0, 7000.0, 1.17e9, HzToRadPerSecond(40.0)};
   options.fixed[kNaturalFrequency] = true;
-  options.residual.error = ErrorMeasure::kRelative;
-  options.solver.num_threads = threads;
+  options.solve.residual.error = ErrorMeasure::kRelative;
+  options.solve.solver.num_threads = threads;
   return options;
 }
 

@@ -59,7 +59,7 @@ ResolvedRun& ClampedBeam() {
 // The configured fit of `run` (FitRun, as `identify` fits), with its residual
 // blocks evaluated on state.range(0) threads.
 void RunConfiguredFit(benchmark::State& state, ResolvedRun& run) {
-  run.options.solver.num_threads = static_cast<int>(state.range(0));
+  run.options.solve.solver.num_threads = static_cast<int>(state.range(0));
   for (auto _ : state) {
     const IdentificationResult result = FitRun(run).best;
     benchmark::DoNotOptimize(result.parameters);

@@ -31,7 +31,7 @@ void BM_DwellResidual(benchmark::State& state) {
   const ResolvedRun& thesis = Thesis();
   ProblemBuilderOptions options;
   options.residual = state.range(0) == 0 ? ResidualKind::kVertical : ResidualKind::kAllRoots;
-  options.residual_options = thesis.options.residual;
+  options.residual_options = thesis.options.solve.residual;
   const ProblemBuilder builder(options);
   std::vector<std::unique_ptr<ceres::CostFunction>> costs;
   for (const Sweep* sweep : thesis.fitted) {

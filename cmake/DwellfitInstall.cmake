@@ -1,15 +1,13 @@
 # Installation and export.
 #
-#   <prefix>/include/dwellfit/{residuals,estimator,config}/<stage>/*.h
+#   <prefix>/include/dwellfit/...    the public headers (DWELLFIT_PUBLIC_HEADERS)
 #   <prefix>/lib/libdwellfit_<stage>.a (one archive per stage of the data path)
 #   <prefix>/lib/cmake/dwellfit/dwellfit{Config,ConfigVersion,Targets}.cmake
-#   <prefix>/bin/dwellfit-identify, dwellfit-simulate-dwell, dwellfit-simulate-rig,
-#   dwellfit-process-traces
+#   <prefix>/bin/dwellfit-<tool>     every command-line tool (tools/*_main.cc)
 #
-# Outside code: find_package(dwellfit) and link dwellfit::dwellfit (all of
-# the library) or one stage (dwellfit::residuals, the header-only functors;
-# dwellfit::fit, ...). Headers are included as "dwellfit/residuals/...",
-# "dwellfit/estimator/...", "dwellfit/config/...".
+# Outside code: find_package(dwellfit) and link dwellfit::dwellfit. It
+# includes the public headers as "dwellfit/estimator/...", "dwellfit/residuals/...";
+# every other header is the library's own and is not installed.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
@@ -23,12 +21,41 @@ install(TARGETS ${dwellfit_library_targets} dwellfit
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 
-# Headers are globbed when `cmake --install` runs, so new ones need no edit here.
-foreach(header_dir residuals estimator config)
-  install(DIRECTORY ${PROJECT_SOURCE_DIR}/${header_dir}/
-    DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/dwellfit/${header_dir}
-    FILES_MATCHING PATTERN "*.h")
+# The public headers: what a user includes to load sweeps (sweep_csv.h, with
+# jump_detection.h to label them), describe a fit (fit_description.h,
+# identification_options.h, initial_guess.h), solve it (identification.h,
+# staged_solve.h), read the result with its intervals (parameter_uncertainty.h,
+# block_covariance.h), draw curves (response_curve.h) and simulate dwells
+# (dwell_simulator.h); then what those include: the header-only model
+# (residuals/model) and the shared small headers. Every one must compile on its
+# own against the installed tree, including only headers of this list (the
+# find_package_project test checks both, and that there are at most 25).
+set(DWELLFIT_PUBLIC_HEADERS
+    estimator/analysis/block_covariance.h
+    estimator/analysis/parameter_uncertainty.h
+    estimator/common/input_error.h
+    estimator/curves/response_curve.h
+    estimator/data/jump_detection.h
+    estimator/data/sweep.h
+    estimator/data/sweep_csv.h
+    estimator/fit/fit_description.h
+    estimator/fit/identification.h
+    estimator/fit/identification_options.h
+    estimator/fit/initial_guess.h
+    estimator/fit/staged_solve.h
+    estimator/simulation/dwell_simulator.h
+    residuals/functors/error_measure.h
+    residuals/model/bracketed_newton.h
+    residuals/model/model_parameters.h
+    residuals/model/response_model.h
+    residuals/model/stable_root.h
+    residuals/model/sweep_vocabulary.h)
+foreach(header IN LISTS DWELLFIT_PUBLIC_HEADERS)
+  get_filename_component(header_dir "${header}" DIRECTORY)
+  install(FILES ${PROJECT_SOURCE_DIR}/${header}
+    DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/dwellfit/${header_dir})
 endforeach()
+list(LENGTH DWELLFIT_PUBLIC_HEADERS DWELLFIT_PUBLIC_HEADER_COUNT)
 
 install(EXPORT dwellfitTargets
   NAMESPACE dwellfit::
@@ -48,13 +75,17 @@ install(FILES
   ${PROJECT_BINARY_DIR}/dwellfitConfigVersion.cmake
   DESTINATION ${DWELLFIT_INSTALL_CMAKEDIR})
 
-# The command-line tools keep their build names (build/tools/identify) but are
-# installed with a dwellfit- prefix: ImageMagick already installs `identify`.
-foreach(tool identify simulate_dwell simulate_rig process_traces)
-  if(TARGET ${tool})
+# The command-line tools (every tools/*_main.cc) keep their build names
+# (build/tools/identify) but are installed with a dwellfit- prefix, '_' as '-':
+# ImageMagick already installs `identify`.
+if(DWELLFIT_BUILD_TOOLS)
+  file(GLOB tool_mains CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/tools/*_main.cc)
+  foreach(main_source IN LISTS tool_mains)
+    get_filename_component(tool "${main_source}" NAME_WE)
+    string(REGEX REPLACE "_main$" "" tool "${tool}")
     string(REPLACE "_" "-" installed_name "dwellfit-${tool}")
     install(PROGRAMS $<TARGET_FILE:${tool}>
       DESTINATION ${CMAKE_INSTALL_BINDIR}
       RENAME ${installed_name})
-  endif()
-endforeach()
+  endforeach()
+endif()

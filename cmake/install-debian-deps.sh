@@ -24,9 +24,6 @@ packages=(
   libfccp-dev
   libboost-dev
   libtbb-dev
-  # GCC's Fortran runtime archive: ATLAS' LAPACK is linked statically
-  # (cmake/DwellfitStaticDependencies.cmake).
-  libgfortran-12-dev
   gnuplot-nox
   # The fuzzers (tests/fuzz): Clang with its libFuzzer and sanitizer runtimes.
   clang-14

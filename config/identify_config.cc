@@ -600,18 +600,18 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
   if (const auto value = top.Optional("fixed")) {
     identification.fixed = ReadFixed(*value, source, config.initial_guess);
   }
-  if (const auto value = top.Optional("stages")) identification.stages = ReadStages(*value, source);
+  if (const auto value = top.Optional("stages"))
+    identification.solve.stages = ReadStages(*value, source);
   if (const auto value = top.Optional("residual")) {
-    identification.residual = ReadResidual(*value, source);
+    identification.solve.residual = ReadResidual(*value, source);
   }
   const ConfigValue solver = OrAbsent(top.Optional("solver"), "solver");
-  if (solver.node.IsDefined()) identification.solver = ReadSolver(solver, source);
+  if (solver.node.IsDefined()) identification.solve.solver = ReadSolver(solver, source);
   std::string message;
-  if (!identification.solver.IsValid(&message)) ThrowInvalidBlock(solver, source, message);
+  if (!identification.solve.solver.IsValid(&message)) ThrowInvalidBlock(solver, source, message);
   if (const auto value = top.Optional("penalties")) {
-    identification.penalties = ReadPenalties(*value, source);
+    identification.solve.penalties = ReadPenalties(*value, source);
   }
-  if (!identification.IsValid(&message)) ThrowInvalidBlock(initial_guess, source, message);
 
   if (const auto value = top.Optional("model_selection")) {
     config.model_selection = ReadModelSelectionConfig(*value, source, config.initial_guess);

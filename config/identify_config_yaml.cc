@@ -113,16 +113,19 @@ void EmitFitSettings(YAML::Emitter& out, const IdentificationOptions& identifica
   }
   out << YAML::EndSeq;
   out << YAML::Key << "stages" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (ResidualKind stage : identification.stages) out << ResidualKindName(stage);
+  for (ResidualKind stage : identification.solve.stages) out << ResidualKindName(stage);
   out << YAML::EndSeq;
 
   out << YAML::Key << "residual" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "error" << YAML::Value << ErrorMeasureName(identification.residual.error);
-  out << YAML::Key << "use_point_sigma" << YAML::Value << identification.residual.use_point_sigma;
-  out << YAML::Key << "amplitude_floor" << YAML::Value << identification.residual.amplitude_floor;
+  out << YAML::Key << "error" << YAML::Value
+      << ErrorMeasureName(identification.solve.residual.error);
+  out << YAML::Key << "use_point_sigma" << YAML::Value
+      << identification.solve.residual.use_point_sigma;
+  out << YAML::Key << "amplitude_floor" << YAML::Value
+      << identification.solve.residual.amplitude_floor;
   out << YAML::EndMap;
 
-  const SolverSettings& solver = identification.solver;
+  const SolverSettings& solver = identification.solve.solver;
   out << YAML::Key << "solver" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "max_iterations" << YAML::Value << solver.max_iterations;
   out << YAML::Key << "function_tolerance" << YAML::Value << ExactNumber(solver.function_tolerance);
@@ -206,7 +209,7 @@ std::string ConfigToYaml(const IdentifyConfig& config, ConfigKeys keys) {
   EmitSelections(out, "validate", config.validate_sweeps);
   EmitInitialGuess(out, config);
   EmitFitSettings(out, config.identification, keys);
-  EmitPenalties(out, config.identification.penalties);
+  EmitPenalties(out, config.identification.solve.penalties);
   EmitMultiStartAndJumpDetection(out, config, keys);
   EmitJumpOverrides(out, config.jump_overrides);
   if (config.omega_ref_rad_s.has_value()) {

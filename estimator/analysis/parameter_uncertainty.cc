@@ -138,10 +138,10 @@ struct PenaltyCurvature {
 // the penalty is off or no stage had it.
 bool PenaltyInFit(const IdentificationOptions& options, const FitSummary* summary, double* weight,
                   int* exponent) {
-  if (!options.penalties.bifurcation_range.enabled || summary == nullptr) return false;
+  if (!options.solve.penalties.bifurcation_range.enabled || summary == nullptr) return false;
   for (auto stage = summary->stages.rbegin(); stage != summary->stages.rend(); ++stage) {
     if (stage->penalty_exponent <= 0) continue;
-    *weight = options.penalties.bifurcation_range.weight * stage->penalty_unit;
+    *weight = options.solve.penalties.bifurcation_range.weight * stage->penalty_unit;
     *exponent = stage->penalty_exponent;
     return *weight > 0.0 && std::isfinite(*weight);
   }
@@ -329,7 +329,7 @@ BlockCovariance PenalisedCovariance(const std::vector<const Sweep*>& fitted,
       }
     };
   }
-  return EstimateBlockCovariance(fit, options.residual);
+  return EstimateBlockCovariance(fit, options.solve.residual);
 }
 
 // The dwells' covariance, with the penalty's curvature at each enforced jump
@@ -342,7 +342,7 @@ BlockCovariance PenaltyCovariance(const std::vector<const Sweep*>& fitted,
   double weight = 0.0;
   int exponent = 0;
   const bool penalty = PenaltyInFit(options, summary, &weight, &exponent);
-  if (options.penalties.bifurcation_range.enabled && !penalty) {
+  if (options.solve.penalties.bifurcation_range.enabled && !penalty) {
     u->warnings.push_back(
         "the bifurcation-range penalty was on, but the fit's penalty weight is not known here: "
         "the intervals are those of the dwells alone and too wide where the penalty constrains "
@@ -351,7 +351,7 @@ BlockCovariance PenaltyCovariance(const std::vector<const Sweep*>& fitted,
   const double noise_variance = data_only.noise_sigma * data_only.noise_sigma;
   if (!penalty || !(noise_variance > 0.0)) return data_only;
   const std::vector<PenaltyCurvature> terms =
-      EnforcedJumps(fitted, options.penalties, weight, exponent, estimate, u);
+      EnforcedJumps(fitted, options.solve.penalties, weight, exponent, estimate, u);
   if (terms.empty()) return data_only;
   BlockCovariance c = PenalisedCovariance(fitted, options, estimate, noise_variance, terms);
   if (!c.available) {
@@ -376,8 +376,8 @@ bool MakeProfileProblem(const std::vector<const Sweep*>& fitted,
                         const IdentificationOptions& options, const FitSummary* summary,
                         double threshold, int threads, ParameterUncertainty* u,
                         ProfileProblem* problem) {
-  const bool penalised = options.penalties.bifurcation_range.enabled ||
-                         options.penalties.branch_stability.enabled;
+  const bool penalised = options.solve.penalties.bifurcation_range.enabled ||
+                         options.solve.penalties.branch_stability.enabled;
   const StageSummary* last =
       summary != nullptr && !summary->stages.empty() ? &summary->stages.back() : nullptr;
   if (last == nullptr ? penalised : last->residual != ResidualKind::kVertical) {
@@ -390,9 +390,9 @@ bool MakeProfileProblem(const std::vector<const Sweep*>& fitted,
   }
   problem->fitted = fitted;
   problem->fixed = options.fixed;
-  problem->residual = options.residual;
+  problem->residual = options.solve.residual;
   if (last != nullptr) problem->penalties = last->penalties;
-  problem->solver = options.solver;
+  problem->solver = options.solve.solver;
   problem->omega_ref_rad_s = u->omega_ref_rad_s;
   problem->threshold = threshold;
   problem->threads = threads;

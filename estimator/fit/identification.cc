@@ -11,13 +11,14 @@ IdentificationResult Identify(const std::vector<const Sweep*>& fitted,
   IdentificationResult result;
   result.parameters = options.initial;
   std::string error;
-  if (!options.IsValid(&error)) {
+  // The start here; the solve's options where they enter SolveStaged.
+  if (!options.InitialIsValid(&error)) {
     result.status = FitStatus::kInvalidInput;
     result.message = error;
     return result;
   }
   const FitDescription fit = SingleBlockFit(fitted, options.fixed, &result.parameters);
-  static_cast<FitSummary&>(result) = SolveStaged(fit, options.SolveOptions());
+  static_cast<FitSummary&>(result) = SolveStaged(fit, options.solve);
   return result;
 }
 

@@ -24,7 +24,8 @@ struct IdentificationResult : FitSummary {
 };
 
 // Runs the configured stages on `fitted` from options.initial
-// (SingleBlockFit). Never aborts: invalid options give kInvalidInput.
+// (SingleBlockFit). Never aborts: invalid options give kInvalidInput. The
+// options are validated here, once (options.solve by SolveStaged).
 IdentificationResult Identify(const std::vector<const Sweep*>& fitted,
                               const IdentificationOptions& options);
 

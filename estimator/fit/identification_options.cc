@@ -150,7 +150,7 @@ bool StagedSolveOptions::IsValid(std::string* error) const {
   return residual.IsValid(error) && penalties.IsValid(error) && solver.IsValid(error);
 }
 
-bool IdentificationOptions::IsValid(std::string* error) const {
+bool IdentificationOptions::InitialIsValid(std::string* error) const {
   for (int i = 0; i < kNumParameters; ++i) {
     const std::string field = std::string("initial.") + ParameterName(i);
     if (!std::isfinite(initial[i])) {
@@ -168,17 +168,11 @@ bool IdentificationOptions::IsValid(std::string* error) const {
       return false;
     }
   }
-  return SolveOptions().IsValid(error);
+  return true;
 }
 
-StagedSolveOptions IdentificationOptions::SolveOptions() const {
-  StagedSolveOptions options;
-  options.stages = stages;
-  options.residual = residual;
-  options.penalties = penalties;
-  options.solver = solver;
-  options.algebraic_start_candidate = algebraic_start_candidate;
-  return options;
+bool IdentificationOptions::IsValid(std::string* error) const {
+  return InitialIsValid(error) && solve.IsValid(error);
 }
 
 }  // namespace dwellfit

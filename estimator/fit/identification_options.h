@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "dwellfit/residuals/functors/vertical_error_residual.h"
+#include "dwellfit/residuals/functors/error_measure.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 
 namespace dwellfit {
@@ -152,17 +152,12 @@ struct IdentificationOptions {
   ParameterVector initial = {0, 0, 0, 0, 0, 0};
   // Parameters held at their initial value.
   std::array<bool, kNumParameters> fixed = {false, false, false, false, false, false};
-  // Fit stages run in order, each starting where the previous one ended.
-  std::vector<ResidualKind> stages = {ResidualKind::kAlgebraic, ResidualKind::kVertical};
-  ResidualOptions residual;
-  // Soft constraints added to every vertical-error stage.
-  PenaltyOptions penalties;
-  SolverSettings solver;
-  // As StagedSolveOptions::algebraic_start_candidate.
-  bool algebraic_start_candidate = true;
+  // The stages and how each is solved.
+  StagedSolveOptions solve;
+  // `initial` alone: finite, and inside the model's range.
+  bool InitialIsValid(std::string* error) const;
+  // InitialIsValid and solve.IsValid.
   bool IsValid(std::string* error) const;
-  // stages, residual, penalties, solver and algebraic_start_candidate.
-  StagedSolveOptions SolveOptions() const;
 };
 
 }  // namespace dwellfit

@@ -89,8 +89,8 @@ MultiStartResult IdentifyMultiStart(const std::vector<const Sweep*>& fitted,
   // The starts share the machine's threads (the result does not depend on
   // how many evaluate each start's residuals).
   IdentificationOptions per_start = options;
-  per_start.solver.num_threads =
-      std::max(1, ResolveThreadCount(options.solver.num_threads) / std::max(parallel_starts, 1));
+  per_start.solve.solver.num_threads = std::max(
+      1, ResolveThreadCount(options.solve.solver.num_threads) / std::max(parallel_starts, 1));
   std::atomic<int> next{0};
   auto worker = [&]() {
     for (int i = next++; i < n; i = next++) {

@@ -492,15 +492,31 @@ std::string StartNote(ResidualKind kind, bool after_start_stage, bool previous_c
 // fold stage (the algebraic residual with the enforced jumps' fold
 // conditions, FoldConditionResidual) runs from it first, once per solve,
 // and the better of its start and end is taken. Leaves the blocks at the
-// chosen start, and in `*rated` the problem the points were rated on, for
-// the stage to solve on (RunStage); false when the fold stage failed.
-bool ChooseStart(const SolveContext& context, ResidualKind kind,
-                 const std::vector<double>* previous_start, bool after_start_stage,
-                 bool* fold_stage_ran, const PenaltyOptions& penalties, FitSummary* summary,
-                 std::string* note, std::string* failure, std::unique_ptr<StageProblem>* rated) {
+// chosen start, and in `rated` the problem the points were rated on, for
+// the stage to solve on (RunStage).
+struct StartRequest {
+  ResidualKind kind = ResidualKind::kVertical;  // the stage's residual
+  // Where the previous stage started; null when there is none to compare.
+  const std::vector<double>* previous_start = nullptr;
+  bool after_start_stage = false;  // the previous stage is the start stage
+  bool fold_stage_ran = false;     // a fold stage already ran in this solve
+};
+struct ChosenStart {
+  bool ok = true;                          // false: the fold stage failed (`failure`)
+  std::optional<StageSummary> fold_stage;  // the fold stage, when one ran
+  std::string note;                        // why the start was chosen, for the stage
+  std::string failure;
+  std::unique_ptr<StageProblem> rated;
+};
+ChosenStart ChooseStart(const SolveContext& context, const StartRequest& request) {
+  const ResidualKind kind = request.kind;
+  const std::vector<double>* previous_start = request.previous_start;
+  const PenaltyOptions& penalties = context.options.penalties;
+  ChosenStart chosen;
+  std::string* note = &chosen.note;
   std::vector<double> best = context.fit.Values();
-  *rated = std::make_unique<StageProblem>(context.fit, MakeSetup(context, kind));
-  StageProblem* problem = rated->get();
+  chosen.rated = std::make_unique<StageProblem>(context.fit, MakeSetup(context, kind));
+  StageProblem* problem = chosen.rated.get();
   // The previous start first: the stage usually starts where the previous
   // one ended, and the problem then holds the values there that a problem
   // assembled for the stage would compute first.
@@ -510,24 +526,23 @@ bool ChooseStart(const SolveContext& context, ResidualKind kind,
   std::vector<double> last_rated = best;
   if (earlier) {
     const bool earlier_better = earlier->BetterThan(rating);
-    *note = StartNote(kind, after_start_stage, earlier_better, *earlier, rating);
+    *note = StartNote(kind, request.after_start_stage, earlier_better, *earlier, rating);
     if (earlier_better) {
       best = *previous_start;
       rating = *earlier;
     }
   }
-  if (kind == ResidualKind::kVertical && !rating.missing_folds.empty() && !*fold_stage_ran) {
+  if (kind == ResidualKind::kVertical && !rating.missing_folds.empty() && !request.fold_stage_ran) {
     context.fit.SetValues(best);
-    summary->stages.emplace_back();
-    StageSummary& fold_stage = summary->stages.back();
+    StageSummary& fold_stage = chosen.fold_stage.emplace();
     fold_stage.fold_stage = true;
     fold_stage.note =
         "fold stage: the vertical stage's start lacks " + JoinLines(rating.missing_folds);
     if (!RunStage(context, ResidualKind::kAlgebraic, penalties, /*start_only=*/true, &fold_stage,
-                  failure)) {
-      return false;
+                  &chosen.failure)) {
+      chosen.ok = false;
+      return chosen;
     }
-    *fold_stage_ran = true;
     const std::vector<double> after = context.fit.Values();
     const StartRating folded = RateStart(context, problem, after, penalties);
     last_rated = after;
@@ -541,7 +556,7 @@ bool ChooseStart(const SolveContext& context, ResidualKind kind,
   }
   context.fit.SetValues(best);
   if (best != last_rated) problem->EvaluateAfresh();
-  return true;
+  return chosen;
 }
 
 // The minimum check's step along an entry: this share of its step unit.
@@ -736,22 +751,26 @@ FitSummary SolveStaged(const FitDescription& fit, const StagedSolveOptions& opti
   bool after_start_stage = false;
   for (size_t s = 0; s < options.stages.size(); ++s) {
     const ResidualKind kind = options.stages[s];
-    std::string note;
+    ChosenStart chosen;
     if (s == 0 && IsBranchLabelled(kind) && options.algebraic_start_candidate) {
       previous_start = fit.Values();
       after_start_stage = RunStartStage(context, kind, &summary);
     }
     const bool choose = kind == ResidualKind::kVertical || (s == 0 && after_start_stage);
-    std::unique_ptr<StageProblem> rated;
-    if (choose &&
-        !ChooseStart(context, kind, after_start_stage || s > 0 ? &previous_start : nullptr,
-                     s == 0 && after_start_stage, &fold_stage_ran, options.penalties, &summary,
-                     &note, &error, &rated)) {
-      summary.status = FitStatus::kFailure;
-      summary.evaluation_failed = true;
-      summary.message = error;
-      summary.final_cost = summary.stages.back().final_cost;
-      return summary;
+    if (choose) {
+      chosen = ChooseStart(context, {kind, after_start_stage || s > 0 ? &previous_start : nullptr,
+                                     s == 0 && after_start_stage, fold_stage_ran});
+      if (chosen.fold_stage) {
+        summary.stages.push_back(std::move(*chosen.fold_stage));
+        fold_stage_ran = true;
+      }
+      if (!chosen.ok) {
+        summary.status = FitStatus::kFailure;
+        summary.evaluation_failed = true;
+        summary.message = chosen.failure;
+        summary.final_cost = summary.stages.back().final_cost;
+        return summary;
+      }
     }
     previous_start = fit.Values();
     // The algebraic stage fits the dwells alone: a fold stage adds the fold
@@ -771,11 +790,11 @@ FitSummary SolveStaged(const FitDescription& fit, const StagedSolveOptions& opti
     const bool start_only = kind == ResidualKind::kAlgebraic && s + 1 < options.stages.size();
     for (const PenaltyOptions& penalties : runs) {
       summary.stages.emplace_back();
-      summary.stages.back().note = note;
-      note.clear();
+      summary.stages.back().note = std::move(chosen.note);
+      chosen.note.clear();
       // The first run solves on the problem its start was rated on.
       if (!RunStage(context, kind, penalties, start_only, &summary.stages.back(), &error,
-                    std::move(rated))) {
+                    std::move(chosen.rated))) {
         summary.status = FitStatus::kFailure;
         summary.evaluation_failed = true;
         summary.message = error;

@@ -96,7 +96,7 @@ void ComputeAfterFit(const ResolvedRun& run, const IdentificationResult& result,
     report->predictions = PredictSweeps(result.parameters, run.fitted, run.validation);
     *predictions_csv = ReportToPredictionsCsv(*report);
   };
-  const int threads = std::min(ResolveThreadCount(run.options.solver.num_threads), 2);
+  const int threads = std::min(ResolveThreadCount(run.options.solve.solver.num_threads), 2);
   const bool large = dwells >= kLargeRunDwells;
   if (large) ReturnFreedMemory();
   if (threads == 1 || dwells < kMinDwellsForThreadsAfterFit || large) {
@@ -161,7 +161,7 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
       config.omega_ref_rad_s.value_or(result.parameters[kNaturalFrequency]);
   ParameterUncertainty uncertainty =
       EstimateUncertaintyAtMinimum(run.fitted, run.options, omega_ref_rad_s, &result,
-                                   ResolveThreadCount(run.options.solver.num_threads));
+                                   ResolveThreadCount(run.options.solve.solver.num_threads));
   // The report states the start the best fit came from.
   IdentificationOptions options = run.options;
   options.initial = multi_start.starts[multi_start.best_start];

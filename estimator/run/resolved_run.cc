@@ -95,25 +95,15 @@ void CheckFixedAreGiven(const IdentifyConfig& config) {
   }
 }
 
-// The settings blocks are checked when the config is loaded (at their
-// lines); checked again here because a config can also be built in code.
+// The settings the run uses before the fit. The config reader checks each
+// block at its line; the fit's options (identification, multi_start) are
+// checked where they enter the fit (IdentifyMultiStart, Identify,
+// SolveStaged). The jump detection enters the library here (DetectJumps
+// takes valid options), so a config built in code is checked here.
 void CheckSettings(const IdentifyConfig& config) {
-  const std::string& path = config.config_path;
-  const IdentificationOptions& options = config.identification;
   std::string message;
-  if (!options.solver.IsValid(&message)) throw InputError(path, 0, "solver", message);
-  if (!options.penalties.bifurcation_range.IsValid(&message)) {
-    throw InputError(path, 0, "penalties.bifurcation_range", message);
-  }
-  if (!options.penalties.branch_stability.IsValid(&message)) {
-    throw InputError(path, 0, "penalties.branch_stability", message);
-  }
-  if (options.stages.empty()) {
-    throw InputError(path, 0, "stages", "at least one fit stage is required");
-  }
-  if (!config.multi_start.IsValid(&message)) throw InputError(path, 0, "multi_start", message);
   if (!config.jump_detection.IsValid(&message)) {
-    throw InputError(path, 0, "jump_detection", message);
+    throw InputError(config.config_path, 0, "jump_detection", message);
   }
   CheckFixedAreGiven(config);
 }
@@ -179,8 +169,9 @@ ResolvedRun ResolveRun(const IdentifyConfig& config, std::vector<Sweep> sweeps) 
   run.multi_start = config.multi_start;
   FillGuessesFromData(config, &run);
   FindAutomaticStart(config, &run);
+  // A start found from the data is new input: checked here, with what to do.
   std::string invalid;
-  if (!run.options.IsValid(&invalid)) {
+  if (run.guessed_from_data && !run.options.InitialIsValid(&invalid)) {
     throw InputError(config.config_path, 0, "initial_guess",
                      "the starting point is not usable (" + invalid +
                          "); give the initial guesses in the config");

@@ -26,14 +26,15 @@ struct PairedFit {
 PairedFit FitBothWays(const IdentifyConfig& config) {
   PairedFit fit;
   fit.data = ResolveRun(config);
-  const PenaltyOptions configured = fit.data.options.penalties;
-  fit.data.options.penalties.bifurcation_range.enabled = true;
+  const PenaltyOptions configured = fit.data.options.solve.penalties;
+  fit.data.options.solve.penalties.bifurcation_range.enabled = true;
   fit.with_penalty = FitRun(fit.data).best;
-  fit.data.options.penalties.bifurcation_range.enabled = false;
-  fit.data.options.penalties.branch_stability.enabled = false;
+  fit.data.options.solve.penalties.bifurcation_range.enabled = false;
+  fit.data.options.solve.penalties.branch_stability.enabled = false;
   fit.without_penalty = FitRun(fit.data).best;
-  fit.data.options.penalties = configured;
-  fit.omega_ref_rad_s = config.omega_ref_rad_s.value_or(fit.with_penalty.parameters[kNaturalFrequency]);
+  fit.data.options.solve.penalties = configured;
+  fit.omega_ref_rad_s =
+      config.omega_ref_rad_s.value_or(fit.with_penalty.parameters[kNaturalFrequency]);
   return fit;
 }
 

@@ -125,8 +125,8 @@ std::vector<FamilyMember> ConvergenceFamily() {
   for (const auto& [name, base] : bases) {
     for (double lambda : {1e-6, 1e-4, 1e-2, 1.0, 1e3}) {
       for (const Variant& variant : {kAllFree, kDeltaFixed, kDuffing, kOmegaFixed}) {
-        family.push_back(Member(name, StringPrintf("a*%g", lambda),
-                                InAmplitudeUnit(base, lambda), variant));
+        family.push_back(
+            Member(name, StringPrintf("a*%g", lambda), InAmplitudeUnit(base, lambda), variant));
       }
     }
     for (double s : {1e-2, 1e2}) {
@@ -138,8 +138,8 @@ std::vector<FamilyMember> ConvergenceFamily() {
       family.push_back(Member(name, "no-jumps", WithoutJumps(base), variant));
     }
     for (double lambda : {1e-6, 1.0, 1e3}) {
-      FamilyMember member = Member(name, StringPrintf("a*%g", lambda),
-                                   InAmplitudeUnit(base, lambda), kAllFree);
+      FamilyMember member =
+          Member(name, StringPrintf("a*%g", lambda), InAmplitudeUnit(base, lambda), kAllFree);
       member.name += " penalty";
       member.bifurcation_penalty = true;
       family.push_back(std::move(member));
@@ -160,7 +160,7 @@ IdentifyConfig MemberConfig(const IdentifyConfig& base, const FamilyMember& memb
   config.omega_ref_rad_s.reset();
   config.multi_start.starts = 1;
   if (member.bifurcation_penalty) {
-    BifurcationRangeOptions& range = config.identification.penalties.bifurcation_range;
+    BifurcationRangeOptions& range = config.identification.solve.penalties.bifurcation_range;
     range.enabled = true;
     range.enforce = {JumpTarget::kFrequencyJumpUp, JumpTarget::kFrequencyJumpDown,
                      JumpTarget::kAmplitudeJumpUp, JumpTarget::kAmplitudeJumpDown};
@@ -189,8 +189,8 @@ FamilyOutcome RunFamilyMember(const IdentifyConfig& base, const FamilyMember& me
       if (member.fixed[i]) continue;
       const double truth = member.plan.truth[i];
       const double error = std::abs(result.parameters[i] - truth) / std::abs(truth);
-      outcome.max_relative_error = std::isnan(error) ? error : std::max(outcome.max_relative_error,
-                                                                        error);
+      outcome.max_relative_error =
+          std::isnan(error) ? error : std::max(outcome.max_relative_error, error);
       if (std::isnan(error)) break;
     }
   } catch (const InputError& error) {

@@ -86,7 +86,7 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
   CoverageStudy study;
   study.replicas = options.replicas;
   study.method = options.method;
-  study.penalty = config.identification.penalties.bifurcation_range.enabled;
+  study.penalty = config.identification.solve.penalties.bifurcation_range.enabled;
   study.omega_ref_rad_s =
       config.omega_ref_rad_s ? *config.omega_ref_rad_s : plan.truth[kNaturalFrequency];
 
@@ -117,7 +117,7 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
     const ParameterUncertainty u =
         options.method == IntervalMethod::kProfile
             ? EstimateUncertaintyAtMinimum(run.fitted, run.options, study.omega_ref_rad_s, &result,
-                                           ResolveThreadCount(run.options.solver.num_threads))
+                                           ResolveThreadCount(run.options.solve.solver.num_threads))
             : EstimateUncertainty(run.fitted, run.options, result.parameters,
                                   study.omega_ref_rad_s, &result, options.method);
     study.refitted += result.final_cost != fitted_cost;

@@ -94,10 +94,10 @@ MethodFit FitMethod(const IdentifyConfig& config, const std::optional<std::vecto
       }
     }
   }
-  run.options.stages = method.stages;
-  run.options.penalties.branch_stability.enabled = false;
-  run.options.penalties.bifurcation_range.enabled = method.range_penalty;
-  run.options.penalties.bifurcation_range.weight *= method.range_weight;
+  run.options.solve.stages = method.stages;
+  run.options.solve.penalties.branch_stability.enabled = false;
+  run.options.solve.penalties.bifurcation_range.enabled = method.range_penalty;
+  run.options.solve.penalties.bifurcation_range.weight *= method.range_weight;
   MethodFit fit;
   const auto start = std::chrono::steady_clock::now();
   fit.result = FitRun(run).best;

@@ -38,7 +38,7 @@ IdentifyConfig VariantConfig(const IdentifyConfig& config, const ModelVariant& v
   IdentifyConfig copy = WithVariant(config, variant);
   copy.fit_sweeps = fit;
   copy.validate_sweeps.clear();
-  copy.identification.solver.num_threads = 1;
+  copy.identification.solve.solver.num_threads = 1;
   copy.multi_start.threads = 1;
   return copy;
 }

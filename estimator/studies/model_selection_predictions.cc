@@ -145,7 +145,7 @@ Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& m) {
 }
 
 bool Enforces(const IdentificationOptions& options, JumpKind kind) {
-  const BifurcationRangeOptions& range = options.penalties.bifurcation_range;
+  const BifurcationRangeOptions& range = options.solve.penalties.bifurcation_range;
   const JumpTarget target =
       kind == JumpKind::kJumpDown ? JumpTarget::kFrequencyJumpDown : JumpTarget::kFrequencyJumpUp;
   return range.enabled &&

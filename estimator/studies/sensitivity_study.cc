@@ -115,7 +115,7 @@ FitRow RunOneFit(const IdentifyConfig& config, const SensitivityOptions& options
     } else {
       run = ResolveRun(config);
     }
-    run.options.solver.num_threads = 1;
+    run.options.solve.solver.num_threads = 1;
     run.multi_start.threads = 1;
     FillEstimates(config, run, FitRun(run).best, options.standard_errors, &row);
   } catch (const InputError&) {

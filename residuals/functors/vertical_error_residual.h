@@ -40,17 +40,12 @@
 #include <cmath>
 
 #include "ceres/autodiff_cost_function.h"
+#include "dwellfit/residuals/functors/error_measure.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 #include "dwellfit/residuals/model/response_model.h"
 #include "dwellfit/residuals/model/stable_root.h"
 
 namespace dwellfit {
-
-// How the vertical error is measured.
-enum class ErrorMeasure {
-  kAbsolute,  // a_i - a_model (the data's length unit)
-  kRelative,  // ln(a_i + f) - ln(a_model + f), f the amplitude floor
-};
 
 // The measured side of the error as `error` measures it: a_i, or
 // ln(a_i + f) for the relative error (a constant of the dwell, formed once).

@@ -216,7 +216,7 @@ TEST_F(NoisyDatasets, IdentityMappedBlocksGiveTheOneBlocksCovariance) {
   IdentificationOptions options;
   options.initial = ThesisStart(kThesisTruth);
   options.fixed[kNaturalFrequency] = true;
-  options.residual.error = ErrorMeasure::kRelative;
+  options.solve.residual.error = ErrorMeasure::kRelative;
   const IdentificationResult fit = Identify(Pointers(*a_), options);
   ASSERT_TRUE(fit.IsSolutionUsable()) << fit.message;
   const ParameterUncertainty single =
@@ -225,7 +225,7 @@ TEST_F(NoisyDatasets, IdentityMappedBlocksGiveTheOneBlocksCovariance) {
 
   ThreeBlocks blocks(fit.parameters);
   const BlockCovariance mapped =
-      EstimateBlockCovariance(blocks.Describe(Pointers(*a_), true), options.residual);
+      EstimateBlockCovariance(blocks.Describe(Pointers(*a_), true), options.solve.residual);
   ASSERT_TRUE(mapped.available) << mapped.message;
   EXPECT_EQ(mapped.num_free, 5);
   EXPECT_EQ(mapped.degrees_of_freedom, single.degrees_of_freedom);
@@ -293,10 +293,10 @@ TEST_F(NoisyDatasets, APriorNarrowsItsEntryBelowTheDataAndThePrior) {
   IdentificationOptions options;
   options.initial = ThesisStart(kThesisTruth);
   options.fixed[kNaturalFrequency] = true;
-  options.residual.error = ErrorMeasure::kRelative;
+  options.solve.residual.error = ErrorMeasure::kRelative;
   ParameterVector p = Identify(Pointers(*a_), options).parameters;
   FitDescription fit = SingleBlockFit(Pointers(*a_), options.fixed, &p);
-  const BlockCovariance data = EstimateBlockCovariance(fit, options.residual);
+  const BlockCovariance data = EstimateBlockCovariance(fit, options.solve.residual);
   ASSERT_TRUE(data.available) << data.message;
   const double prior_sigma = data.standard_error[kMu1];  // as good as the data
   fit.add_residuals = [&](ceres::Problem* problem) {
@@ -306,7 +306,7 @@ TEST_F(NoisyDatasets, APriorNarrowsItsEntryBelowTheDataAndThePrior) {
     for (int i = 0; i < kNumParameters; ++i) mean[i] = p[i];
     problem->AddResidualBlock(new ceres::NormalPrior(inverse_sigma, mean), nullptr, p.data());
   };
-  const BlockCovariance with_prior = EstimateBlockCovariance(fit, options.residual);
+  const BlockCovariance with_prior = EstimateBlockCovariance(fit, options.solve.residual);
   ASSERT_TRUE(with_prior.available) << with_prior.message;
   EXPECT_EQ(with_prior.caller_residuals, 1);
   EXPECT_THAT(with_prior.message, HasSubstr("1 residual(s) of the caller's"));
@@ -318,12 +318,12 @@ TEST_F(NoisyDatasets, APriorNarrowsItsEntryBelowTheDataAndThePrior) {
   // any size: the dense Jacobian's covariance.
   Eigen::MatrixXd prior_row = Eigen::MatrixXd::Zero(1, kNumParameters);
   prior_row(0, kMu1) = 1.0 / prior_sigma;
-  const DenseResult dense = DenseCovariance(fit, options.residual, prior_row);
+  const DenseResult dense = DenseCovariance(fit, options.solve.residual, prior_row);
   for (int chunk_rows : kChunkRows) {
     SCOPED_TRACE(chunk_rows);
     BlockCovarianceOptions chunked;
     chunked.chunk_rows = chunk_rows;
-    const BlockCovariance c = EstimateBlockCovariance(fit, options.residual, chunked);
+    const BlockCovariance c = EstimateBlockCovariance(fit, options.solve.residual, chunked);
     ASSERT_TRUE(c.available) << c.message;
     EXPECT_EQ(c.caller_residuals, 1);
     EXPECT_NEAR(c.collinearity, dense.collinearity, 1e-9 * dense.collinearity);

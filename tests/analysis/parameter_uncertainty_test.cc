@@ -159,7 +159,7 @@ TEST_F(UncertaintyThesisNumerical, PointSigmasStandardiseTheResidualsAndUseTheNo
     for (DwellPoint& point : sweep.points) point.sigma = 0.01 * point.amplitude;
   }
   IdentificationOptions options = config_.identification;
-  options.residual.use_point_sigma = true;
+  options.solve.residual.use_point_sigma = true;
   const ParameterUncertainty given =
       EstimateUncertainty(fitted, options, result.parameters, omega_ref_, nullptr, IntervalMethod::kLinearised);
   ASSERT_TRUE(given.available) << given.message;
@@ -356,7 +356,7 @@ void UncertaintyThesisNumerical::CheckPenalisedLinearisation(std::uint64_t seed)
   SCOPED_TRACE("seed " + std::to_string(seed));
   const ResolvedRun noisy = NoisyRun(seed);  // fits that keep every branch label
   IdentificationOptions options = config_.identification;
-  options.penalties.bifurcation_range.enabled = true;
+  options.solve.penalties.bifurcation_range.enabled = true;
   const IdentificationResult result = Identify(noisy.fitted, options);
   EXPECT_TRUE(result.converged) << result.message;
   const ParameterVector& p = result.parameters;
@@ -374,7 +374,7 @@ void UncertaintyThesisNumerical::CheckPenalisedLinearisation(std::uint64_t seed)
   const StageSummary& stage = result.stages.back();
   EXPECT_EQ(stage.penalty_exponent, 10);
   // The fit hands on the weight it used, in the cost's units.
-  const double weight = options.penalties.bifurcation_range.weight * stage.penalty_unit;
+  const double weight = options.solve.penalties.bifurcation_range.weight * stage.penalty_unit;
   EXPECT_DOUBLE_EQ(stage.penalties.bifurcation_range.weight, weight);
   const double s2 = data.noise_sigma * data.noise_sigma;
   // Free parameters only (omega is fixed), scaled by their values.

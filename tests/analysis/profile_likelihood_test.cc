@@ -136,9 +136,9 @@ TEST_P(ProfileOfEveryBundledDataset, FindsNoCostBelowTheReportedMinimum) {
   ProfileProblem problem;
   problem.fitted = run.fitted;
   problem.fixed = run.options.fixed;
-  problem.residual = run.options.residual;
+  problem.residual = run.options.solve.residual;
   problem.penalties = result.stages.back().penalties;
-  problem.solver = run.options.solver;
+  problem.solver = run.options.solve.solver;
   problem.omega_ref_rad_s = omega_ref;
   problem.threshold = u.interval_kind == "profile_likelihood"
                           ? u.profile.threshold

@@ -97,13 +97,13 @@ TEST(ConfigOverrides, ChangeTheValuesOfTheFile) {
       {"effective_nonlinearity_reference_hz", "null", "--set"},
   };
   const IdentifyConfig config = LoadIdentifyConfig(path, overrides);
-  EXPECT_EQ(config.identification.solver.max_iterations, 50);
-  EXPECT_EQ(config.identification.solver.num_threads, 2);  // the rest of the block stays
+  EXPECT_EQ(config.identification.solve.solver.max_iterations, 50);
+  EXPECT_EQ(config.identification.solve.solver.num_threads, 2);  // the rest of the block stays
   EXPECT_EQ(config.identification.initial[kMu1], 0.3);
   EXPECT_EQ(config.identification.initial[kEtaE], 130.0);
   EXPECT_THAT(config.identification.fixed, ElementsAre(false, false, false, true, false, true));
-  EXPECT_THAT(config.identification.stages, ElementsAre(ResidualKind::kVertical));
-  EXPECT_EQ(config.identification.residual.error, ErrorMeasure::kAbsolute);
+  EXPECT_THAT(config.identification.solve.stages, ElementsAre(ResidualKind::kVertical));
+  EXPECT_EQ(config.identification.solve.residual.error, ErrorMeasure::kAbsolute);
   EXPECT_EQ(config.output_dir, "/tmp/x");
   EXPECT_FALSE(config.omega_ref_rad_s.has_value());
   EXPECT_EQ(config.overrides.size(), overrides.size());
@@ -332,15 +332,15 @@ TEST(ConfigOverrides, SetOnAnAliasedBlockChangesOnlyTheNamedPath) {
   const std::string path = dir.WriteConfig(
       Replace(kValidConfig, "output_dir:", std::string(kAliasedPenalties) + "output_dir:"));
   IdentifyConfig config = LoadIdentifyConfig(path);
-  EXPECT_EQ(config.identification.penalties.branch_stability.weight, 2.0);  // the alias reads
+  EXPECT_EQ(config.identification.solve.penalties.branch_stability.weight, 2.0);  // the alias reads
   config = LoadIdentifyConfig(path, ParseSetFlag("penalties.branch_stability.weight=5", "--set"));
-  EXPECT_EQ(config.identification.penalties.branch_stability.weight, 5.0);
-  EXPECT_EQ(config.identification.penalties.bifurcation_range.weight, 2.0);
-  EXPECT_TRUE(config.identification.penalties.branch_stability.enabled);
+  EXPECT_EQ(config.identification.solve.penalties.branch_stability.weight, 5.0);
+  EXPECT_EQ(config.identification.solve.penalties.bifurcation_range.weight, 2.0);
+  EXPECT_TRUE(config.identification.solve.penalties.branch_stability.enabled);
   config = LoadIdentifyConfig(path,
                               ParseSetFlag("penalties.branch_stability={enabled: false}", "--set"));
-  EXPECT_FALSE(config.identification.penalties.branch_stability.enabled);
-  EXPECT_TRUE(config.identification.penalties.bifurcation_range.enabled);
+  EXPECT_FALSE(config.identification.solve.penalties.branch_stability.enabled);
+  EXPECT_TRUE(config.identification.solve.penalties.bifurcation_range.enabled);
   // A value the override did not set still names its line in the file.
   const std::string bad = dir.WriteFile(
       "bad.yaml",

@@ -33,7 +33,7 @@ constexpr char kPenalties[] = R"(penalties:
 TEST(ConfigPenalties, BlockLandsInPenaltyOptions) {
   const ConfigDirectory dir;
   const IdentifyConfig config = LoadIdentifyConfig(dir.WriteConfig(ConfigWith(kPenalties)));
-  const PenaltyOptions& penalties = config.identification.penalties;
+  const PenaltyOptions& penalties = config.identification.solve.penalties;
   EXPECT_TRUE(penalties.bifurcation_range.enabled);
   EXPECT_EQ(penalties.bifurcation_range.exponent, 6);
   EXPECT_EQ(penalties.bifurcation_range.weight, 2.5);
@@ -51,7 +51,7 @@ TEST(ConfigPenalties, BlockLandsInPenaltyOptions) {
 TEST(ConfigPenalties, MissingKeysTakeTheDocumentedDefaults) {
   const ConfigDirectory dir;
   IdentifyConfig config = LoadIdentifyConfig(dir.WriteConfig(kValidConfig));
-  const PenaltyOptions* penalties = &config.identification.penalties;
+  const PenaltyOptions* penalties = &config.identification.solve.penalties;
   EXPECT_FALSE(penalties->bifurcation_range.enabled);
   EXPECT_EQ(penalties->bifurcation_range.exponent, 10);
   EXPECT_EQ(penalties->bifurcation_range.weight, 1.0);
@@ -64,7 +64,7 @@ TEST(ConfigPenalties, MissingKeysTakeTheDocumentedDefaults) {
   // A block that sets one key keeps the documented values of the others.
   config = LoadIdentifyConfig(
       dir.WriteConfig(ConfigWith("penalties:\n  branch_stability:\n    enabled: true\n")));
-  penalties = &config.identification.penalties;
+  penalties = &config.identification.solve.penalties;
   EXPECT_TRUE(penalties->branch_stability.enabled);
   EXPECT_EQ(penalties->branch_stability.lambda, 50.0);
   EXPECT_EQ(penalties->branch_stability.weight, 1.0);
@@ -73,7 +73,7 @@ TEST(ConfigPenalties, MissingKeysTakeTheDocumentedDefaults) {
   // An empty enforce list enforces no jump.
   config = LoadIdentifyConfig(
       dir.WriteConfig(ConfigWith("penalties:\n  bifurcation_range:\n    enforce: []\n")));
-  EXPECT_TRUE(config.identification.penalties.bifurcation_range.enforce.empty());
+  EXPECT_TRUE(config.identification.solve.penalties.bifurcation_range.enforce.empty());
 }
 
 TEST(ConfigPenalties, InvalidValuesAreReportedAtTheirBlock) {
@@ -147,14 +147,14 @@ TEST(ConfigPenalties, OverridesSetAndCheckPenalties) {
       LoadIdentifyConfig(path, ParseSetFlag("penalties.bifurcation_range.enabled=false,"
                                             "penalties.branch_stability.lambda=80",
                                             "--set"));
-  EXPECT_FALSE(config.identification.penalties.bifurcation_range.enabled);
-  EXPECT_EQ(config.identification.penalties.bifurcation_range.exponent, 6);  // from the file
-  EXPECT_EQ(config.identification.penalties.branch_stability.lambda, 80.0);
+  EXPECT_FALSE(config.identification.solve.penalties.bifurcation_range.enabled);
+  EXPECT_EQ(config.identification.solve.penalties.bifurcation_range.exponent, 6);  // from the file
+  EXPECT_EQ(config.identification.solve.penalties.branch_stability.lambda, 80.0);
 
   // A block the file lacks is created.
   config = LoadIdentifyConfig(dir.WriteFile("lacks.yaml", kValidConfig),
                               ParseSetFlag("penalties.branch_stability.enabled=true", "--set"));
-  EXPECT_TRUE(config.identification.penalties.branch_stability.enabled);
+  EXPECT_TRUE(config.identification.solve.penalties.branch_stability.enabled);
 
   // An invalid value set on the command line names the flag.
   InputError error = ErrorOf([&] {
@@ -181,8 +181,8 @@ TEST(ConfigPenalties, PrintedConfigRoundTrips) {
                               "amplitude_jump_down]\n  branch_stability:\n    enabled: true\n"
                               "    lambda: 30\n    weight: 0.5\n"));
   const IdentifyConfig reloaded = LoadIdentifyConfig(dir.WriteFile("in_effect.yaml", yaml));
-  const PenaltyOptions& a = loaded.identification.penalties;
-  const PenaltyOptions& b = reloaded.identification.penalties;
+  const PenaltyOptions& a = loaded.identification.solve.penalties;
+  const PenaltyOptions& b = reloaded.identification.solve.penalties;
   EXPECT_EQ(b.bifurcation_range.enabled, a.bifurcation_range.enabled);
   EXPECT_EQ(b.bifurcation_range.exponent, a.bifurcation_range.exponent);
   EXPECT_EQ(b.bifurcation_range.weight, a.bifurcation_range.weight);

@@ -66,14 +66,14 @@ TEST(LoadIdentifyConfig, ValidConfigLandsInTheStructs) {
   EXPECT_EQ(options.initial[kAlpha], 1.17e9);
   EXPECT_DOUBLE_EQ(options.initial[kNaturalFrequency], 2.0 * M_PI * 40.0);  // Hz -> rad/s
   EXPECT_THAT(options.fixed, ElementsAre(false, false, false, false, false, true));
-  EXPECT_THAT(options.stages, ElementsAre(ResidualKind::kAlgebraic, ResidualKind::kVertical));
-  EXPECT_EQ(options.residual.error, ErrorMeasure::kRelative);
-  EXPECT_FALSE(options.residual.use_point_sigma);
-  EXPECT_EQ(options.solver.max_iterations, 150);
-  EXPECT_EQ(options.solver.function_tolerance, 1e-12);
-  EXPECT_EQ(options.solver.gradient_tolerance, 1e-25);
-  EXPECT_EQ(options.solver.parameter_tolerance, 1e-18);
-  EXPECT_EQ(options.solver.num_threads, 2);
+  EXPECT_THAT(options.solve.stages, ElementsAre(ResidualKind::kAlgebraic, ResidualKind::kVertical));
+  EXPECT_EQ(options.solve.residual.error, ErrorMeasure::kRelative);
+  EXPECT_FALSE(options.solve.residual.use_point_sigma);
+  EXPECT_EQ(options.solve.solver.max_iterations, 150);
+  EXPECT_EQ(options.solve.solver.function_tolerance, 1e-12);
+  EXPECT_EQ(options.solve.solver.gradient_tolerance, 1e-25);
+  EXPECT_EQ(options.solve.solver.parameter_tolerance, 1e-18);
+  EXPECT_EQ(options.solve.solver.num_threads, 2);
   EXPECT_EQ(config.jump_detection.min_ratio, 3.0);
   EXPECT_EQ(config.jump_detection.min_relative_amplitude, 0.25);
   ASSERT_TRUE(config.omega_ref_rad_s.has_value());
@@ -97,18 +97,18 @@ output_dir: out
   EXPECT_EQ(config.fit_sweeps[0].direction, SweepDirection::kUp);
   EXPECT_TRUE(config.validate_sweeps.empty());
   for (int i = 0; i < kNumParameters; ++i) EXPECT_FALSE(options.fixed[i]) << i;  // all free
-  EXPECT_THAT(options.stages, ElementsAre(ResidualKind::kAlgebraic, ResidualKind::kVertical));
-  EXPECT_EQ(options.residual.error, ErrorMeasure::kAbsolute);
-  EXPECT_TRUE(options.residual.use_point_sigma);
-  EXPECT_EQ(options.residual.amplitude_floor, 0.0);
-  EXPECT_EQ(options.solver.max_iterations, 200);
-  EXPECT_EQ(options.solver.function_tolerance, 1e-8);
-  EXPECT_EQ(options.solver.start_function_tolerance, 1e-5);
-  EXPECT_EQ(options.solver.gradient_tolerance, 1e-30);
-  EXPECT_EQ(options.solver.parameter_tolerance, 1e-20);
-  EXPECT_EQ(options.solver.num_threads, 0);
-  EXPECT_FALSE(options.solver.nonmonotonic_steps);
-  EXPECT_TRUE(options.solver.valley_polish);
+  EXPECT_THAT(options.solve.stages, ElementsAre(ResidualKind::kAlgebraic, ResidualKind::kVertical));
+  EXPECT_EQ(options.solve.residual.error, ErrorMeasure::kAbsolute);
+  EXPECT_TRUE(options.solve.residual.use_point_sigma);
+  EXPECT_EQ(options.solve.residual.amplitude_floor, 0.0);
+  EXPECT_EQ(options.solve.solver.max_iterations, 200);
+  EXPECT_EQ(options.solve.solver.function_tolerance, 1e-8);
+  EXPECT_EQ(options.solve.solver.start_function_tolerance, 1e-5);
+  EXPECT_EQ(options.solve.solver.gradient_tolerance, 1e-30);
+  EXPECT_EQ(options.solve.solver.parameter_tolerance, 1e-20);
+  EXPECT_EQ(options.solve.solver.num_threads, 0);
+  EXPECT_FALSE(options.solve.solver.nonmonotonic_steps);
+  EXPECT_TRUE(options.solve.solver.valley_polish);
   EXPECT_EQ(config.multi_start.starts, 1);
   EXPECT_EQ(config.multi_start.spread, 3.0);
   EXPECT_EQ(config.multi_start.seed, 1u);
@@ -155,15 +155,17 @@ TEST(ConfigToYaml, RoundTripsThroughLoadIdentifyConfig) {
         << ParameterName(i);
   }
   EXPECT_EQ(reloaded.identification.fixed, loaded.identification.fixed);
-  EXPECT_EQ(reloaded.identification.stages, loaded.identification.stages);
-  EXPECT_EQ(reloaded.identification.residual.error, loaded.identification.residual.error);
-  EXPECT_EQ(reloaded.identification.residual.use_point_sigma,
-            loaded.identification.residual.use_point_sigma);
-  EXPECT_EQ(reloaded.identification.solver.max_iterations,
-            loaded.identification.solver.max_iterations);
-  EXPECT_EQ(reloaded.identification.solver.gradient_tolerance,
-            loaded.identification.solver.gradient_tolerance);
-  EXPECT_EQ(reloaded.identification.solver.num_threads, loaded.identification.solver.num_threads);
+  EXPECT_EQ(reloaded.identification.solve.stages, loaded.identification.solve.stages);
+  EXPECT_EQ(reloaded.identification.solve.residual.error,
+            loaded.identification.solve.residual.error);
+  EXPECT_EQ(reloaded.identification.solve.residual.use_point_sigma,
+            loaded.identification.solve.residual.use_point_sigma);
+  EXPECT_EQ(reloaded.identification.solve.solver.max_iterations,
+            loaded.identification.solve.solver.max_iterations);
+  EXPECT_EQ(reloaded.identification.solve.solver.gradient_tolerance,
+            loaded.identification.solve.solver.gradient_tolerance);
+  EXPECT_EQ(reloaded.identification.solve.solver.num_threads,
+            loaded.identification.solve.solver.num_threads);
   EXPECT_EQ(reloaded.jump_detection.min_relative_amplitude,
             loaded.jump_detection.min_relative_amplitude);
   EXPECT_DOUBLE_EQ(*reloaded.omega_ref_rad_s, *loaded.omega_ref_rad_s);
@@ -178,11 +180,11 @@ TEST(LoadIdentifyConfig, StartFunctionToleranceIsReadAndShown) {
   const std::string line = "  function_tolerance: 1e-12\n";
   ASSERT_NE(text.find(line), std::string::npos);
   const std::string path = dir.WriteConfig(text);
-  EXPECT_EQ(LoadIdentifyConfig(path).identification.solver.start_function_tolerance,
+  EXPECT_EQ(LoadIdentifyConfig(path).identification.solve.solver.start_function_tolerance,
             1e-5);  // config/README.md's default
   text.replace(text.find(line), line.size(), line + "  start_function_tolerance: 1e-3\n");
   const IdentifyConfig config = LoadIdentifyConfig(dir.WriteConfig(text));
-  EXPECT_EQ(config.identification.solver.start_function_tolerance, 1e-3);
+  EXPECT_EQ(config.identification.solve.solver.start_function_tolerance, 1e-3);
   EXPECT_THAT(ConfigToYaml(config), HasSubstr("start_function_tolerance: 0.001"));
 }
 
@@ -193,11 +195,11 @@ TEST(LoadIdentifyConfig, ValleyPolishIsReadAndShown) {
   const std::string line = "  max_iterations: 150\n";
   ASSERT_NE(std::string(kValidConfig).find(line), std::string::npos);
   const IdentifyConfig by_default = LoadIdentifyConfig(dir.WriteConfig(kValidConfig));
-  EXPECT_TRUE(by_default.identification.solver.valley_polish);
+  EXPECT_TRUE(by_default.identification.solve.solver.valley_polish);
   EXPECT_THAT(ConfigToYaml(by_default), HasSubstr("valley_polish: true"));
   const IdentifyConfig off = LoadIdentifyConfig(
       dir.WriteConfig(Replace(kValidConfig, line, line + "  valley_polish: false\n")));
-  EXPECT_FALSE(off.identification.solver.valley_polish);
+  EXPECT_FALSE(off.identification.solve.solver.valley_polish);
   EXPECT_THAT(ConfigToYaml(off), HasSubstr("valley_polish: false"));
   std::string path;
   const InputError error = ErrorWith(dir, line, line + "  valley_polish: sometimes\n", &path);
@@ -234,9 +236,9 @@ TEST(ConfigReadme, AnnotatedExampleLoads) {
   const IdentifyConfig config = LoadIdentifyConfig(dir.WriteConfig(ReadmeExample()));
   EXPECT_THAT(Names(config.fit_sweeps), ElementsAre("F0.01", "A41.5"));
   EXPECT_DOUBLE_EQ(config.identification.initial[kNaturalFrequency], HzToRadPerSecond(40.0));
-  EXPECT_EQ(config.identification.solver.max_iterations, 200);
-  EXPECT_TRUE(config.identification.penalties.bifurcation_range.enabled);
-  EXPECT_FALSE(config.identification.penalties.branch_stability.enabled);
+  EXPECT_EQ(config.identification.solve.solver.max_iterations, 200);
+  EXPECT_TRUE(config.identification.solve.penalties.bifurcation_range.enabled);
+  EXPECT_FALSE(config.identification.solve.penalties.branch_stability.enabled);
   // The example spells out the jump-detection defaults of the README's table.
   EXPECT_EQ(config.jump_detection.min_ratio, 1.07);
   EXPECT_EQ(config.jump_detection.min_relative_amplitude, 0.2);

@@ -100,8 +100,8 @@ TEST_F(ClampedBeamIdentification, Mu2IsHeldOnItsBoundWhereTheCostPushesItOutward
   ParameterVector p;
   std::copy(held_stage->values.begin(), held_stage->values.end(), p.begin());
   ProblemBuilderOptions options;
-  options.residual_options = config_->identification.residual;
-  options.penalties = config_->identification.penalties;
+  options.residual_options = config_->identification.solve.residual;
+  options.penalties = config_->identification.solve.penalties;
   options.penalties.bifurcation_range.exponent = held_stage->penalty_exponent;
   options.penalties.bifurcation_range.weight *= held_stage->penalty_unit;
   const ProblemBuilder builder(options);
@@ -127,10 +127,10 @@ TEST_F(ClampedBeamIdentification, Mu2IsHeldOnItsBoundWhereTheCostPushesItOutward
 // steps the fit now ends 0.013 % below the committed cost, 0.02 Hz away in w.
 TEST_F(ClampedBeamIdentification, SameMinimumWithoutNonmonotonicStepsOrTheAlgebraicStage) {
   IdentificationOptions monotonic = config_->identification;
-  monotonic.solver.nonmonotonic_steps = false;
+  monotonic.solve.solver.nonmonotonic_steps = false;
   IdentificationOptions vertical_only = config_->identification;
-  vertical_only.stages = {ResidualKind::kVertical};
-  vertical_only.algebraic_start_candidate = false;  // no algebraic stage at all
+  vertical_only.solve.stages = {ResidualKind::kVertical};
+  vertical_only.solve.algebraic_start_candidate = false;  // no algebraic stage at all
   for (const IdentificationOptions& options : {monotonic, vertical_only}) {
     const IdentificationResult fit = Identify(data_->fitted, options);
     std::cout << "final cost " << fit.final_cost << " against " << committed_->final_cost << "\n";
@@ -150,7 +150,7 @@ TEST_F(ClampedBeamIdentification, SameMinimumWithoutNonmonotonicStepsOrTheAlgebr
 TEST_F(ClampedBeamIdentification, AVerticalStageAloneKeepsAGivenStartBetterThanTheStartStages) {
   IdentificationOptions options = config_->identification;
   options.initial = committed_->parameters;
-  options.stages = {ResidualKind::kVertical};
+  options.solve.stages = {ResidualKind::kVertical};
   const IdentificationResult fit = Identify(data_->fitted, options);
   ASSERT_GE(fit.stages.size(), 2u);
   EXPECT_TRUE(fit.stages[0].start_stage);
@@ -169,9 +169,9 @@ TEST_F(ClampedBeamIdentification, AVerticalStageAloneKeepsAGivenStartBetterThanT
 // Ceres in block order: the fit is bitwise the same on 1 and on 3 threads.
 TEST_F(ClampedBeamIdentification, ResultDoesNotDependOnTheThreadCount) {
   IdentificationOptions one = config_->identification;
-  one.solver.num_threads = 1;
+  one.solve.solver.num_threads = 1;
   IdentificationOptions three = config_->identification;
-  three.solver.num_threads = 3;
+  three.solve.solver.num_threads = 3;
   const IdentificationResult a = Identify(data_->fitted, one);
   const IdentificationResult b = Identify(data_->fitted, three);
   EXPECT_EQ(a.parameters, b.parameters);

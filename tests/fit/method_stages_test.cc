@@ -102,7 +102,7 @@ IdentificationResult FitWithoutStartStage(const std::string& stages, const std::
     for (const ConfigOverride& o : ParseSetFlag(set, "--set")) overrides.push_back(o);
   }
   ResolvedRun run = ResolveRun(LoadIdentifyConfig(kThesis + "/beam.yaml", overrides));
-  run.options.algebraic_start_candidate = false;
+  run.options.solve.algebraic_start_candidate = false;
   const IdentificationResult result = FitRun(run).best;
   std::cout << stages << (set.empty() ? " from the config's start" : " from the data's")
             << " without the start stage: final cost " << result.final_cost << ", mu1 "

@@ -84,11 +84,11 @@ TEST_F(StagedSolve, InvalidIdentificationAndMultiStartOptionsNameTheField) {
   EXPECT_THAT(result.message, HasSubstr("initial.mu2 must be a finite number"));
 
   options.initial = ThesisStart(kThesisTruth);
-  options.solver.parameter_tolerance = -1.0;
+  options.solve.solver.parameter_tolerance = -1.0;
   EXPECT_THAT(Identify(Pointers(sweeps_), options).message,
               HasSubstr("solver.parameter_tolerance"));
 
-  options.solver = SolverSettings{};
+  options.solve.solver = SolverSettings{};
   MultiStartOptions multi_start;
   multi_start.spread = 1.0;
   const MultiStartResult multi = IdentifyMultiStart(Pointers(sweeps_), options, {}, multi_start);
@@ -184,13 +184,12 @@ TEST_F(StagedSolve, MappedBlocksGiveTheSingleBlocksAnswerWhenTheMappingIsTheIden
   IdentificationOptions options;
   options.initial = ThesisStart(kThesisTruth);
   options.fixed[kNaturalFrequency] = true;
-  options.residual.error = ErrorMeasure::kRelative;
+  options.solve.residual.error = ErrorMeasure::kRelative;
   const IdentificationResult single = Identify(Pointers(sweeps_), options);
   ASSERT_EQ(single.status, FitStatus::kConverged) << single.message;
 
   ThreeBlocks blocks(options.initial);
-  const FitSummary mapped =
-      SolveStaged(blocks.Describe(Pointers(sweeps_), true), options.SolveOptions());
+  const FitSummary mapped = SolveStaged(blocks.Describe(Pointers(sweeps_), true), options.solve);
   ASSERT_EQ(mapped.status, FitStatus::kConverged) << mapped.message;
   const ParameterVector estimate = blocks.Values();
   for (int i = 0; i < kNumParameters; ++i) {

@@ -56,8 +56,8 @@ TEST_F(ThesisNumerical, CommittedConfigStartsAtTheFirstStartOfTheIssue) {
 // truth with nothing held.
 TEST_F(ThesisNumerical, AParameterHeldOnItsBoundIsReleasedWhenTheCostPullsItBack) {
   IdentificationOptions options = StartAt({0.5, 1.0, 1.0, 1.0, 1.0});
-  options.stages = {ResidualKind::kVertical};
-  options.algebraic_start_candidate = false;  // the vertical stage from this start
+  options.solve.stages = {ResidualKind::kVertical};
+  options.solve.algebraic_start_candidate = false;  // the vertical stage from this start
   const IdentificationResult result = Identify(fitted_, options);
   ASSERT_EQ(result.stages.size(), 1u);
   const StageSummary& stage = result.stages.front();
@@ -91,8 +91,8 @@ TEST_F(ThesisNumerical,
   for (const std::vector<double>& factors : {std::vector<double>{1.3, 0.7, 1.3, 0.7, 1.3},
                                              std::vector<double>{0.7, 1.3, 0.7, 1.3, 0.7}}) {
     IdentificationOptions options = StartAt(factors);
-    options.penalties.bifurcation_range.enabled = true;
-    options.penalties.branch_stability.enabled = true;
+    options.solve.penalties.bifurcation_range.enabled = true;
+    options.solve.penalties.branch_stability.enabled = true;
     const IdentificationResult result = Identify(fitted_, options);
     EXPECT_TRUE(result.converged);
     for (int i = 0; i < 5; ++i) {
@@ -115,9 +115,9 @@ TEST_F(ThesisNumerical, VerticalErrorAloneFromTheFirstStartEndsAtAWrongMinimum) 
   // stage gets the algebraic start stage: without either, the damping
   // collapses (the issue's observation, kept as a regression guard).
   IdentificationOptions options = StartAt({1.3, 0.7, 1.3, 0.7, 1.3});
-  options.stages = {ResidualKind::kVertical};
-  options.algebraic_start_candidate = false;
-  options.penalties = PenaltyOptions{};  // none
+  options.solve.stages = {ResidualKind::kVertical};
+  options.solve.algebraic_start_candidate = false;
+  options.solve.penalties = PenaltyOptions{};  // none
   const IdentificationResult result = Identify(fitted_, options);
   EXPECT_GT(std::abs(result.parameters[kMu2] / kTruth[kMu2] - 1.0), 0.1);
 }

@@ -186,8 +186,8 @@ class LargeSweep : public ::testing::Test {
     IdentificationOptions options;
     options.initial = {130.0, 0.14, 390.0, 7000.0, 1.17e9, HzToRadPerSecond(40.0)};
     options.fixed[kNaturalFrequency] = true;
-    options.residual.error = ErrorMeasure::kRelative;
-    options.solver.valley_polish = valley_polish;
+    options.solve.residual.error = ErrorMeasure::kRelative;
+    options.solve.solver.valley_polish = valley_polish;
     return Identify({&(*sweeps_)[0], &(*sweeps_)[1]}, options);
   }
 

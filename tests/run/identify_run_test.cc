@@ -57,7 +57,7 @@ TEST(RunIdentify, WithoutRenderingWritesTheScriptButNoImage) {
   const YAML::Node in_effect = result["config_in_effect"];
   EXPECT_EQ(in_effect["fit"].size(), 2u);
   EXPECT_EQ(in_effect["solver"]["function_tolerance"].as<double>(),
-            config.identification.solver.function_tolerance);
+            config.identification.solve.solver.function_tolerance);
   EXPECT_EQ(in_effect["initial_guess"]["mu1"].as<double>(), *config.initial_guess[kMu1]);
   EXPECT_FALSE(in_effect["output_dir"]);
   EXPECT_FALSE(in_effect["solver"]["num_threads"]);

@@ -120,25 +120,33 @@ TEST(ResolveRun, NoResonanceToStartFromIsAnInputErrorNamingTheInitialGuess) {
   EXPECT_THAT(error.what(), HasSubstr("give the initial guesses in the config"));
 }
 
-// LoadIdentifyConfig checks every settings block at its line; a config built
-// or changed in code is checked again, naming the field.
-TEST(ResolveRun, InvalidSettingsBuiltInCodeAreInputErrorsNamingTheField) {
+// LoadIdentifyConfig checks every settings block at its line. A config built
+// or changed in code is checked where each block enters the library, once:
+// the jump detection by ResolveRun (an InputError naming the field), the
+// fit's options by the fit (a run ending in kInvalidInput, its message
+// naming the field).
+TEST(ResolveRun, InvalidJumpDetectionBuiltInCodeIsAnInputErrorNamingTheField) {
+  IdentifyConfig config = LoadIdentifyConfig(kConfig);
+  config.jump_detection.min_ratio = 1.0;
+  const InputError error = ErrorOf([&] { ResolveRun(config); });
+  EXPECT_EQ(error.file(), config.config_path);
+  EXPECT_EQ(error.field(), "jump_detection");
+}
+
+TEST(FitRun, InvalidFitOptionsBuiltInCodeEndInvalidInputNamingTheField) {
   const IdentifyConfig loaded = LoadIdentifyConfig(kConfig);
   IdentifyConfig solver = loaded;
-  solver.identification.solver.max_iterations = 0;
+  solver.identification.solve.solver.max_iterations = 0;
   IdentifyConfig multi_start = loaded;
   multi_start.multi_start.starts = 0;
-  IdentifyConfig jump_detection = loaded;
-  jump_detection.jump_detection.min_ratio = 1.0;
   IdentifyConfig start = loaded;
   start.identification.initial[kEtaE] = 0.0;
-  for (const auto& [config, field] : {std::pair{&solver, "solver"},
-                                      {&multi_start, "multi_start"},
-                                      {&jump_detection, "jump_detection"},
-                                      {&start, "initial_guess"}}) {
-    const InputError error = ErrorOf([&] { ResolveRun(*config); });
-    EXPECT_EQ(error.file(), loaded.config_path) << field;
-    EXPECT_EQ(error.field(), field);
+  for (const auto& [config, field] : {std::pair{&solver, "solver.max_iterations"},
+                                      {&multi_start, "multi_start.starts"},
+                                      {&start, "initial.eta_e"}}) {
+    const MultiStartResult fit = FitRun(ResolveRun(*config));
+    EXPECT_EQ(fit.best.status, FitStatus::kInvalidInput) << field;
+    EXPECT_THAT(fit.best.message, HasSubstr(field));
   }
 }
 
