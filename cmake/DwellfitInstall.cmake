@@ -25,7 +25,7 @@ install(TARGETS ${dwellfit_library_targets} dwellfit
 # jump_detection.h to label them), describe a fit (fit_description.h,
 # identification_options.h, initial_guess.h), solve it (identification.h,
 # staged_solve.h), read the result with its intervals (parameter_uncertainty.h,
-# block_covariance.h), draw curves (response_curve.h) and simulate dwells
+# profile_likelihood.h, block_covariance.h), draw curves (response_curve.h) and simulate dwells
 # (dwell_simulator.h); then what those include: the header-only model
 # (residuals/model) and the shared small headers. Every one must compile on its
 # own against the installed tree, including only headers of this list (the
@@ -33,6 +33,7 @@ install(TARGETS ${dwellfit_library_targets} dwellfit
 set(DWELLFIT_PUBLIC_HEADERS
     estimator/analysis/block_covariance.h
     estimator/analysis/parameter_uncertainty.h
+    estimator/analysis/profile_likelihood.h
     estimator/common/input_error.h
     estimator/curves/response_curve.h
     estimator/data/jump_detection.h

@@ -31,13 +31,14 @@ int main(int argc, char** argv) {
     dwellfit::IdentificationOptions options;
     options.initial = dwellfit::AutomaticInitialGuess(fitted, {}).guess;
     options.solve.residual.error = dwellfit::ErrorMeasure::kRelative;
-    const dwellfit::IdentificationResult fit = dwellfit::Identify(fitted, options);
+    dwellfit::IdentificationResult fit = dwellfit::Identify(fitted, options);
+
+    // 3. The estimates with their 95 % intervals: identify's, the profile of
+    // the fitted cost (the fit goes on where a profile finds a lower cost).
+    const dwellfit::ParameterUncertainty u =
+        dwellfit::EstimateUncertaintyAtMinimum(fitted, options, 0.0, &fit);
     std::printf("%s: %s\n", dwellfit::FitStatusName(fit.status), fit.message.c_str());
     if (!fit.converged) return 1;
-
-    // 3. The estimates with their 95 % intervals (linearised at the estimate).
-    const dwellfit::ParameterUncertainty u =
-        dwellfit::EstimateUncertainty(fitted, options, fit.parameters, 0.0, &fit);
     if (!u.available) {
       std::printf("no intervals: %s\n", u.message.c_str());
       return 1;
