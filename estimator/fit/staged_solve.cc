@@ -684,6 +684,16 @@ std::string CheckMinimum(const SolveContext& context, FitSummary* summary, bool*
   return "";
 }
 
+// The summary of a solve that could not evaluate its cost: `why`, the
+// blocks where that solve stopped.
+FitSummary EvaluationFailed(const std::string& why, FitSummary* summary) {
+  summary->status = FitStatus::kFailure;
+  summary->evaluation_failed = true;
+  summary->message = why;
+  summary->final_cost = summary->stages.back().final_cost;
+  return std::move(*summary);
+}
+
 // Status and message from how the last stage ended: a failure when an
 // enforced fold is missing, the penalties dominate the cost, or a value is
 // not finite; else converged or not.
@@ -765,11 +775,7 @@ FitSummary SolveStaged(const FitDescription& fit, const StagedSolveOptions& opti
         fold_stage_ran = true;
       }
       if (!chosen.ok) {
-        summary.status = FitStatus::kFailure;
-        summary.evaluation_failed = true;
-        summary.message = chosen.failure;
-        summary.final_cost = summary.stages.back().final_cost;
-        return summary;
+        return EvaluationFailed(chosen.failure, &summary);
       }
     }
     previous_start = fit.Values();
@@ -795,23 +801,13 @@ FitSummary SolveStaged(const FitDescription& fit, const StagedSolveOptions& opti
       // The first run solves on the problem its start was rated on.
       if (!RunStage(context, kind, penalties, start_only, &summary.stages.back(), &error,
                     std::move(chosen.rated))) {
-        summary.status = FitStatus::kFailure;
-        summary.evaluation_failed = true;
-        summary.message = error;
-        summary.final_cost = summary.stages.back().final_cost;
-        return summary;
+        return EvaluationFailed(error, &summary);
       }
     }
   }
   bool solved = true;
   const std::string not_minimum = CheckMinimum(context, &summary, &solved, &error);
-  if (!solved) {
-    summary.status = FitStatus::kFailure;
-    summary.evaluation_failed = true;
-    summary.message = error;
-    summary.final_cost = summary.stages.back().final_cost;
-    return summary;
-  }
+  if (!solved) return EvaluationFailed(error, &summary);
   Conclude(fit, &summary);
   summary.not_minimum = not_minimum;
   if (!not_minimum.empty() && summary.status == FitStatus::kConverged) {
