@@ -25,6 +25,8 @@ packages=(
   libboost-dev
   libtbb-dev
   gnuplot-nox
+  # The library-state check (tests/check_library_state.py).
+  python3
   # The fuzzers (tests/fuzz): Clang with its libFuzzer and sanitizer runtimes.
   clang-14
   libclang-rt-14-dev
