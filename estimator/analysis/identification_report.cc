@@ -498,9 +498,9 @@ void PrintJumps(const IdentificationReport& report, std::ostream& out) {
 // coverage of each quantity.
 void PrintValidationIntervals(const ValidationIntervals& v, std::ostream& out) {
   if (v.levels.empty()) return;
-  out << "validation prediction intervals (95 %, " << kPredictionIntervalRule << ")\n";
+  out << "validation prediction intervals (95 %)\n  rule: " << kPredictionIntervalRule << "\n";
   if (!v.note.empty()) out << "  " << v.note << "\n";
-  out << StringPrintf("%-20s %-24s %12s %28s %s\n", "sweep", "quantity", "measured",
+  out << StringPrintf("%-20s %-24s %-14s %-30s %s\n", "sweep", "quantity", "measured",
                       "predicted +/- half-width", "inside");
   for (const ValidationLevel& level : v.levels) {
     for (const HeldOutPrediction& p : level.predictions) {
@@ -509,7 +509,7 @@ void PrintValidationIntervals(const ValidationIntervals& v, std::ostream& out) {
           std::isfinite(p.predicted)
               ? StringPrintf("%.6g +/- %.3g%s", p.predicted, p.half_width, unit)
               : std::string("no fold");
-      out << StringPrintf("%-20s %-24s %12s %28s %s\n", p.sweep.c_str(),
+      out << StringPrintf("%-20s %-24s %-14s %-30s %s\n", p.sweep.c_str(),
                           HeldOutQuantityName(p.quantity),
                           StringPrintf("%.6g%s", p.measured, unit).c_str(), predicted.c_str(),
                           p.inside ? "yes" : "no");

@@ -346,6 +346,12 @@ ValidationIntervals PredictValidationIntervals(const std::vector<const Sweep*>& 
     std::vector<HeldOutPrediction>& level = intervals.levels[it->second].predictions;
     level.insert(level.end(), predicted.begin(), predicted.end());
   }
+  // Amplitude sweeps and frequency sweeps without a measured jump predict
+  // nothing here.
+  intervals.levels.erase(
+      std::remove_if(intervals.levels.begin(), intervals.levels.end(),
+                     [](const ValidationLevel& level) { return level.predictions.empty(); }),
+      intervals.levels.end());
   std::vector<std::vector<HeldOutPrediction>*> levels;
   for (ValidationLevel& level : intervals.levels) levels.push_back(&level.predictions);
   intervals.coverage = AddPredictionIntervals(levels);

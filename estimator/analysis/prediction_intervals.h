@@ -143,7 +143,9 @@ struct ValidationIntervals {
 
 // Predicts every validation sweep at the fit's `parameters` (usable: the
 // fit gave a solution), with intervals; the levels are the validation
-// sweeps' ids, and each level's s_m comes from the other validation levels.
+// sweeps' ids (those with something to predict: a measured jump of a
+// frequency sweep, an upper branch), and each level's s_m comes from the
+// other validation levels.
 ValidationIntervals PredictValidationIntervals(const std::vector<const Sweep*>& fitted,
                                                const std::vector<const Sweep*>& validation,
                                                const IdentificationOptions& options,
