@@ -322,6 +322,9 @@ void EmitLevelRefits(const LevelRefits& r, YAML::Emitter* out) {
       *out << YAML::EndMap;
     }
     *out << YAML::EndMap;
+    *out << YAML::Key << "warnings" << YAML::Value << YAML::BeginSeq;
+    for (const std::string& warning : r.warnings) *out << warning;
+    *out << YAML::EndSeq;
   }
   *out << YAML::EndMap;
 }
@@ -536,16 +539,11 @@ void PrintLevelRefits(const IdentificationReport& report, std::ostream& out) {
   if (r.message.empty()) return;  // not run (AddModelError)
   out << "leave-one-level-out refits: " << r.message << "\n";
   if (!r.computed) return;
-  for (const LevelRefit& refit : r.refits) {
-    if (!refit.usable) {
-      out << "  without " << refit.left_out << ": " << FitStatusName(refit.status) << ", "
-          << refit.message << "\n";
-    }
-  }
-  if (r.spread.empty()) return;
   const ParameterUncertainty& u = report.uncertainty;
-  out << StringPrintf("%-8s %-14s %-30s %-12s %s\n", "param", "estimate", "refits min..max",
-                      "jackknife se", "95% interval");
+  if (!r.spread.empty()) {
+    out << StringPrintf("%-8s %-14s %-30s %-12s %s\n", "param", "estimate", "refits min..max",
+                        "jackknife se", "95% interval");
+  }
   for (const RefitSpread& s : r.spread) {
     const bool alpha_e = s.index == kNumParameters;
     const std::string interval =
@@ -557,6 +555,7 @@ void PrintLevelRefits(const IdentificationReport& report, std::ostream& out) {
                         StringPrintf("%.6g..%.6g", s.min, s.max).c_str(),
                         s.jackknife_standard_error, interval.c_str());
   }
+  for (const std::string& warning : r.warnings) out << "warning: " << warning << "\n";
 }
 
 }  // namespace

@@ -49,6 +49,25 @@ RefitSpread SpreadOf(int index, double estimate, const std::vector<double>& valu
   return spread;
 }
 
+// The refits' warnings (see the header).
+std::vector<std::string> Warnings(const LevelRefits& r) {
+  std::vector<std::string> warnings;
+  for (const LevelRefit& refit : r.refits) {
+    if (refit.usable) continue;
+    warnings.push_back("the refit without " + refit.left_out + " gave no usable solution (" +
+                       FitStatusName(refit.status) + "): " + refit.message);
+  }
+  for (const RefitSpread& s : r.spread) {
+    const double slack = 1e-9 * std::abs(s.estimate);
+    if (s.estimate >= s.min - slack && s.estimate <= s.max + slack) continue;
+    warnings.push_back(StringPrintf(
+        "%s = %.6g from all %zu levels lies outside its leave-one-level-out refits' range "
+        "%.6g..%.6g: the levels disagree on it, or the all-level fit found another minimum",
+        s.name.c_str(), s.estimate, r.levels.size(), s.min, s.max));
+  }
+  return warnings;
+}
+
 }  // namespace
 
 std::vector<std::string> FittedLevels(const std::vector<const Sweep*>& fitted) {
@@ -112,6 +131,7 @@ LevelRefits RefitLeavingOneLevelOut(const std::vector<const Sweep*>& fitted,
   for (const LevelRefit& refit : result.refits) result.usable += refit.usable;
   result.spread = SpreadOverRefits(result.refits, options.fixed, estimate, omega_ref_rad_s);
   result.computed = true;
+  result.warnings = Warnings(result);
   result.message = StringPrintf(
       "%d refits, each without one of the %d fitted levels, from the reported fit's start; %d "
       "usable%s",

@@ -9,7 +9,9 @@
 // stages, residual, penalties, solver, fixed parameters) from the same start
 // as the reported fit (Identify), each refit's residuals on one thread, the
 // refits side by side on `threads`; the result does not depend on the
-// thread count. Per free parameter and for alpha_e (at the run's Omega_ref),
+// thread count. Warnings: a refit that is not usable, and an all-level
+// estimate outside the refits' range (beyond 1e-9 of its magnitude). Per
+// free parameter and for alpha_e (at the run's Omega_ref),
 // over the refits whose solution is usable (IsSolutionUsable, finite):
 //   - min and max of the refits' values, beside the all-level estimate;
 //   - the jackknife standard error
@@ -60,6 +62,9 @@ struct LevelRefits {
   std::vector<LevelRefit> refits;   // one per level, in its order
   int usable = 0;                   // refits counted in the spread
   std::vector<RefitSpread> spread;  // free parameters in ParameterIndex order, then alpha_e
+  // A refit that failed; an all-level estimate outside every refit's value
+  // (the levels disagree, or the all-level fit found another minimum).
+  std::vector<std::string> warnings;
 };
 
 // The fitted sweeps' levels (sweep ids) in data order.

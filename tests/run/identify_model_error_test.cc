@@ -70,6 +70,7 @@ TEST(IdentifyModelError, ThreeFittedLevelsReportTheLeaveOneLevelOutSpread) {
     EXPECT_GT(s.jackknife_standard_error, statistical / 4.0) << s.name;
     EXPECT_LT(s.jackknife_standard_error, statistical * 4.0) << s.name;
   }
+  EXPECT_TRUE(refits.warnings.empty()) << refits.warnings.front();
   EXPECT_THAT(printed.str(), HasSubstr("leave-one-level-out refits: 3 refits"));
   const YAML::Node result = YAML::LoadFile(out_dir + "/result.yaml");
   const YAML::Node lolo = result["leave_one_level_out"];
