@@ -527,9 +527,11 @@ void PrintValidationIntervals(const ValidationIntervals& v, std::ostream& out) {
               {"upper-branch amplitude", v.coverage.upper_branch, ""}};
   for (const auto& row : rows) {
     if (row.c.total == 0) continue;
-    out << StringPrintf("%s: %d of %d measured inside, median half-width %.3g%s (%.3g %%)\n",
-                        row.name, row.c.inside, row.c.total, row.c.median_half_width, row.unit,
-                        row.c.median_half_width_percent);
+    out << StringPrintf("%s: %d of %d measured inside, ", row.name, row.c.inside, row.c.total)
+        << (std::isfinite(row.c.median_half_width)
+                ? StringPrintf("median half-width %.3g%s (%.3g %%)\n", row.c.median_half_width,
+                               row.unit, row.c.median_half_width_percent)
+                : std::string("no interval (the model predicts none of them)\n"));
   }
 }
 
