@@ -1,5 +1,6 @@
 #include "dwellfit/estimator/analysis/identification_report.h"
 
+#include <cmath>
 #include <sstream>
 #include <utility>
 
@@ -24,6 +25,16 @@ IdentificationReport MakeIdentificationReport(const std::string& config_path,
       omega_ref_rad_s > 0.0 ? omega_ref_rad_s : result.parameters[kNaturalFrequency];
   report.predictions = PredictSweeps(result.parameters, fitted, validation);
   return report;
+}
+
+void AddModelError(const std::vector<const Sweep*>& fitted,
+                   const std::vector<const Sweep*>& validation, int threads,
+                   IdentificationReport* report) {
+  const IdentificationResult& result = report->result;
+  report->validation_intervals = PredictValidationIntervals(
+      fitted, validation, report->options, result.parameters, result.IsSolutionUsable());
+  report->level_refits = RefitLeavingOneLevelOut(fitted, report->options, result.parameters,
+                                                 report->omega_ref_rad_s, threads);
 }
 
 namespace {
@@ -218,6 +229,106 @@ void EmitSweep(const SweepPrediction& prediction, YAML::Emitter* out) {
   *out << YAML::EndMap;
 }
 
+// A number, or null when it is not finite (a missing prediction).
+void EmitNumber(double value, YAML::Emitter* out) {
+  if (std::isfinite(value)) {
+    *out << value;
+  } else {
+    *out << YAML::Null;
+  }
+}
+
+bool IsAmplitude(const HeldOutPrediction& p) {
+  return p.quantity == HeldOutQuantity::kUpperBranchAmplitude;
+}
+
+void EmitCoverage(const char* key, const IntervalCoverage& c, YAML::Emitter* out) {
+  *out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginMap;
+  *out << YAML::Key << "inside" << YAML::Value << c.inside;
+  *out << YAML::Key << "total" << YAML::Value << c.total;
+  *out << YAML::Key << "median_half_width" << YAML::Value;
+  EmitNumber(c.median_half_width, out);
+  *out << YAML::Key << "median_half_width_percent" << YAML::Value;
+  EmitNumber(c.median_half_width_percent, out);
+  *out << YAML::EndMap;
+}
+
+// validation_intervals: the rule, the coverage of each quantity (half-widths
+// in Hz for the jumps, the data's unit for the amplitude) and every
+// prediction.
+void EmitValidationIntervals(const ValidationIntervals& v, YAML::Emitter* out) {
+  *out << YAML::Key << "validation_intervals" << YAML::Value << YAML::BeginMap;
+  *out << YAML::Key << "rule" << YAML::Value << kPredictionIntervalRule;
+  *out << YAML::Key << "parameter_covariance" << YAML::Value << v.parameter_covariance;
+  if (!v.note.empty()) *out << YAML::Key << "note" << YAML::Value << v.note;
+  *out << YAML::Key << "coverage" << YAML::Value << YAML::BeginMap;
+  EmitCoverage("jump_down", v.coverage.jump_down, out);
+  EmitCoverage("jump_up", v.coverage.jump_up, out);
+  EmitCoverage("upper_branch_amplitude", v.coverage.upper_branch, out);
+  *out << YAML::EndMap;
+  *out << YAML::Key << "predictions" << YAML::Value << YAML::BeginSeq;
+  for (const ValidationLevel& level : v.levels) {
+    for (const HeldOutPrediction& p : level.predictions) {
+      *out << YAML::Flow << YAML::BeginMap;
+      *out << YAML::Key << "sweep" << YAML::Value << p.sweep;
+      *out << YAML::Key << "quantity" << YAML::Value << HeldOutQuantityKey(p.quantity);
+      *out << YAML::Key << "unit" << YAML::Value << (IsAmplitude(p) ? "data" : "Hz");
+      *out << YAML::Key << "measured" << YAML::Value << p.measured;
+      for (const auto& [key, value] : {std::pair<const char*, double>{"predicted", p.predicted},
+                                       {"half_width", p.half_width},
+                                       {"parameter_sd", p.parameter_sd},
+                                       {"model_sd", p.model_sd}}) {
+        *out << YAML::Key << key << YAML::Value;
+        EmitNumber(value, out);
+      }
+      *out << YAML::Key << "inside" << YAML::Value << p.inside;
+      *out << YAML::EndMap;
+    }
+  }
+  *out << YAML::EndSeq;
+  *out << YAML::EndMap;
+}
+
+// leave_one_level_out: whether the refits ran, each refit, and the spread
+// of every free parameter and alpha_e (omega in rad/s).
+void EmitLevelRefits(const LevelRefits& r, YAML::Emitter* out) {
+  *out << YAML::Key << "leave_one_level_out" << YAML::Value << YAML::BeginMap;
+  *out << YAML::Key << "computed" << YAML::Value << r.computed;
+  *out << YAML::Key << "message" << YAML::Value << r.message;
+  *out << YAML::Key << "levels" << YAML::Value << YAML::Flow << r.levels;
+  if (r.computed) {
+    *out << YAML::Key << "usable" << YAML::Value << r.usable;
+    *out << YAML::Key << "refits" << YAML::Value << YAML::BeginSeq;
+    for (const LevelRefit& refit : r.refits) {
+      *out << YAML::Flow << YAML::BeginMap;
+      *out << YAML::Key << "left_out" << YAML::Value << refit.left_out;
+      *out << YAML::Key << "status" << YAML::Value << FitStatusName(refit.status);
+      *out << YAML::Key << "usable" << YAML::Value << refit.usable;
+      *out << YAML::Key << "final_cost" << YAML::Value << refit.final_cost;
+      for (int i = 0; i < kNumParameters; ++i) {
+        *out << YAML::Key << ParameterName(i) << YAML::Value << refit.parameters[i];
+      }
+      *out << YAML::Key << "alpha_e" << YAML::Value << refit.effective_nonlinearity;
+      *out << YAML::EndMap;
+    }
+    *out << YAML::EndSeq;
+    *out << YAML::Key << "spread" << YAML::Value << YAML::BeginMap;
+    for (const RefitSpread& s : r.spread) {
+      *out << YAML::Key << s.name << YAML::Value << YAML::Flow << YAML::BeginMap;
+      *out << YAML::Key << "estimate" << YAML::Value << s.estimate;
+      *out << YAML::Key << "min" << YAML::Value << s.min;
+      *out << YAML::Key << "max" << YAML::Value << s.max;
+      *out << YAML::Key << "jackknife_standard_error" << YAML::Value << s.jackknife_standard_error;
+      *out << YAML::EndMap;
+    }
+    *out << YAML::EndMap;
+    *out << YAML::Key << "warnings" << YAML::Value << YAML::BeginSeq;
+    for (const std::string& warning : r.warnings) *out << warning;
+    *out << YAML::EndSeq;
+  }
+  *out << YAML::EndMap;
+}
+
 // Appends `mapping` (YAML text of a block mapping) to the top-level block
 // mapping `yaml` as the value of `key`, every line indented two spaces, as
 // text: the configuration is already YAML, and parsing it again to emit it
@@ -258,6 +369,10 @@ std::string ReportToYaml(const IdentificationReport& report) {
   out << YAML::Key << "sweeps" << YAML::Value << YAML::BeginSeq;
   for (const SweepPrediction& prediction : report.predictions) EmitSweep(prediction, &out);
   out << YAML::EndSeq;
+  if (!report.validation_intervals.levels.empty()) {
+    EmitValidationIntervals(report.validation_intervals, &out);
+  }
+  if (!report.level_refits.message.empty()) EmitLevelRefits(report.level_refits, &out);
   out << YAML::EndMap;
   std::string yaml = std::string(out.c_str()) + "\n";
   if (!report.config_in_effect.empty()) {
@@ -382,6 +497,69 @@ void PrintJumps(const IdentificationReport& report, std::ostream& out) {
   }
 }
 
+// The validation sweeps' prediction intervals, one line each, and the
+// coverage of each quantity.
+void PrintValidationIntervals(const ValidationIntervals& v, std::ostream& out) {
+  if (v.levels.empty()) return;
+  out << "validation prediction intervals (95 %)\n  rule: " << kPredictionIntervalRule << "\n";
+  if (!v.note.empty()) out << "  " << v.note << "\n";
+  out << StringPrintf("%-20s %-24s %-14s %-30s %s\n", "sweep", "quantity", "measured",
+                      "predicted +/- half-width", "inside");
+  for (const ValidationLevel& level : v.levels) {
+    for (const HeldOutPrediction& p : level.predictions) {
+      const char* unit = IsAmplitude(p) ? "" : " Hz";
+      const std::string predicted =
+          std::isfinite(p.predicted)
+              ? StringPrintf("%.6g +/- %.3g%s", p.predicted, p.half_width, unit)
+              : std::string("no fold");
+      out << StringPrintf("%-20s %-24s %-14s %-30s %s\n", p.sweep.c_str(),
+                          HeldOutQuantityName(p.quantity),
+                          StringPrintf("%.6g%s", p.measured, unit).c_str(), predicted.c_str(),
+                          p.inside ? "yes" : "no");
+    }
+  }
+  const struct {
+    const char* name;
+    const IntervalCoverage& c;
+    const char* unit;
+  } rows[] = {{"jump-down", v.coverage.jump_down, " Hz"},
+              {"jump-up", v.coverage.jump_up, " Hz"},
+              {"upper-branch amplitude", v.coverage.upper_branch, ""}};
+  for (const auto& row : rows) {
+    if (row.c.total == 0) continue;
+    out << StringPrintf("%s: %d of %d measured inside, ", row.name, row.c.inside, row.c.total)
+        << (std::isfinite(row.c.median_half_width)
+                ? StringPrintf("median half-width %.3g%s (%.3g %%)\n", row.c.median_half_width,
+                               row.unit, row.c.median_half_width_percent)
+                : std::string("no interval (the model predicts none of them)\n"));
+  }
+}
+
+// The leave-one-level-out spread beside the reported interval.
+void PrintLevelRefits(const IdentificationReport& report, std::ostream& out) {
+  const LevelRefits& r = report.level_refits;
+  if (r.message.empty()) return;  // not run (AddModelError)
+  out << "leave-one-level-out refits: " << r.message << "\n";
+  if (!r.computed) return;
+  const ParameterUncertainty& u = report.uncertainty;
+  if (!r.spread.empty()) {
+    out << StringPrintf("%-8s %-14s %-30s %-12s %s\n", "param", "estimate", "refits min..max",
+                        "jackknife se", "95% interval");
+  }
+  for (const RefitSpread& s : r.spread) {
+    const bool alpha_e = s.index == kNumParameters;
+    const std::string interval =
+        !u.available ? "-"
+        : alpha_e    ? StringPrintf("[%.6g, %.6g]", u.effective_nonlinearity_ci95_low,
+                                    u.effective_nonlinearity_ci95_high)
+                     : StringPrintf("[%.6g, %.6g]", u.ci95_low[s.index], u.ci95_high[s.index]);
+    out << StringPrintf("%-8s %-14.6g %-30s %-12.3g %s\n", s.name.c_str(), s.estimate,
+                        StringPrintf("%.6g..%.6g", s.min, s.max).c_str(),
+                        s.jackknife_standard_error, interval.c_str());
+  }
+  for (const std::string& warning : r.warnings) out << "warning: " << warning << "\n";
+}
+
 }  // namespace
 
 void PrintReport(const IdentificationReport& report, std::ostream& out) {
@@ -392,6 +570,9 @@ void PrintReport(const IdentificationReport& report, std::ostream& out) {
   PrintSweeps(report, out);
   out << "\n";
   PrintJumps(report, out);
+  out << "\n";
+  PrintValidationIntervals(report.validation_intervals, out);
+  PrintLevelRefits(report, out);
   out << "\nstatus: " << FitStatusName(report.result.status) << ": " << report.result.message
       << "\n";
 }

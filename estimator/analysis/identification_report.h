@@ -8,11 +8,13 @@
 #include <string>
 #include <vector>
 
+#include "dwellfit/estimator/analysis/level_refits.h"
+#include "dwellfit/estimator/analysis/parameter_uncertainty.h"
+#include "dwellfit/estimator/analysis/prediction_intervals.h"
+#include "dwellfit/estimator/analysis/sweep_prediction.h"
 #include "dwellfit/estimator/fit/identification.h"
 #include "dwellfit/estimator/fit/identification_options.h"
 #include "dwellfit/estimator/fit/multi_start.h"
-#include "dwellfit/estimator/analysis/parameter_uncertainty.h"
-#include "dwellfit/estimator/analysis/sweep_prediction.h"
 
 namespace dwellfit {
 
@@ -31,6 +33,11 @@ struct IdentificationReport {
   // The starts and how many reached the best (one start: trivially 1 of 1).
   MultiStartResult multi_start;
   ParameterUncertainty uncertainty;
+  // Model error (docs/uncertainty.md, "Model error"), set by AddModelError:
+  // the validation sweeps' 95 % prediction intervals, and the
+  // leave-one-level-out refits of the fitted levels.
+  ValidationIntervals validation_intervals;
+  LevelRefits level_refits;
 };
 
 // Builds the report: predicts every sweep at the identified parameters.
@@ -42,10 +49,19 @@ IdentificationReport MakeIdentificationReport(const std::string& config_path,
                                               const std::vector<const Sweep*>& fitted,
                                               const std::vector<const Sweep*>& validation);
 
+// Fills report->validation_intervals (PredictValidationIntervals at the
+// report's estimate) and report->level_refits (RefitLeavingOneLevelOut with
+// report->options, whose `initial` is the reported fit's start, at
+// report->omega_ref_rad_s, on `threads`).
+void AddModelError(const std::vector<const Sweep*>& fitted,
+                   const std::vector<const Sweep*>& validation, int threads,
+                   IdentificationReport* report);
+
 // result.yaml: the run's status and its reason, the dwellfit version, the
 // parameters (omega in rad/s), effective nonlinearity and its Omega_ref,
-// final_cost, iterations, stages, per-sweep errors, measured jump brackets
-// and the configuration in effect.
+// final_cost, iterations, stages, per-sweep errors, measured jump brackets,
+// the validation prediction intervals and leave-one-level-out refits (when
+// computed) and the configuration in effect.
 std::string ReportToYaml(const IdentificationReport& report);
 
 // predictions.csv: one row per measured dwell with the model's amplitude.

@@ -218,17 +218,6 @@ bool Predicts(const Plan& plan, int set, const Sweep& sweep) {
   return std::find(names.begin(), names.end(), sweep.Name()) != names.end();
 }
 
-// The covariance of a fit's predictions (PredictionCovariance); none when
-// the fit's dwells-alone covariance is not available.
-std::optional<ParameterMatrix> FitCovariance(const ResolvedRun& run,
-                                             const IdentificationResult& result) {
-  if (!result.IsSolutionUsable()) return std::nullopt;
-  const ParameterUncertainty uncertainty = EstimateUncertainty(
-      run.fitted, run.options, result.parameters, 0.0, nullptr, IntervalMethod::kDataOnly);
-  if (!uncertainty.available) return std::nullopt;
-  return PredictionCovariance(uncertainty.covariance, run.fitted, run.options, result.parameters);
-}
-
 TaskResult RunTask(const IdentifyConfig& config, const ModelVariant& variant,
                    const std::vector<Sweep>& sweeps, const Plan& plan, int set) {
   TaskResult task;
@@ -261,7 +250,9 @@ TaskResult RunTask(const IdentifyConfig& config, const ModelVariant& variant,
   // The intervals are for the cross-validation's held-out levels.
   const bool held_out_levels = !plan.fold_training.empty();
   const std::optional<ParameterMatrix> covariance =
-      held_out_levels ? FitCovariance(run, result) : std::nullopt;
+      held_out_levels && result.IsSolutionUsable()
+          ? FitPredictionCovariance(run.fitted, run.options, result.parameters)
+          : std::nullopt;
   for (const Sweep& sweep : run.sweeps) {
     if (!Predicts(plan, set, sweep)) continue;
     task.predicted[sweep.Name()] =
@@ -606,13 +597,6 @@ void PredictionErrors::Add(const PredictionErrors& other) {
   jump_up_hz.insert(jump_up_hz.end(), other.jump_up_hz.begin(), other.jump_up_hz.end());
   upper_branch_percent.insert(upper_branch_percent.end(), other.upper_branch_percent.begin(),
                               other.upper_branch_percent.end());
-}
-
-double MedianOf(std::vector<double> values) {
-  if (values.empty()) return kNaN;
-  std::sort(values.begin(), values.end());
-  const std::size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
 ModelSelectionReport RunModelSelection(const IdentifyConfig& config, int threads) {

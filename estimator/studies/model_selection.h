@@ -58,12 +58,13 @@
 //   jump-down, else from the config's validate sweeps; with neither, the
 //   lowest BIC.
 //
-// 95 % prediction intervals of every held-out level (cross-validation only):
-// for a predicted quantity q (a jump's frequency in Hz, the upper-branch
-// amplitude), q_model +/- 1.96 sqrt(s_p^2 + s_m^2), with
+// 95 % prediction intervals of every held-out level (cross-validation only;
+// the rule of estimator/analysis/prediction_intervals.h, which identify
+// applies to its validation sweeps): for a predicted quantity q (a jump's frequency in Hz, the
+// upper-branch amplitude), q_model +/- 1.96 sqrt(s_p^2 + s_m^2), with
 //   - s_p^2 = g^T C g: the fold's parameter uncertainty by the delta method,
-//     C the dwells-alone covariance of the fold's fit (EstimateUncertainty,
-//     IntervalMethod::kDataOnly), g = dq/dp by central differences;
+//     C the fold fit's PredictionCovariance (its dwells-alone covariance with
+//     the enforced jumps as observations), g = dq/dp by central differences;
 //   - s_m = q_model x the RMS of the relative errors (q_model - q) / q of the
 //     same quantity at every other held-out level: the model error the
 //     cross-validation shows, none of it from the level itself (the
@@ -80,6 +81,7 @@
 #include <vector>
 
 #include "dwellfit/config/identify_config.h"
+#include "dwellfit/estimator/analysis/prediction_intervals.h"
 #include "dwellfit/estimator/fit/staged_solve.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 
@@ -105,25 +107,6 @@ struct ModelVariant {
 // Every combination of the block's choices, delta slowest, omega fastest.
 std::vector<ModelVariant> ModelVariants(const ModelSelectionConfig& selection);
 
-// What a held-out prediction is of.
-enum class HeldOutQuantity { kJumpDown, kJumpUp, kUpperBranchAmplitude };
-const char* HeldOutQuantityName(HeldOutQuantity quantity);  // "jump-down", ...
-
-// One predicted quantity of a held-out sweep, with its 95 % prediction
-// interval (see above).
-struct HeldOutPrediction {
-  std::string sweep;  // its name, "L0.070g/up"
-  HeldOutQuantity quantity = HeldOutQuantity::kJumpDown;
-  double measured = 0.0;      // Hz (the bracket's centre), or the amplitude (data's unit)
-  double predicted = 0.0;     // the same; NaN: no usable fit, or the model lacks the fold
-  double parameter_sd = 0.0;  // s_p, the same unit; 0 when the fit has no covariance
-  double model_sd = 0.0;      // s_m, the same unit
-  double half_width = 0.0;    // 1.96 sqrt(s_p^2 + s_m^2); NaN without a prediction
-  bool inside = false;        // measured within predicted +/- half_width
-  // 100 (predicted - measured) / measured; NaN without a prediction.
-  double ErrorPercent() const;
-};
-
 // Errors of predicted sweeps (see above), pooled over the sweeps scored.
 struct PredictionErrors {
   std::vector<double> jump_down_percent;  // one per measured jump-down
@@ -134,8 +117,6 @@ struct PredictionErrors {
   std::vector<double> relative_rms;          // one per sweep
   void Add(const PredictionErrors& other);
 };
-// Median of `values`; NaN when empty.
-double MedianOf(std::vector<double> values);
 
 // One fit of a variant on a set of sweeps.
 struct VariantFit {
@@ -154,15 +135,6 @@ struct CrossValidationFold {
   int fit = 0;                                 // index into VariantResult::fits
   PredictionErrors errors;                     // of the level's pool sweeps
   std::vector<HeldOutPrediction> predictions;  // of the level's pool sweeps
-};
-
-// How often the held-out measurements of one quantity fall inside their
-// 95 % prediction intervals.
-struct IntervalCoverage {
-  int inside = 0;
-  int total = 0;                   // measured quantities (missing predictions count outside)
-  double median_half_width = 0.0;  // Hz or the amplitude's unit; NaN when none
-  double median_half_width_percent = 0.0;  // of the predicted value
 };
 
 // A free parameter's spread over a variant's usable fits (or alpha_e's).

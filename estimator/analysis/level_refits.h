@@ -1,0 +1,91 @@
+// Leave-one-level-out refits: how much each parameter moves when one level
+// (a sweep id: its up and down sweeps together) is left out of the fit.
+//
+// Measured residuals are not independent noise: the dwells of one level
+// share its model error, so the statistical interval (its noise taken as
+// independent) can be much narrower than the estimate's dependence on which
+// levels were measured. With L >= kMinLevelsForRefits fitted levels, the fit
+// is run again L times, each time without one level: the same options (the
+// stages, residual, penalties, solver, fixed parameters) from the same start
+// as the reported fit (Identify), each refit's residuals on one thread, the
+// refits side by side on `threads`; the result does not depend on the
+// thread count. Warnings: a refit that is not usable, and an all-level
+// estimate outside the refits' range (beyond 1e-9 of its magnitude). Per
+// free parameter and for alpha_e (at the run's Omega_ref),
+// over the refits whose solution is usable (IsSolutionUsable, finite):
+//   - min and max of the refits' values, beside the all-level estimate;
+//   - the jackknife standard error
+//       se_J = sqrt((m - 1) / m sum_i (theta_i - theta_bar)^2),
+//     m the usable refits, theta_bar their mean: the spread scaled up to a
+//     fit on all the levels (each refit saw (m - 1) / m of them).
+#ifndef DWELLFIT_ESTIMATOR_ANALYSIS_LEVEL_REFITS_H_
+#define DWELLFIT_ESTIMATOR_ANALYSIS_LEVEL_REFITS_H_
+
+#include <string>
+#include <vector>
+
+#include "dwellfit/estimator/data/sweep.h"
+#include "dwellfit/estimator/fit/identification_options.h"
+#include "dwellfit/estimator/fit/staged_solve.h"
+#include "dwellfit/residuals/model/model_parameters.h"
+
+namespace dwellfit {
+
+// Fewer fitted levels than this: no refits (two refits of one level each
+// say little about the spread).
+inline constexpr int kMinLevelsForRefits = 3;
+
+struct LevelRefit {
+  std::string left_out;  // the sweep id left out
+  FitStatus status = FitStatus::kInvalidInput;
+  bool usable = false;  // counted in the spread
+  std::string message;
+  double final_cost = 0.0;
+  ParameterVector parameters{};  // physical units, omega in rad/s
+  double effective_nonlinearity = 0.0;
+};
+
+// One quantity's spread over the usable refits. Index kNumParameters is
+// alpha_e; omega in rad/s.
+struct RefitSpread {
+  int index = 0;
+  std::string name;       // ParameterName, or "alpha_e"
+  double estimate = 0.0;  // the all-level fit's
+  double min = 0.0, max = 0.0;
+  double jackknife_standard_error = 0.0;
+};
+
+struct LevelRefits {
+  bool computed = false;            // refits were run
+  std::string message;              // what was done, or why not
+  std::vector<std::string> levels;  // the fitted levels, in data order
+  std::vector<LevelRefit> refits;   // one per level, in its order
+  int usable = 0;                   // refits counted in the spread
+  std::vector<RefitSpread> spread;  // free parameters in ParameterIndex order, then alpha_e
+  // A refit that failed; an all-level estimate outside every refit's value
+  // (the levels disagree, or the all-level fit found another minimum).
+  std::vector<std::string> warnings;
+};
+
+// The fitted sweeps' levels (sweep ids) in data order.
+std::vector<std::string> FittedLevels(const std::vector<const Sweep*>& fitted);
+
+// Runs the refits (see above) of the fit of `fitted` with `options`
+// (options.initial: the reported fit's start) whose estimate is `estimate`.
+// With fewer than kMinLevelsForRefits levels, computed = false and the
+// message says so. Never throws for a failed refit: its status says it.
+LevelRefits RefitLeavingOneLevelOut(const std::vector<const Sweep*>& fitted,
+                                    const IdentificationOptions& options,
+                                    const ParameterVector& estimate, double omega_ref_rad_s,
+                                    int threads);
+
+// The spread of each free parameter and alpha_e over the usable refits
+// (none with fewer than two). Part of RefitLeavingOneLevelOut; exposed for
+// tests.
+std::vector<RefitSpread> SpreadOverRefits(const std::vector<LevelRefit>& refits,
+                                          const std::array<bool, kNumParameters>& fixed,
+                                          const ParameterVector& estimate, double omega_ref_rad_s);
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_ESTIMATOR_ANALYSIS_LEVEL_REFITS_H_

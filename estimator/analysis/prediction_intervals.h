@@ -1,0 +1,156 @@
+// 95 % prediction intervals of sweeps a fit did not see: of each measured
+// jump's frequency (frequency sweeps) and of the upper-branch amplitude, the
+// one rule used by `identify` (its validation sweeps) and `select_model`
+// (its held-out levels). docs/model-selection.md and docs/uncertainty.md
+// ("Model error") state it with the beam's numbers.
+//
+// The predicted quantities of a sweep (PredictHeldOut):
+//   - each measured jump: the model's fold nearest the bracket (PredictJumps)
+//     in Hz, against the bracket's centre; NaN when the model lacks the fold;
+//   - the upper-branch amplitude of an up-sweep with a measured jump-down:
+//     the mean measured amplitude A of its dwells before the jump whose
+//     amplitude exceeds half the sweep's peak (UpperBranchDwells), against
+//     the mean of the model's amplitudes on that branch at the same dwells.
+//
+// The interval of a predicted quantity q at one level (a sweep id: its up
+// and down sweeps together):
+//
+//   q_model +/- z sqrt(s_p^2 + s_m^2),   z = 1.95996 (normal, 0.975),
+//
+//   - s_p^2 = g^T C g, the parameters' uncertainty by the delta method,
+//     g = dq/dp by central differences (relative step 1e-5; 1e-6 absolute
+//     at 0), C the fit's prediction covariance (PredictionCovariance): its
+//     dwells-alone covariance with each enforced jump as one observation;
+//   - s_m = |q_model| x the RMS of the relative errors (q_model - q) / q of
+//     the same quantity at every *other* level predicted from the same fit:
+//     the model error those levels show, none of it from the level itself.
+//     With no other level, s_m = 0.
+// A prediction is inside when |q_model - q| <= half-width; a missing
+// prediction (no fold) has no interval and counts outside.
+#ifndef DWELLFIT_ESTIMATOR_ANALYSIS_PREDICTION_INTERVALS_H_
+#define DWELLFIT_ESTIMATOR_ANALYSIS_PREDICTION_INTERVALS_H_
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dwellfit/estimator/analysis/parameter_uncertainty.h"
+#include "dwellfit/estimator/data/sweep.h"
+#include "dwellfit/estimator/fit/identification_options.h"
+#include "dwellfit/residuals/model/model_parameters.h"
+
+namespace dwellfit {
+
+// The 0.975 quantile of the standard normal: the intervals' z.
+inline constexpr double kPredictionIntervalZ = 1.959963984540054;
+
+// The rule above in one line, for reports.
+extern const char* const kPredictionIntervalRule;
+
+// What a prediction is of.
+enum class HeldOutQuantity { kJumpDown, kJumpUp, kUpperBranchAmplitude };
+const char* HeldOutQuantityName(HeldOutQuantity quantity);  // "jump-down", ...
+// "jump_down", "jump_up", "upper_branch_amplitude" (file keys).
+const char* HeldOutQuantityKey(HeldOutQuantity quantity);
+
+// One predicted quantity of a sweep the fit did not see, with its 95 %
+// prediction interval.
+struct HeldOutPrediction {
+  std::string sweep;  // its name, "L0.070g/up"
+  HeldOutQuantity quantity = HeldOutQuantity::kJumpDown;
+  double measured = 0.0;      // Hz (the bracket's centre), or the amplitude (data's unit)
+  double predicted = 0.0;     // the same; NaN: no usable fit, or the model lacks the fold
+  double parameter_sd = 0.0;  // s_p, the same unit; 0 when the fit has no covariance
+  double model_sd = 0.0;      // s_m, the same unit
+  double half_width = 0.0;    // z sqrt(s_p^2 + s_m^2); NaN without a prediction
+  bool inside = false;        // measured within predicted +/- half_width
+  // 100 (predicted - measured) / measured; NaN without a prediction.
+  double ErrorPercent() const;
+};
+
+// How often the measurements of one quantity fall inside their intervals.
+struct IntervalCoverage {
+  int inside = 0;
+  int total = 0;                   // measured quantities (missing predictions count outside)
+  double median_half_width = 0.0;  // Hz or the amplitude's unit; NaN when none
+  double median_half_width_percent = 0.0;  // of the predicted value
+};
+
+struct PredictionCoverage {
+  IntervalCoverage jump_down, jump_up, upper_branch;
+};
+
+// Median of `values`; NaN when empty.
+double MedianOf(std::vector<double> values);
+
+// The dwells of the upper branch of an up frequency sweep with a measured
+// jump-down: those before the jump whose amplitude exceeds half the sweep's
+// peak (indices into sweep.points). Empty for any other sweep.
+std::vector<int> UpperBranchDwells(const Sweep& sweep);
+
+// The predictions of `sweep`'s measured jumps (frequency sweeps only) and of
+// its upper-branch amplitude, under `parameters` (none usable: every
+// prediction NaN). With `covariance` (physical units, zero rows for fixed
+// parameters), each prediction's parameter_sd by the delta method over the
+// parameters `fixed` leaves free; without it, 0. model_sd, half_width and
+// inside are left for AddPredictionIntervals.
+std::vector<HeldOutPrediction> PredictHeldOut(const Sweep& sweep, const ParameterVector& parameters,
+                                              bool usable, const ParameterMatrix* covariance,
+                                              const std::array<bool, kNumParameters>& fixed);
+
+// The covariance a fit's predictions are uncertain by: the fit's
+// dwells-alone covariance C_d (EstimateUncertainty, kDataOnly) with every
+// enforced jump of the fitted frequency sweeps (the bifurcation-range
+// penalty's, when on) taken as one observation of its fold frequency f_k
+// with the bracket's half-width h_k as standard deviation -- what the
+// penalty holds it to:
+//   C = (C_d^+ + sum_k g_k g_k^T / h_k^2)^+,   g_k = d f_k / d p,
+// on the free parameters, computed in the scale of C_d's diagonal (^+: the
+// pseudo-inverse, eigenvalues below 1e-12 of the largest dropped). Without
+// the penalty, C_d.
+ParameterMatrix PredictionCovariance(const ParameterMatrix& data_only,
+                                     const std::vector<const Sweep*>& fitted,
+                                     const IdentificationOptions& options,
+                                     const ParameterVector& parameters);
+
+// PredictionCovariance of the fit of `fitted` at `parameters`, C_d
+// estimated here; none when the dwells-alone covariance is not available
+// (`why`, when given, says why).
+std::optional<ParameterMatrix> FitPredictionCovariance(const std::vector<const Sweep*>& fitted,
+                                                       const IdentificationOptions& options,
+                                                       const ParameterVector& parameters,
+                                                       std::string* why = nullptr);
+
+// Fills model_sd, half_width and inside of every prediction of every level
+// (levels[i]: the predictions of level i, all from one fit or each from its
+// own, see above) and returns the coverage of each quantity.
+PredictionCoverage AddPredictionIntervals(
+    const std::vector<std::vector<HeldOutPrediction>*>& levels);
+
+// The intervals of a fit's validation sweeps (identify).
+struct ValidationLevel {
+  std::string level;                           // sweep id
+  std::vector<HeldOutPrediction> predictions;  // of its validation sweeps, in data order
+};
+struct ValidationIntervals {
+  std::vector<ValidationLevel> levels;  // in the order of the validation sweeps
+  PredictionCoverage coverage;
+  // Whether s_p came from a covariance; when not, `note` says why (s_p = 0).
+  bool parameter_covariance = false;
+  std::string note;
+};
+
+// Predicts every validation sweep at the fit's `parameters` (usable: the
+// fit gave a solution), with intervals; the levels are the validation
+// sweeps' ids (those with something to predict: a measured jump of a
+// frequency sweep, an upper branch), and each level's s_m comes from the
+// other validation levels.
+ValidationIntervals PredictValidationIntervals(const std::vector<const Sweep*>& fitted,
+                                               const std::vector<const Sweep*>& validation,
+                                               const IdentificationOptions& options,
+                                               const ParameterVector& parameters, bool usable);
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_ESTIMATOR_ANALYSIS_PREDICTION_INTERVALS_H_
