@@ -314,6 +314,21 @@ SideResult SearchSide(const ProfileProblem& problem, const Side& side, double mi
   return result;
 }
 
+// The constrained fit with the quantity held at the estimate's own value,
+// from the estimate: only its lower point, if any, counts.
+SideResult FitAtEstimate(const ProfileProblem& problem, int quantity,
+                         const ParameterVector& estimate, double minimum_cost) {
+  SideResult result;
+  Trial trial{ValueOf(problem, quantity, estimate), 0.0, estimate};
+  const double cost = ConstrainedMinimum(problem, quantity, trial.t, minimum_cost, &trial.p);
+  result.fits = 1;
+  if (cost < minimum_cost * (1.0 - kLowerCostTolerance)) {
+    result.lower = trial;
+    result.lower_cost = cost;
+  }
+  return result;
+}
+
 // The side's linearised path d p / d theta = C g / (g^T C g) and first step
 // q sqrt(g^T C g), g the gradient of the quantity.
 Side MakeSide(const ProfileProblem& problem, int quantity, double sign,
@@ -372,16 +387,26 @@ ProfileLikelihood ProfileCost(const ProfileProblem& problem, const ParameterVect
   for (int q = 0; q <= kEffective; ++q) {
     if (IsProfiled(problem, q)) quantities.push_back(q);
   }
-  std::vector<SideResult> sides(2 * quantities.size());
+  // Per quantity three searches, in a fixed order (3 q + k): the lower side,
+  // the upper side, and the constrained fit at the estimate's own value
+  // (the fit of the others with it held where it is: a lower cost there
+  // shows a fit that stopped short along a valley, or a parameter on its
+  // bound whose neighbours were not at their minimum).
+  std::vector<SideResult> sides(3 * quantities.size());
   const auto search = [&](size_t i) {
-    const Side side = MakeSide(problem, quantities[i / 2], i % 2 == 0 ? -1.0 : 1.0, estimate,
-                               covariance, quantile);
+    const int q = quantities[i / 3];
+    if (i % 3 == 2) {
+      sides[i] = FitAtEstimate(problem, q, estimate, profile.minimum_cost);
+      return;
+    }
+    const Side side =
+        MakeSide(problem, q, i % 3 == 0 ? -1.0 : 1.0, estimate, covariance, quantile);
     sides[i] = SearchSide(problem, side, profile.minimum_cost);
   };
   tbb::task_arena arena(std::max(problem.threads, 1));
   arena.execute([&] { tbb::parallel_for(size_t{0}, sides.size(), search); });
-  for (size_t i = 0; i < sides.size(); i += 2) {
-    const int q = quantities[i / 2];
+  for (size_t i = 0; i < sides.size(); i += 3) {
+    const int q = quantities[i / 3];
     ProfileInterval& interval =
         q == kEffective ? profile.effective_nonlinearity : profile.parameters[q];
     interval.computed = true;
@@ -389,9 +414,9 @@ ProfileLikelihood ProfileCost(const ProfileProblem& problem, const ParameterVect
     interval.low_end = sides[i].kind;
     interval.high = sides[i + 1].end;
     interval.high_end = sides[i + 1].kind;
-    interval.fits = sides[i].fits + sides[i + 1].fits;
+    interval.fits = sides[i].fits + sides[i + 1].fits + sides[i + 2].fits;
     profile.fits += interval.fits;
-    for (const SideResult* side : {&sides[i], &sides[i + 1]}) {
+    for (const SideResult* side : {&sides[i], &sides[i + 1], &sides[i + 2]}) {
       if (!side->lower || (profile.found_lower && side->lower_cost >= profile.lower_cost)) continue;
       profile.found_lower = true;
       profile.lower_cost = side->lower_cost;

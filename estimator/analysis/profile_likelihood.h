@@ -35,7 +35,9 @@
 // threshold, and "open" when the search ends without crossing (the data do
 // not bound the quantity there: the end is reported as +/- infinity).
 //
-// A constrained fit that ends below F^ (by more than kLowerCostTolerance,
+// Beside the two searches, each quantity gets one constrained fit at the
+// estimate's own value (held where it is, the others refitted). A
+// constrained fit that ends below F^ (by more than kLowerCostTolerance,
 // relative) shows that the estimate is no minimum: the lowest such point is
 // returned, and the caller fits again from it (EstimateUncertaintyAtMinimum,
 // parameter_uncertainty.h).
