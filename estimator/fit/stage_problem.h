@@ -69,14 +69,9 @@ class StageProblem {
   // Per ambient entry: held at its value in addition to the fixed entries
   // (empty: none), in place of StageSetup::held from the next Configure on.
   void Hold(const std::vector<bool>& held);
-  // The next evaluation (DataCost, a solve's first) gives every value a
-  // problem just assembled would give at that point: each residual block is
-  // evaluated anew, the vertical error's root solves from the measured
-  // amplitudes (VerticalErrorResidual::ForgetRoot). Without it the values a
-  // problem already evaluated gives can differ in the last bits from a new
-  // one's, as its root solves start where the last ones ended. So one
-  // problem can rate several points, and then be solved, with the values of
-  // a problem assembled for each.
+  // The next evaluation gives every value a problem just assembled would
+  // give at that point: each residual block is evaluated anew, the vertical
+  // error's root solves from the measured amplitudes (ForgetRoot).
   void EvaluateAfresh();
 
   // The cost of the dwells alone at the blocks' current values (infinity
@@ -163,10 +158,8 @@ class StageProblem {
   std::vector<bool> eta_e_entries_;       // per ambient entry
   std::vector<bool> damping_entries_;
   std::vector<bool> fixed_;
-  // Every residual block's cost function. The problem does not own them
-  // (Problem::Options::cost_function_ownership): owning, Ceres keeps a map
-  // entry per cost function to count its blocks, at a million dwells some
-  // 60 MB and a tree insertion per dwell. Destroyed after problem_.
+  // Every residual block's cost function (the problem does not own them, so
+  // Ceres keeps no map entry per cost function). Destroyed after problem_.
   std::vector<std::unique_ptr<const ceres::CostFunction>> cost_functions_;
   ParallelResidualEvaluator evaluator_;  // outlives the problems, which call it
   ceres::Problem problem_;
