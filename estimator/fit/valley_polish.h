@@ -10,8 +10,7 @@
 // near zero while the model's is not. Every step is then a fraction of the
 // way to the minimum, and the cost falls about twice as much as the model
 // predicts (step-quality ratio rho = actual / predicted decrease near 2; a
-// cost linear along the step gives exactly 2). At 1e5 simulated dwells the
-// vertical stage took 60 such steps.
+// cost linear along the step gives exactly 2).
 //
 // CreepWatcher stops a trust-region solve after `steps` successful steps in
 // a row with rho above `min_ratio`. PolishAlongValley then minimises the

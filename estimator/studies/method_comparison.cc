@@ -30,7 +30,7 @@ struct Method {
 
 // The weight of the root-transition penalty in the all-roots method, in
 // units of the data's cost where the stage starts (docs/model.md): large, as
-// the chapter's; with weight 1 the measured beam's fit loses its jump-downs.
+// the chapter's.
 constexpr double kAllRootsRangeWeight = 1e4;
 
 std::vector<Method> Methods(bool with_phase) {
