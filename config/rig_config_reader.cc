@@ -25,14 +25,14 @@ double NonNegative(const ConfigValue& value, const ConfigSource& source) {
 void ReadSettling(const ConfigValue& value, const ConfigSource& source, RigOptions* rig) {
   const StrictMap block(value, source, {"tolerance", "window_periods", "max_periods"});
   if (auto v = block.Optional("tolerance")) rig->settle_tolerance = Positive(*v, source);
-  if (auto v = block.Optional("window_periods")) rig->settle_window_periods = ReadInt(*v, source);
-  if (auto v = block.Optional("max_periods")) rig->max_settle_periods = ReadInt(*v, source);
+  block.Read("window_periods", &rig->settle_window_periods);
+  block.Read("max_periods", &rig->max_settle_periods);
 }
 
 RigChannels ReadChannels(const ConfigValue& value, const ConfigSource& source) {
   const StrictMap block(value, source, {"skew_samples", "base_filter_hz", "response_filter_hz"});
   RigChannels channels;
-  if (auto v = block.Optional("skew_samples")) channels.skew_samples = ReadFiniteDouble(*v, source);
+  block.Read("skew_samples", &channels.skew_samples);
   if (auto v = block.Optional("base_filter_hz"))
     channels.base_filter_cutoff_hz = NonNegative(*v, source);
   if (auto v = block.Optional("response_filter_hz")) {
@@ -51,7 +51,7 @@ void ReadBeam(const ConfigValue& value, const ConfigSource& source, StrainGaugeO
                 "boundary", {"cantilever", "clamped_clamped"});
   gauge->boundary =
       boundary == "cantilever" ? BeamBoundary::kCantilever : BeamBoundary::kClampedClamped;
-  if (auto v = block.Optional("mode")) gauge->mode = ReadInt(*v, source);
+  block.Read("mode", &gauge->mode);
   gauge->length_m = Positive(block.Required("length_m", "add the span [m]"), source);
   gauge->thickness_m = Positive(block.Required("thickness_m", "add the thickness [m]"), source);
   gauge->gauge_position_m = NonNegative(
@@ -70,9 +70,8 @@ void ReadProcessing(const ConfigValue& value, const ConfigSource& source,
   const StrictMap block(value, source,
                         {"correct_channels", "harmonics", "settle_tolerance",
                          "harmonic_warning_ratio", "level_tolerance"});
-  if (auto v = block.Optional("correct_channels"))
-    processing->correct_channels = ReadBool(*v, source);
-  if (auto v = block.Optional("harmonics")) processing->harmonics = ReadInt(*v, source);
+  block.Read("correct_channels", &processing->correct_channels);
+  block.Read("harmonics", &processing->harmonics);
   if (auto v = block.Optional("settle_tolerance"))
     processing->settle_tolerance = Positive(*v, source);
   if (auto v = block.Optional("harmonic_warning_ratio")) {

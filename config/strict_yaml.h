@@ -38,6 +38,11 @@ class StrictMap {
   std::optional<ConfigValue> Optional(const std::string& key) const;
   // Throws InputError "missing required key" ending with `hint` (what to add).
   ConfigValue Required(const std::string& key, const std::string& hint) const;
+  // Reads `key`, when present, into `value` (ReadFiniteDouble, ReadInt,
+  // ReadBool); leaves `value` as it is when absent.
+  void Read(const std::string& key, double* value) const;
+  void Read(const std::string& key, int* value) const;
+  void Read(const std::string& key, bool* value) const;
 
   const ConfigValue& block() const { return block_; }
 
