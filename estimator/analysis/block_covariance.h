@@ -31,17 +31,13 @@
 // entries stepping in those normalised units (ScaledSubsetManifold), and
 // returns C in physical units.
 //
-// Memory. J (n x k) is never held whole: it is evaluated a chunk of residual
-// blocks at a time (BlockCovarianceOptions::chunk_rows rows or a little more)
-// and each chunk folded into the upper-triangular k x k factor R of its QR
-// decomposition, J = Q R: with [R; J_chunk] = Q' R', R'^T R' = R^T R +
-// J_chunk^T J_chunk, so after the last chunk R^T R = J^T J, without forming
-// J^T J (which would square the condition number). R has J's column norms, singular values and
-// right singular vectors, so the collinearity check and the null space are
-// those of R with normalised columns, R_n. ceres::Covariance then runs on a
-// small problem: one copy of the entries and one linear residual block r =
-// M (x - x0) whose Jacobian in the normalised tangent coordinates is R_n,
-// so that its (R_n^T R_n)^-1 is the (J_n^T J_n)^-1 of the whole problem.
+// Memory. J (n x k) is never held whole: its R factor is accumulated a chunk
+// of residual blocks at a time (jacobian_factor.h), R^T R = J^T J, and the
+// collinearity check and the null space are those of R with normalised
+// columns, R_n. ceres::Covariance then runs on a small problem: one linear
+// residual block r = M (x - x0) whose Jacobian in the normalised tangent
+// coordinates is R_n, so that its (R_n^T R_n)^-1 is the (J_n^T J_n)^-1 of the
+// whole problem.
 //
 // Blocks of the caller's own that its residual blocks read are held at their
 // values: C is conditional on them.
