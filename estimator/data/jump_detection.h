@@ -37,7 +37,6 @@ struct JumpDetectionOptions {
   bool IsValid(std::string* error) const;
 };
 
-
 // What DetectJumps weighs in one sweep (for logs, reports and tests).
 //
 // Steps: r_i = ln(a_{i+1} / a_i) between consecutive dwells i, i+1.

@@ -93,10 +93,10 @@ struct StageSummary {
   // the branch-stability penalty divided by the dwells), exponents and
   // enforced jumps: what the analysis of the fit reads (profile_likelihood.h).
   PenaltyOptions penalties;
-  int residual_blocks = 0;   // dwell points fitted
-  int iterations = 0;        // over the stage's solves and valley polishes
-  int solves = 0;            // one, and one more per bound held or released and per valley polish
-  bool converged = false;    // its last solve met a convergence test
+  int residual_blocks = 0;  // dwell points fitted
+  int iterations = 0;       // over the stage's solves and valley polishes
+  int solves = 0;           // one, and one more per bound held or released and per valley polish
+  bool converged = false;   // its last solve met a convergence test
   // Bounded entries the stage ended holding on their bound (an active set),
   // as ambient indices of the description (for Identify: ParameterIndex).
   std::vector<int> held_at_bound;
