@@ -3,19 +3,12 @@
 // and the covariance (estimator/analysis/block_covariance.h) build theirs
 // here.
 //
-// In order: every described block (AddParameterBlock, blocks in order); the
-// dwells of every dataset in batches (ProblemBuilder::AddSweep on the
-// dataset's layout), evaluated on the threads of a ParallelResidualEvaluator
-// that watches every described block (unless !threaded_evaluation), and
-// with threaded evaluation seen by the solver as one compressed block
-// (compress_dwells); then, when asked, the penalties
-// (AddPenalties) and the caller's residual blocks (AddCallerResiduals); and
-// last the entries' configuration (Configure):
-//   - lower bound 0 on every entry holding eta_e of some dataset, and on
-//     every entry holding mu1 or mu2 when `bound_damping`;
-//   - fixed and held entries do not move; a block with none free is held
-//     constant, the others step in units of their scale
-//     (ScaledSubsetManifold).
+// In order: every described block; the dwells of every dataset in batches
+// (ProblemBuilder::AddSweep), evaluated through a ParallelResidualEvaluator
+// unless !threaded_evaluation, and then seen by the solver as one compressed
+// block (compress_dwells); when asked, the penalties (AddPenalties) and the
+// caller's residual blocks (AddCallerResiduals); last the entries' bounds,
+// fixed and held entries and scaling (Configure; fit_description.h).
 #ifndef DWELLFIT_ESTIMATOR_FIT_STAGE_PROBLEM_H_
 #define DWELLFIT_ESTIMATOR_FIT_STAGE_PROBLEM_H_
 
