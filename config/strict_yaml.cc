@@ -151,6 +151,22 @@ double ReadFiniteDouble(const ConfigValue& value, const ConfigSource& source) {
   return number;
 }
 
+double ReadPositive(const ConfigValue& value, const ConfigSource& source) {
+  const double number = ReadFiniteDouble(value, source);
+  if (!(number > 0.0)) {
+    throw source.Error(value.path, value.mark, "must be positive, got " + value.node.Scalar());
+  }
+  return number;
+}
+
+double ReadNonNegative(const ConfigValue& value, const ConfigSource& source) {
+  const double number = ReadFiniteDouble(value, source);
+  if (number < 0.0) {
+    throw source.Error(value.path, value.mark, "must not be negative, got " + value.node.Scalar());
+  }
+  return number;
+}
+
 int ReadInt(const ConfigValue& value, const ConfigSource& source) {
   return ReadNumber<int>(value, source, "an integer", "a whole number (e.g. 200)");
 }

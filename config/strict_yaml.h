@@ -57,6 +57,9 @@ class StrictMap {
 
 // Typed values; each throws InputError on a value of the wrong type.
 double ReadFiniteDouble(const ConfigValue& value, const ConfigSource& source);
+// A finite number > 0, and one >= 0.
+double ReadPositive(const ConfigValue& value, const ConfigSource& source);
+double ReadNonNegative(const ConfigValue& value, const ConfigSource& source);
 int ReadInt(const ConfigValue& value, const ConfigSource& source);
 std::uint64_t ReadUint64(const ConfigValue& value, const ConfigSource& source);
 bool ReadBool(const ConfigValue& value, const ConfigSource& source);
