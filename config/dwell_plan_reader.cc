@@ -37,22 +37,6 @@ SweepKind OtherKind(SweepKind kind) {
   return kind == SweepKind::kFrequency ? SweepKind::kAmplitude : SweepKind::kFrequency;
 }
 
-double ReadPositive(const ConfigValue& value, const ConfigSource& source) {
-  const double number = ReadFiniteDouble(value, source);
-  if (!(number > 0.0)) {
-    throw source.Error(value.path, value.mark, "must be positive, got " + value.node.Scalar());
-  }
-  return number;
-}
-
-double ReadNonNegative(const ConfigValue& value, const ConfigSource& source) {
-  const double number = ReadFiniteDouble(value, source);
-  if (number < 0.0) {
-    throw source.Error(value.path, value.mark, "must not be negative, got " + value.node.Scalar());
-  }
-  return number;
-}
-
 // A non-empty list, given as a list (a single value is not taken for one);
 // `expected` describes it in the error.
 std::vector<ConfigValue> ReadNonEmptyList(const ConfigValue& value, const ConfigSource& source,

@@ -210,14 +210,14 @@ void ThrowInvalidBlock(const ConfigValue& block, const ConfigSource& source,
 MultiStartOptions ReadMultiStart(const ConfigValue& value, const ConfigSource& source) {
   const StrictMap block(value, source, {"starts", "spread", "seed", "threads"});
   MultiStartOptions multi_start;
-  if (const auto v = block.Optional("starts")) multi_start.starts = ReadInt(*v, source);
-  if (const auto v = block.Optional("spread")) multi_start.spread = ReadFiniteDouble(*v, source);
+  block.Read("starts", &multi_start.starts);
+  block.Read("spread", &multi_start.spread);
   if (const auto v = block.Optional("seed")) {
     const int seed = ReadInt(*v, source);
     if (seed < 0) throw source.Error(v->path, v->mark, "must be a non-negative integer");
     multi_start.seed = static_cast<std::uint64_t>(seed);
   }
-  if (const auto v = block.Optional("threads")) multi_start.threads = ReadInt(*v, source);
+  block.Read("threads", &multi_start.threads);
   std::string message;
   if (!multi_start.IsValid(&message)) ThrowInvalidBlock(value, source, message);
   return multi_start;
@@ -303,9 +303,7 @@ ResidualOptions ReadResidual(const ConfigValue& value, const ConfigSource& sourc
                              DidYouMean(name, allowed) + "; allowed: " + JoinNames(allowed));
     }
   }
-  if (const auto use_point_sigma = block.Optional("use_point_sigma")) {
-    residual.use_point_sigma = ReadBool(*use_point_sigma, source);
-  }
+  block.Read("use_point_sigma", &residual.use_point_sigma);
   if (const auto floor = block.Optional("amplitude_floor")) {
     residual.amplitude_floor = ReadFiniteDouble(*floor, source);
     if (residual.amplitude_floor < 0.0) {
@@ -322,26 +320,14 @@ SolverSettings ReadSolver(const ConfigValue& value, const ConfigSource& source) 
       {"max_iterations", "function_tolerance", "start_function_tolerance", "gradient_tolerance",
        "parameter_tolerance", "num_threads", "nonmonotonic_steps", "valley_polish"});
   SolverSettings solver;
-  if (const auto v = block.Optional("max_iterations")) solver.max_iterations = ReadInt(*v, source);
-  if (const auto v = block.Optional("function_tolerance")) {
-    solver.function_tolerance = ReadFiniteDouble(*v, source);
-  }
-  if (const auto v = block.Optional("start_function_tolerance")) {
-    solver.start_function_tolerance = ReadFiniteDouble(*v, source);
-  }
-  if (const auto v = block.Optional("gradient_tolerance")) {
-    solver.gradient_tolerance = ReadFiniteDouble(*v, source);
-  }
-  if (const auto v = block.Optional("parameter_tolerance")) {
-    solver.parameter_tolerance = ReadFiniteDouble(*v, source);
-  }
-  if (const auto v = block.Optional("valley_polish")) {
-    solver.valley_polish = ReadBool(*v, source);
-  }
-  if (const auto v = block.Optional("nonmonotonic_steps")) {
-    solver.nonmonotonic_steps = ReadBool(*v, source);
-  }
-  if (const auto v = block.Optional("num_threads")) solver.num_threads = ReadInt(*v, source);
+  block.Read("max_iterations", &solver.max_iterations);
+  block.Read("function_tolerance", &solver.function_tolerance);
+  block.Read("start_function_tolerance", &solver.start_function_tolerance);
+  block.Read("gradient_tolerance", &solver.gradient_tolerance);
+  block.Read("parameter_tolerance", &solver.parameter_tolerance);
+  block.Read("valley_polish", &solver.valley_polish);
+  block.Read("nonmonotonic_steps", &solver.nonmonotonic_steps);
+  block.Read("num_threads", &solver.num_threads);
   return solver;
 }
 
@@ -350,18 +336,10 @@ JumpDetectionOptions ReadJumpDetection(const ConfigValue& value, const ConfigSou
       value, source,
       {"min_ratio", "min_relative_amplitude", "noise_multiple", "min_candidate_steps"});
   JumpDetectionOptions jump_detection;
-  if (const auto v = block.Optional("min_ratio")) {
-    jump_detection.min_ratio = ReadFiniteDouble(*v, source);
-  }
-  if (const auto v = block.Optional("min_relative_amplitude")) {
-    jump_detection.min_relative_amplitude = ReadFiniteDouble(*v, source);
-  }
-  if (const auto v = block.Optional("noise_multiple")) {
-    jump_detection.noise_multiple = ReadFiniteDouble(*v, source);
-  }
-  if (const auto v = block.Optional("min_candidate_steps")) {
-    jump_detection.min_candidate_steps = ReadInt(*v, source);
-  }
+  block.Read("min_ratio", &jump_detection.min_ratio);
+  block.Read("min_relative_amplitude", &jump_detection.min_relative_amplitude);
+  block.Read("noise_multiple", &jump_detection.noise_multiple);
+  block.Read("min_candidate_steps", &jump_detection.min_candidate_steps);
   return jump_detection;
 }
 
@@ -524,9 +502,9 @@ std::vector<JumpTarget> ReadJumpTargets(const ConfigValue& value, const ConfigSo
 BifurcationRangeOptions ReadBifurcationRange(const ConfigValue& value, const ConfigSource& source) {
   const StrictMap block(value, source, {"enabled", "exponent", "weight", "enforce"});
   BifurcationRangeOptions range;
-  if (const auto v = block.Optional("enabled")) range.enabled = ReadBool(*v, source);
-  if (const auto v = block.Optional("exponent")) range.exponent = ReadInt(*v, source);
-  if (const auto v = block.Optional("weight")) range.weight = ReadFiniteDouble(*v, source);
+  block.Read("enabled", &range.enabled);
+  block.Read("exponent", &range.exponent);
+  block.Read("weight", &range.weight);
   if (const auto v = block.Optional("enforce")) range.enforce = ReadJumpTargets(*v, source);
   return range;
 }
@@ -534,9 +512,9 @@ BifurcationRangeOptions ReadBifurcationRange(const ConfigValue& value, const Con
 BranchStabilityOptions ReadBranchStability(const ConfigValue& value, const ConfigSource& source) {
   const StrictMap block(value, source, {"enabled", "lambda", "weight"});
   BranchStabilityOptions stability;
-  if (const auto v = block.Optional("enabled")) stability.enabled = ReadBool(*v, source);
-  if (const auto v = block.Optional("lambda")) stability.lambda = ReadFiniteDouble(*v, source);
-  if (const auto v = block.Optional("weight")) stability.weight = ReadFiniteDouble(*v, source);
+  block.Read("enabled", &stability.enabled);
+  block.Read("lambda", &stability.lambda);
+  block.Read("weight", &stability.weight);
   return stability;
 }
 

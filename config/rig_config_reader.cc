@@ -6,37 +6,21 @@
 namespace dwellfit {
 namespace {
 
-double Positive(const ConfigValue& value, const ConfigSource& source) {
-  const double number = ReadFiniteDouble(value, source);
-  if (!(number > 0.0)) {
-    throw source.Error(value.path, value.mark, "must be positive, got " + value.node.Scalar());
-  }
-  return number;
-}
-
-double NonNegative(const ConfigValue& value, const ConfigSource& source) {
-  const double number = ReadFiniteDouble(value, source);
-  if (number < 0.0) {
-    throw source.Error(value.path, value.mark, "must not be negative, got " + value.node.Scalar());
-  }
-  return number;
-}
-
 void ReadSettling(const ConfigValue& value, const ConfigSource& source, RigOptions* rig) {
   const StrictMap block(value, source, {"tolerance", "window_periods", "max_periods"});
-  if (auto v = block.Optional("tolerance")) rig->settle_tolerance = Positive(*v, source);
-  if (auto v = block.Optional("window_periods")) rig->settle_window_periods = ReadInt(*v, source);
-  if (auto v = block.Optional("max_periods")) rig->max_settle_periods = ReadInt(*v, source);
+  if (auto v = block.Optional("tolerance")) rig->settle_tolerance = ReadPositive(*v, source);
+  block.Read("window_periods", &rig->settle_window_periods);
+  block.Read("max_periods", &rig->max_settle_periods);
 }
 
 RigChannels ReadChannels(const ConfigValue& value, const ConfigSource& source) {
   const StrictMap block(value, source, {"skew_samples", "base_filter_hz", "response_filter_hz"});
   RigChannels channels;
-  if (auto v = block.Optional("skew_samples")) channels.skew_samples = ReadFiniteDouble(*v, source);
+  block.Read("skew_samples", &channels.skew_samples);
   if (auto v = block.Optional("base_filter_hz"))
-    channels.base_filter_cutoff_hz = NonNegative(*v, source);
+    channels.base_filter_cutoff_hz = ReadNonNegative(*v, source);
   if (auto v = block.Optional("response_filter_hz")) {
-    channels.response_filter_cutoff_hz = NonNegative(*v, source);
+    channels.response_filter_cutoff_hz = ReadNonNegative(*v, source);
   }
   std::string error;
   if (!channels.IsValid(&error)) throw source.Error(value.path, value.mark, error);
@@ -51,18 +35,18 @@ void ReadBeam(const ConfigValue& value, const ConfigSource& source, StrainGaugeO
                 "boundary", {"cantilever", "clamped_clamped"});
   gauge->boundary =
       boundary == "cantilever" ? BeamBoundary::kCantilever : BeamBoundary::kClampedClamped;
-  if (auto v = block.Optional("mode")) gauge->mode = ReadInt(*v, source);
-  gauge->length_m = Positive(block.Required("length_m", "add the span [m]"), source);
-  gauge->thickness_m = Positive(block.Required("thickness_m", "add the thickness [m]"), source);
-  gauge->gauge_position_m = NonNegative(
+  block.Read("mode", &gauge->mode);
+  gauge->length_m = ReadPositive(block.Required("length_m", "add the span [m]"), source);
+  gauge->thickness_m = ReadPositive(block.Required("thickness_m", "add the thickness [m]"), source);
+  gauge->gauge_position_m = ReadNonNegative(
       block.Required("gauge_position_m", "add the gauge's distance from the clamp [m]"), source);
 }
 
 void ReadGauge(const ConfigValue& value, const ConfigSource& source, StrainGaugeOptions* gauge) {
   const StrictMap block(value, source, {"excitation_v", "gain", "gauge_factor"});
-  gauge->excitation_v = Positive(block.Required("excitation_v", "add V_excite [V]"), source);
-  gauge->gain = Positive(block.Required("gain", "add the conditioner's gain G"), source);
-  gauge->gauge_factor = Positive(block.Required("gauge_factor", "add K_g"), source);
+  gauge->excitation_v = ReadPositive(block.Required("excitation_v", "add V_excite [V]"), source);
+  gauge->gain = ReadPositive(block.Required("gain", "add the conditioner's gain G"), source);
+  gauge->gauge_factor = ReadPositive(block.Required("gauge_factor", "add K_g"), source);
 }
 
 void ReadProcessing(const ConfigValue& value, const ConfigSource& source,
@@ -70,16 +54,15 @@ void ReadProcessing(const ConfigValue& value, const ConfigSource& source,
   const StrictMap block(value, source,
                         {"correct_channels", "harmonics", "settle_tolerance",
                          "harmonic_warning_ratio", "level_tolerance"});
-  if (auto v = block.Optional("correct_channels"))
-    processing->correct_channels = ReadBool(*v, source);
-  if (auto v = block.Optional("harmonics")) processing->harmonics = ReadInt(*v, source);
+  block.Read("correct_channels", &processing->correct_channels);
+  block.Read("harmonics", &processing->harmonics);
   if (auto v = block.Optional("settle_tolerance"))
-    processing->settle_tolerance = Positive(*v, source);
+    processing->settle_tolerance = ReadPositive(*v, source);
   if (auto v = block.Optional("harmonic_warning_ratio")) {
-    processing->harmonic_warning_ratio = Positive(*v, source);
+    processing->harmonic_warning_ratio = ReadPositive(*v, source);
   }
   if (auto v = block.Optional("level_tolerance"))
-    processing->level_tolerance = Positive(*v, source);
+    processing->level_tolerance = ReadPositive(*v, source);
 }
 
 RigConfig ReadConfig(const ConfigSource& source) {
@@ -90,7 +73,7 @@ RigConfig ReadConfig(const ConfigSource& source) {
   RigConfig config;
   RigOptions& rig = config.rig;
   rig.sample_rate_hz =
-      Positive(block.Required("sample_rate_hz", "add the sample rate [Hz]"), source);
+      ReadPositive(block.Required("sample_rate_hz", "add the sample rate [Hz]"), source);
   rig.record_periods =
       ReadInt(block.Required("record_periods", "add the drive periods recorded per dwell"), source);
   if (auto v = block.Optional("settling")) ReadSettling(*v, source, &rig);
@@ -98,7 +81,7 @@ RigConfig ReadConfig(const ConfigSource& source) {
   if (auto v = block.Optional("noise")) {
     const StrictMap noise(*v, source, {"relative_sigma", "seed"});
     rig.noise_relative_sigma =
-        NonNegative(noise.Required("relative_sigma", "add relative_sigma (0: none)"), source);
+        ReadNonNegative(noise.Required("relative_sigma", "add relative_sigma (0: none)"), source);
     rig.noise_seed = ReadUint64(noise.Required("seed", "add seed (a whole number >= 0)"), source);
   }
   ReadBeam(block.Required("beam",

@@ -119,6 +119,18 @@ std::optional<ConfigValue> StrictMap::Optional(const std::string& key) const {
   return entry->second;
 }
 
+void StrictMap::Read(const std::string& key, double* value) const {
+  if (const auto v = Optional(key)) *value = ReadFiniteDouble(*v, source_);
+}
+
+void StrictMap::Read(const std::string& key, int* value) const {
+  if (const auto v = Optional(key)) *value = ReadInt(*v, source_);
+}
+
+void StrictMap::Read(const std::string& key, bool* value) const {
+  if (const auto v = Optional(key)) *value = ReadBool(*v, source_);
+}
+
 ConfigValue StrictMap::Required(const std::string& key, const std::string& hint) const {
   const auto entry = entries_.find(key);
   if (entry != entries_.end()) return entry->second;
@@ -135,6 +147,22 @@ double ReadFiniteDouble(const ConfigValue& value, const ConfigSource& source) {
     throw source.Error(
         value.path, value.mark,
         "expected a finite number, got '" + EscapeForMessage(value.node.Scalar()) + "'");
+  }
+  return number;
+}
+
+double ReadPositive(const ConfigValue& value, const ConfigSource& source) {
+  const double number = ReadFiniteDouble(value, source);
+  if (!(number > 0.0)) {
+    throw source.Error(value.path, value.mark, "must be positive, got " + value.node.Scalar());
+  }
+  return number;
+}
+
+double ReadNonNegative(const ConfigValue& value, const ConfigSource& source) {
+  const double number = ReadFiniteDouble(value, source);
+  if (number < 0.0) {
+    throw source.Error(value.path, value.mark, "must not be negative, got " + value.node.Scalar());
   }
   return number;
 }

@@ -38,6 +38,11 @@ class StrictMap {
   std::optional<ConfigValue> Optional(const std::string& key) const;
   // Throws InputError "missing required key" ending with `hint` (what to add).
   ConfigValue Required(const std::string& key, const std::string& hint) const;
+  // Reads `key`, when present, into `value` (ReadFiniteDouble, ReadInt,
+  // ReadBool); leaves `value` as it is when absent.
+  void Read(const std::string& key, double* value) const;
+  void Read(const std::string& key, int* value) const;
+  void Read(const std::string& key, bool* value) const;
 
   const ConfigValue& block() const { return block_; }
 
@@ -52,6 +57,9 @@ class StrictMap {
 
 // Typed values; each throws InputError on a value of the wrong type.
 double ReadFiniteDouble(const ConfigValue& value, const ConfigSource& source);
+// A finite number > 0, and one >= 0.
+double ReadPositive(const ConfigValue& value, const ConfigSource& source);
+double ReadNonNegative(const ConfigValue& value, const ConfigSource& source);
 int ReadInt(const ConfigValue& value, const ConfigSource& source);
 std::uint64_t ReadUint64(const ConfigValue& value, const ConfigSource& source);
 bool ReadBool(const ConfigValue& value, const ConfigSource& source);

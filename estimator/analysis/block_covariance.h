@@ -20,9 +20,8 @@
 // sqrt(C_jj), q the 0.975 quantile of Student's t with n - k degrees of
 // freedom (s estimated) or of the standard normal (s = 1).
 //
-// Scaling. The entries span nine decades (mu1 ~ 0.1, alpha ~ 1e9): on the
-// unscaled problem ceres::Covariance meets a reciprocal condition number near
-// 1e-21 (two beams sharing eta_e) and fails. Here J is taken in tangent
+// Scaling. The entries span nine decades (mu1 ~ 0.1, alpha ~ 1e9), so J is
+// taken in tangent
 // units of each entry's magnitude and its columns are normalised to unit
 // length; the condition number of that matrix measures only how nearly the
 // entries' effects on the residuals coincide (the collinearity diagnostic of
@@ -32,18 +31,13 @@
 // entries stepping in those normalised units (ScaledSubsetManifold), and
 // returns C in physical units.
 //
-// Memory. J (n x k) is never held whole: it is evaluated a chunk of residual
-// blocks at a time (BlockCovarianceOptions::chunk_rows rows or a little more)
-// and each chunk folded into the upper-triangular k x k factor R of its QR
-// decomposition, J = Q R: with [R; J_chunk] = Q' R', R'^T R' = R^T R +
-// J_chunk^T J_chunk, so after the last chunk R^T R = J^T J, without forming
-// J^T J (which would square the condition number: collinearity 1e8 is a
-// condition number 1e16 there). R has J's column norms, singular values and
-// right singular vectors, so the collinearity check and the null space are
-// those of R with normalised columns, R_n. ceres::Covariance then runs on a
-// small problem: one copy of the entries and one linear residual block r =
-// M (x - x0) whose Jacobian in the normalised tangent coordinates is R_n,
-// so that its (R_n^T R_n)^-1 is the (J_n^T J_n)^-1 of the whole problem.
+// Memory. J (n x k) is never held whole: its R factor is accumulated a chunk
+// of residual blocks at a time (jacobian_factor.h), R^T R = J^T J, and the
+// collinearity check and the null space are those of R with normalised
+// columns, R_n. ceres::Covariance then runs on a small problem: one linear
+// residual block r = M (x - x0) whose Jacobian in the normalised tangent
+// coordinates is R_n, so that its (R_n^T R_n)^-1 is the (J_n^T J_n)^-1 of the
+// whole problem.
 //
 // Blocks of the caller's own that its residual blocks read are held at their
 // values: C is conditional on them.
@@ -62,8 +56,7 @@ namespace dwellfit {
 // Largest sigma_max / sigma_min of the column-normalised Jacobian for which a
 // covariance is reported: about 1/sqrt(machine epsilon), so that J^T J keeps a
 // reciprocal condition number above ~1e-16 and its inverse is not rounding
-// noise. Measured: exactly collinear parameters (delta and alpha on one
-// amplitude sweep) give 8e15; the thesis case's two fitted sweeps give ~200.
+// noise.
 inline constexpr double kMaxCollinearity = 1e8;
 
 struct BlockCovarianceOptions {

@@ -1,19 +1,10 @@
 // How a dwellfit tool's process asks the C library's allocator to treat
 // large blocks.
 //
-// By default glibc serves every block of 128 KiB and more (growing with use
-// up to 32 MiB) with its own mmap, and hands it back to the kernel when it is
-// freed; memory freed at the top of the heap beyond 128 KiB goes back too.
-// A fit allocates and frees blocks of that size again and again (each stage's
-// problem, Ceres' Jacobian and its QR copies, the output text), and every
-// time the kernel must map fresh zeroed pages in on first touch: one page
-// fault per 4 KiB, some 10 microseconds each on a virtual machine. Kept in
-// the heap instead, a freed block is reused as it is.
-//
-// What a run has freed is not returned before it ends. That can raise the
-// peak resident memory where a phase that frees much is followed by one whose
-// blocks do not fit in the freed space (blocks of 32 MiB and more are still
-// mapped afresh): a run calls ReturnFreedMemory between the two.
+// A fit allocates and frees large blocks again and again; kept in the heap
+// rather than mapped afresh each time (glibc's default above 128 KiB), a
+// freed block is reused without page faults. What a run has freed is not
+// returned before it ends unless it calls ReturnFreedMemory.
 #ifndef DWELLFIT_ESTIMATOR_COMMON_MEMORY_POLICY_H_
 #define DWELLFIT_ESTIMATOR_COMMON_MEMORY_POLICY_H_
 
@@ -26,9 +17,7 @@ namespace dwellfit {
 bool KeepFreedMemoryForReuse();
 
 // Returns the pages of the heap's free memory to the kernel (malloc_trim);
-// blocks later served from them fault their pages in again. On a
-// million-dwell identify run, called after the fit: 15 ms, and the run's
-// peak 435 -> 336 MB resident.
+// blocks later served from them fault their pages in again.
 void ReturnFreedMemory();
 
 }  // namespace dwellfit

@@ -420,14 +420,4 @@ double CurveAmplitudeOnBranch(const std::vector<CurveRoot>& roots, Branch branch
   return best;
 }
 
-std::vector<double> FrequenciesAtAmplitude(const ParameterVector& p, double a_base, double a) {
-  double x_minus, x_plus;
-  QuadraticRoots(MakeQuadratic(p, a_base, a), false, &x_minus, &x_plus);
-  std::vector<double> omegas;
-  for (double x : {x_minus, x_plus}) {
-    if (x > 0.0) omegas.push_back(std::sqrt(x));
-  }
-  return omegas;
-}
-
 }  // namespace dwellfit

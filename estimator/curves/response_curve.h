@@ -104,12 +104,6 @@ std::vector<CurveRoot> CurveAmplitudesAt(const ParameterVector& parameters,
 // (kOnly). NaN when the curve has no stable root there.
 double CurveAmplitudeOnBranch(const std::vector<CurveRoot>& roots, Branch branch, double a_guess);
 
-// The frequency-sweep drive frequencies at amplitude `a` and base level
-// `a_base`: the positive roots x = Omega^2 of the quadratic above, as Omega
-// [rad/s] ascending (zero, one or two).
-std::vector<double> FrequenciesAtAmplitude(const ParameterVector& parameters, double a_base,
-                                           double a);
-
 }  // namespace dwellfit
 
 #endif  // DWELLFIT_ESTIMATOR_CURVES_RESPONSE_CURVE_H_

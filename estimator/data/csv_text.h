@@ -1,10 +1,7 @@
 // The text of a large CSV file, built row by row in one buffer.
 //
-// The run's predictions.csv and curves.csv hold tens of thousands of rows of
-// four numbers each. Each field is written straight into the end of one
-// growing buffer: numbers by std::to_chars (the shortest text that reads back
-// as the same double), labels by one copy, with no stream, temporary string
-// or per-character append.
+// Numbers are written by std::to_chars (the shortest text that reads back as
+// the same double), straight into the end of one growing buffer.
 //
 //   CsvText csv("sweep,freq_hz,a", rows * 40);
 //   csv.Text("F1");

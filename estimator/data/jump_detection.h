@@ -18,8 +18,8 @@
 
 namespace dwellfit {
 
-// Jump detection in measured sweeps (the test and the numbers behind these
-// defaults are below).
+// Jump detection in measured sweeps (docs/performance.md has the data sets
+// behind these defaults).
 struct JumpDetectionOptions {
   // A jump's step between consecutive dwells must change the amplitude by
   // more than this ratio, either way (in an amplitude sweep: beyond the
@@ -37,7 +37,6 @@ struct JumpDetectionOptions {
   bool IsValid(std::string* error) const;
 };
 
-
 // What DetectJumps weighs in one sweep (for logs, reports and tests).
 //
 // Steps: r_i = ln(a_{i+1} / a_i) between consecutive dwells i, i+1.
@@ -52,11 +51,8 @@ struct JumpDetectionOptions {
 // trend (the slope changes sign at the peak): p = 0 and e_i = r_i.
 // Noise: sigma = 1.4826 MAD(e) over the candidates, the robust standard
 // deviation of a step. Over the candidates, not the whole sweep: the noise
-// floor far from resonance is noisier in ln(a) than the response near it
-// (measured beam, down-sweeps: 0.019-0.032 over all steps, 0.010-0.017 over
-// the candidates). The MAD ignores the jump itself and a smeared transition
-// of a few steps. It measures the sweep's own step-to-step change (noise and
-// slope), so a jump is a step that stands out from both.
+// floor far from resonance is noisier in ln(a) than the response near it.
+// The MAD ignores the jump itself and a smeared transition of a few steps.
 struct JumpEvidence {
   int candidate_steps = 0;
   int step = -1;             // the candidate with the largest |e_i| (-1: none)
@@ -77,18 +73,7 @@ JumpEvidence WeighJumpEvidence(const JumpDetectionOptions& options, const Sweep&
 // Finds at most one jump in `sweep` and labels every point's branch.
 //
 // The jump is the step WeighJumpEvidence accepts: amplitude rising across it
-// is a jump up, falling a jump down. The defaults (identification_options.h)
-// were set on two data sets, |e| / threshold being the margin:
-// - the measured clamped beam (datasets/clamped-beam-27C): the up-sweeps of
-//   0.040-0.085 g drop by a factor 39-148 (1170-5560 sigma, margin 54-74);
-//   the down-sweeps' jump up is smeared over several dwells, its largest step
-//   a factor 1.10-1.43 only (7.4-29.6 sigma, margin 1.24-4.6), found at most
-//   two dwells before the top of the transition; steps more than 10 dwells
-//   away from the jump reach at most 0.80 of the threshold;
-// - the thesis-numerical plan, noise-free and with 1 % noise (100 seeds):
-//   exactly the true jump in every sweep, margin at least 2.7; frequency
-//   sweeps below the onset of hysteresis reach at most 0.3 of the threshold,
-//   amplitude sweeps without a fold (39 and 40 Hz) at most 0.83.
+// is a jump up, falling a jump down.
 // Limits: a smooth but nearly vertical flank just below the onset of
 // hysteresis, or a sharp peak sampled by a handful of dwells, can pass for a
 // jump or hide one; state such sweeps in the config (`jumps:`).
@@ -98,9 +83,7 @@ JumpEvidence WeighJumpEvidence(const JumpDetectionOptions& options, const Sweep&
 // reaches min_relative_amplitude of the largest amplitude, the response left
 // the branch it was on and the instrument recorded nothing: a jump down
 // between the last dwell and the first missing row (after it, at another
-// control), marked into_missing_data. The measured beam's 0.090 and 0.095 g
-// up-sweeps end so: their largest step is a factor 1.016 (margin 0.24), then
-// zeros.
+// control), marked into_missing_data.
 //
 // Labels: before a jump down Branch::kUpper and after it kLower; before a jump
 // up kLower and after it kUpper; no jump: every point kOnly. Replaces any

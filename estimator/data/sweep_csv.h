@@ -19,14 +19,9 @@
 // are skipped; lines may end in LF or CRLF (not CR alone); a UTF-8 byte-order
 // mark before the header is skipped.
 //
-// Why the bounds: the model takes powers up to a^6 and Omega^4 and squares
-// the residuals; its parameters take magnitudes set by the data's units
-// (alpha ~ w^2 / a^2). With every magnitude within 1e-20..1e20 (frequencies
-// within 1e-6..1e9 Hz, Omega^4 < 1.6e39) those powers stay within about
-// 1e+-120 and their squares within 1e+-240: normal doubles, far from overflow
-// (1.8e308) and from subnormal underflow (2.2e-308), where a cost becomes inf
-// or NaN and a fit garbage. Any unit that puts a small vibration's amplitude
-// between 1e-12 and 1e3 (SI metres included) is well inside.
+// The bounds keep the model's powers (up to a^6 and Omega^4) and the squared
+// residuals within about 1e+-240: normal doubles, far from overflow and
+// subnormal underflow.
 //
 // Order: within a sweep, the control (freq_hz in a frequency sweep, a_base in
 // an amplitude sweep) must rise from row to row in an up-sweep and fall in a

@@ -5,9 +5,7 @@
 // and so is each parameter block's Jacobian (row-major, the members' rows
 // stacked). Ceres' work per residual block (bookkeeping, the Jacobian's
 // projection onto the manifold, the validity checks) is then paid once per
-// batch instead of once per dwell, which on thousands of one-row dwell blocks
-// was about a third of a fit's time. Each member keeps its own definition: for
-// a dwell the autodiff VerticalErrorResidual with its Newton root solve.
+// batch instead of once per dwell. Each member keeps its own definition.
 //
 // The cost of a batch is (1/2) sum_i |r_i|^2, the sum of its members' costs;
 // no loss function may be attached to a batch (it would act on the sum).
@@ -49,9 +47,8 @@ class BatchedCostFunction : public ceres::CostFunction {
 
 // FunctorBatch: the same stacking for dwells whose cost function would be a
 // ceres::AutoDiffCostFunction<Functor, 1, kNumParameters> each, with the
-// functors held side by side instead of a cost function object (and its
-// vector of block sizes) per dwell: on a million dwells some 100 MB less at a
-// fit's peak. Functor's operator() is Functor::Evaluate on the parameters'
+// functors held side by side instead of a cost function object per dwell.
+// Functor's operator() is Functor::Evaluate on the parameters'
 // terms (ParameterTerms); a batch forms the terms once for all its members,
 // from the parameters with Jacobians as Jets seeded by Ceres'
 // Make1stOrderPerturbations (as AutoDifferentiate seeds them per call), and

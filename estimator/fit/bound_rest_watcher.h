@@ -3,14 +3,9 @@
 //
 // Ceres projects a trust-region step that crosses a bound back onto it, but
 // rates the step by the decrease its linear model predicted for the
-// unprojected step. While the cost pulls a parameter through its bound (the
-// measured beam's mu2 = 0), every step therefore rates poorly, the trust
-// region shrinks step after step, and the solve creeps: on the beam, some
-// 150 iterations at a step-quality ratio near 0.24 whose predicted and
-// actual decreases agree once the projection is accounted for. With the
-// parameter held at its bound the model is exact again and the solve
-// converges in a few steps (Identify's stages: hold, solve, then release any
-// held parameter whose cost gradient points back into the feasible side).
+// unprojected step. While the cost pulls a parameter through its bound every
+// step therefore rates poorly, the trust region shrinks and the solve
+// creeps. With the parameter held at its bound the model is exact again.
 //
 // The watcher reads the watched entries after every successful step (needs
 // ceres::Solver::Options::update_state_every_iteration) and stops the solve,
@@ -18,10 +13,8 @@
 // on its bound for `steps` successful steps in a row. It reads each entry
 // twice: in the caller's block, and, where given, in the solver's iterate.
 // The two differ with non-monotonic steps, where Ceres writes only the best
-// point so far into the caller's blocks: during an excursion above that
-// cost the iterate can rest on a bound (and creep along it, as above) while
-// the best point lies elsewhere. resting_at_iterate() says that the iterate
-// rested there and the best point did not.
+// point so far into the caller's blocks. resting_at_iterate() says that the
+// iterate rested there and the best point did not.
 #ifndef DWELLFIT_ESTIMATOR_FIT_BOUND_REST_WATCHER_H_
 #define DWELLFIT_ESTIMATOR_FIT_BOUND_REST_WATCHER_H_
 

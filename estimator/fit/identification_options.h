@@ -40,20 +40,13 @@ struct ResidualOptions {
 struct SolverSettings {
   int max_iterations = 200;
   // Convergence tests of ceres::Solver::Options. The gradient and parameter
-  // tests are off in effect: parameters span nine orders of magnitude (see
-  // ProblemBuilder). A relative cost change of 1e-8 resolves a fit far below
-  // its statistics (noise moves the cost by about 1/N of itself), and exact
-  // data still converge to round-off, their cost falling by decades a step;
-  // tighter, measured data only creep along their weakly determined
-  // directions (the beam's delta-alpha valley).
+  // tests are off in effect: parameters span nine orders of magnitude. A
+  // relative cost change of 1e-8 resolves a fit far below its statistics
+  // (noise moves the cost by about 1/N of itself).
   double function_tolerance = 1e-8;
   // The same test for an algebraic stage whose end only starts a later stage
   // (the start stage, a fold stage, an algebraic stage before the last):
-  // its minimum is not the estimate, and on measured data its cost creeps
-  // along the same valleys long after its end has stopped changing where
-  // the later stage starts (the measured beam: 31 iterations at 1e-8, 16 at
-  // 1e-5, and 103 against 78 in all, for the same final cost;
-  // docs/performance.md).
+  // its minimum is not the estimate (docs/performance.md).
   double start_function_tolerance = 1e-5;
   double gradient_tolerance = 1e-30;
   double parameter_tolerance = 1e-20;
@@ -66,9 +59,8 @@ struct SolverSettings {
   // narrow valleys of measured data with penalties.
   bool nonmonotonic_steps = false;
   // Finish a vertical or all-roots solve that creeps along a weakly
-  // determined direction with a quasi-Newton polish (valley_polish.h):
-  // the simulated sweep of 1e6 dwells in 13 BFGS iterations instead of 60
-  // Levenberg-Marquardt steps. false: Levenberg-Marquardt alone.
+  // determined direction with a quasi-Newton polish (valley_polish.h).
+  // false: Levenberg-Marquardt alone.
   bool valley_polish = true;
   bool IsValid(std::string* error) const;
 };

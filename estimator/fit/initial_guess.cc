@@ -418,11 +418,13 @@ void SetStiffness(const BackboneFit& fit, const KnownParameters& known,
   std::vector<std::string>& steps = report->steps;
   if (known[kNaturalFrequency]) {
     guess[kNaturalFrequency] = *known[kNaturalFrequency];
-    steps.push_back(StringPrintf("omega = %s: given", RadPerSecondText(guess[kNaturalFrequency]).c_str()));
+    steps.push_back(
+        StringPrintf("omega = %s: given", RadPerSecondText(guess[kNaturalFrequency]).c_str()));
   } else {
     guess[kNaturalFrequency] = std::sqrt(fit.w2);
     steps.push_back(StringPrintf("omega = %s: %s; w^2 is its value at a = 0",
-                                 RadPerSecondText(guess[kNaturalFrequency]).c_str(), fit.how.c_str()));
+                                 RadPerSecondText(guess[kNaturalFrequency]).c_str(),
+                                 fit.how.c_str()));
   }
   if (known[kAlpha]) {
     guess[kAlpha] = *known[kAlpha];

@@ -19,11 +19,8 @@
 
 namespace dwellfit {
 
-// The most starts a run may ask for. Each start is a whole fit (0.01-0.2 s
-// on the bundled data on two cores), so 1000 starts take minutes at most,
-// while a factor-3 box in six parameters is sampled densely long before that
-// (the bundled cases reach their best from a handful of starts); a larger
-// count is a typo or a wrong unit, and would run for hours.
+// The most starts a run may ask for: each start is a whole fit, and a larger
+// count is more likely a typo than a need.
 inline constexpr int kMaxStarts = 1000;
 
 struct MultiStartOptions {

@@ -21,9 +21,7 @@ namespace dwellfit {
 int ResolveThreadCount(int num_threads) {
   if (num_threads > 0) return num_threads;
   // The processors this process may run on (its affinity mask), not every
-  // processor of the host. Asked of the kernel: TBB's answer first maps the
-  // machine's topology, loading libraries for it (some 1.5 ms of a process
-  // whose fit takes one).
+  // processor of the host.
   cpu_set_t allowed;
   CPU_ZERO(&allowed);
   if (sched_getaffinity(0, sizeof(allowed), &allowed) == 0) return std::max(1, CPU_COUNT(&allowed));
@@ -35,14 +33,8 @@ int ResolveThreadCount(int num_threads) {
 // caller returns once every unit has run. A thread without work sleeps on a
 // condition variable at once, without spinning: woken for the next
 // evaluation, it gets the processor back at once from a program that shares
-// its core, and runs its units before that program's turn comes again.
-// (TBB's workers look for work for a while before they sleep; on two cores
-// with one kept busy by another process, that program then preempted them
-// in the middle of a unit, and the caller waited milliseconds for it: the
-// beam fit took 16-29 % longer than on one thread, 1-33 % shorter with
-// these threads; docs/performance.md.) A thread that wakes late finds the
-// units taken and sleeps again; it never touches an evaluation that has
-// ended.
+// its core (TBB's workers spin before they sleep; docs/performance.md). A
+// thread that wakes late finds the units taken and sleeps again.
 class ParallelResidualEvaluator::Workers {
  public:
   explicit Workers(int threads) {
@@ -70,9 +62,8 @@ class ParallelResidualEvaluator::Workers {
     }
     wake_.notify_all();
     Work(batch.get());
-    // The units still running on the threads: waited for on the processor
-    // (an idle machine's thread ends its unit within some 50 us), then,
-    // after about a millisecond, asleep.
+    // The units still running on the threads: waited for on the processor,
+    // then, after about a millisecond, asleep.
     int spins = 0;
     while (batch->done.load() < units && ++spins < kCallerSpins) {
     }

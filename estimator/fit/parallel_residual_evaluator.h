@@ -1,56 +1,26 @@
 // ParallelResidualEvaluator: evaluates the residual blocks of one parameter
 // block on several threads before Ceres asks for them, deterministically.
 //
-// Ceres' own threaded evaluation (Solver::Options::num_threads) sums the cost
-// and gradient in per-thread partial sums whose membership follows the
-// scheduling, so their last bits, and with them a trust-region path that is
-// sensitive to last bits, vary from run to run; on this problem (thousands
-// of one-row blocks) it was also no faster (the measured-beam fit: 0.78 s on
-// two threads, 0.76 s on one). Here Ceres runs on one thread and this class,
-// its EvaluationCallback, evaluates every wrapped cost function at each new
-// point, as Ceres' ParallelFor does, on `num_threads` threads (the caller's
-// among them; Solver::Options::num_threads, 0 meaning one per processor
-// available) or, below a size, inline on the caller. The work is split into
-// units fixed by the wrappers' order whatever the thread count (a chunk of
-// compressed wrappers, or one other wrapper), each unit writes only its own
-// values, and they are combined in unit order: each block's residual and
-// Jacobian come from the same code whichever thread runs it, and Ceres sums
-// them in block order, so the solve does not depend on the number of
-// threads. The units go one at a time to whichever thread asks next, the
-// caller among them, so a thread the machine is slow to run leaves the
-// rest to the others. The other threads are the evaluator's own
-// (num_threads - 1, started with its first threaded evaluation, joined
-// with it), and sleep as soon as their units are done (Workers, in the .cc,
-// says why not TBB's). Fewer than 2 * kMinRowsPerThread residuals, or fewer
-// than two units, run inline (waking a thread costs tens of microseconds;
-// kMinRowsPerThread says what was measured). No timing, no state outside
-// the evaluator.
+// Ceres runs on one thread; this class, its EvaluationCallback, evaluates
+// every wrapped cost function at each new point on `num_threads` threads (the
+// caller's among them; 0 means one per processor available) or, below a size,
+// inline. The work is split into units fixed by the wrappers' order whatever
+// the thread count, each unit writes only its own values, and Ceres sums them
+// in block order, so the solve does not depend on the number of threads.
 //
-// Compress() stands the wrappers made so far (a stage's dwells) in for one
-// residual block of a few rows: with the wrappers' rows stacked as
-// A = [J | r] (m rows; J over the whole point, r the residuals), the
+// Compress() stands the wrappers made so far in for one residual block of a
+// few rows: with the wrappers' rows stacked as A = [J | r] (m rows), the
 // Householder factorization A = Q [R_J q; 0 rho; 0 0] gives the block whose
 // residuals are [q; rho] and whose Jacobian is [R_J; 0]. Its cost
 // (|q|^2 + rho^2)/2 is |r|^2/2, its gradient R_J^T q is J^T r, its
 // Gauss-Newton matrix R_J^T R_J is J^T J, and for every step s
-// |[q; rho] + [R_J; 0] s| = |r + J s|: a trust-region solve takes the steps
-// it would take on the m rows, while Ceres' work per iteration (the
-// Jacobian's assembly, scaling and dense QR, each over m rows, about a third
-// of the measured beam's fit on one thread) shrinks to a few rows. The
-// factorization runs with the evaluation, on the threads: the wrappers in
-// chunks of about kCompressedChunkRows rows, fixed by the wrappers' order
-// whatever the thread count, each chunk's rows to an R of its own, and then
-// the chunks' R, stacked in order, to one (tall-skinny QR). Its Jacobian is
-// not the derivative of its residuals (Q moves with the point), so only a
-// Gauss-Newton-type solver may use it; the wrappers' own values stay as
-// they were for everything else (CostGradient, a problem of their own).
+// |[q; rho] + [R_J; 0] s| = |r + J s|. The factorization is a tall-skinny QR
+// over chunks of about kCompressedChunkRows rows. Its Jacobian is not the
+// derivative of its residuals (Q moves with the point), so only a
+// Gauss-Newton-type solver may use it.
 //
-// A wrapped cost function (Wrap) keeps its own definition: for a dwell it is
-// the autodiff VerticalErrorResidual with its Newton root solve. Ceres then
-// calls the wrapper, which returns the values computed for the point the
-// callback last saw, and evaluates the wrapped function itself at any other
-// point. Jacobians are computed with every new point: a trust-region step is
-// usually accepted, and Ceres then asks for the Jacobian at that same point.
+// A wrapper (Wrap) returns the values computed for the point the callback
+// last saw, and evaluates the wrapped function itself at any other point.
 //
 // Use: construct with the parameter blocks the wrapped functions read, pass
 // it as ceres::Problem::Options::evaluation_callback, add Wrap(cost, blocks)
@@ -84,14 +54,7 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   };
 
   // Residuals per thread at the least: an evaluation of fewer than twice
-  // this many runs inline on the caller. Measured on two cores with
-  // BM_CompressedDwellEvaluation (identification_benchmark; the measured
-  // beam's vertical residuals, compressed, one evaluation with Jacobians per
-  // point, min_rows_per_thread 1; us on 1 / 2 threads, medians of five, two
-  // runs): 512 dwells 99 / 92-97, 1024 dwells 244-260 / 174-193, 2048
-  // dwells 417-420 / 328-345, 4096 dwells 839-864 / 643-667. Two chunks of
-  // kCompressedChunkRows break even (waking a thread costs some 50-100 us on
-  // that machine); four gain 1.35x.
+  // this many runs inline on the caller (docs/performance.md).
   static constexpr int kMinRowsPerThread = 512;
 
   // `blocks`: every parameter block a wrapped cost function reads, distinct.

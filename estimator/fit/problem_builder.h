@@ -44,10 +44,7 @@ struct ProblemBuilderOptions {
   PenaltyOptions penalties;
   // AddSweep puts up to ProblemBuilder::kDwellsPerBatch consecutive dwells in
   // one residual block (FunctorBatch, BatchedCostFunction) instead of one
-  // block per dwell:
-  // Ceres' work and memory per block are then paid once per batch. Every
-  // stage problem (stage_problem.h) batches; a caller that wants a residual
-  // block per dwell keeps the default.
+  // block per dwell.
   bool batch_dwells = false;
   bool IsValid(std::string* error) const;
 };

@@ -3,19 +3,12 @@
 // and the covariance (estimator/analysis/block_covariance.h) build theirs
 // here.
 //
-// In order: every described block (AddParameterBlock, blocks in order); the
-// dwells of every dataset in batches (ProblemBuilder::AddSweep on the
-// dataset's layout), evaluated on the threads of a ParallelResidualEvaluator
-// that watches every described block (unless !threaded_evaluation), and
-// with threaded evaluation seen by the solver as one compressed block
-// (compress_dwells); then, when asked, the penalties
-// (AddPenalties) and the caller's residual blocks (AddCallerResiduals); and
-// last the entries' configuration (Configure):
-//   - lower bound 0 on every entry holding eta_e of some dataset, and on
-//     every entry holding mu1 or mu2 when `bound_damping`;
-//   - fixed and held entries do not move; a block with none free is held
-//     constant, the others step in units of their scale
-//     (ScaledSubsetManifold).
+// In order: every described block; the dwells of every dataset in batches
+// (ProblemBuilder::AddSweep), evaluated through a ParallelResidualEvaluator
+// unless !threaded_evaluation, and then seen by the solver as one compressed
+// block (compress_dwells); when asked, the penalties (AddPenalties) and the
+// caller's residual blocks (AddCallerResiduals); last the entries' bounds,
+// fixed and held entries and scaling (Configure; fit_description.h).
 #ifndef DWELLFIT_ESTIMATOR_FIT_STAGE_PROBLEM_H_
 #define DWELLFIT_ESTIMATOR_FIT_STAGE_PROBLEM_H_
 
@@ -69,14 +62,9 @@ class StageProblem {
   // Per ambient entry: held at its value in addition to the fixed entries
   // (empty: none), in place of StageSetup::held from the next Configure on.
   void Hold(const std::vector<bool>& held);
-  // The next evaluation (DataCost, a solve's first) gives every value a
-  // problem just assembled would give at that point: each residual block is
-  // evaluated anew, the vertical error's root solves from the measured
-  // amplitudes (VerticalErrorResidual::ForgetRoot). Without it the values a
-  // problem already evaluated gives can differ in the last bits from a new
-  // one's, as its root solves start where the last ones ended. So one
-  // problem can rate several points, and then be solved, with the values of
-  // a problem assembled for each.
+  // The next evaluation gives every value a problem just assembled would
+  // give at that point: each residual block is evaluated anew, the vertical
+  // error's root solves from the measured amplitudes (ForgetRoot).
   void EvaluateAfresh();
 
   // The cost of the dwells alone at the blocks' current values (infinity
@@ -163,10 +151,8 @@ class StageProblem {
   std::vector<bool> eta_e_entries_;       // per ambient entry
   std::vector<bool> damping_entries_;
   std::vector<bool> fixed_;
-  // Every residual block's cost function. The problem does not own them
-  // (Problem::Options::cost_function_ownership): owning, Ceres keeps a map
-  // entry per cost function to count its blocks, at a million dwells some
-  // 60 MB and a tree insertion per dwell. Destroyed after problem_.
+  // Every residual block's cost function (the problem does not own them, so
+  // Ceres keeps no map entry per cost function). Destroyed after problem_.
   std::vector<std::unique_ptr<const ceres::CostFunction>> cost_functions_;
   ParallelResidualEvaluator evaluator_;  // outlives the problems, which call it
   ceres::Problem problem_;

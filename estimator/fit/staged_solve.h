@@ -34,27 +34,20 @@
 // disagree), or at values that are not finite.
 //
 // A run whose first stage is branch-labelled (vertical or all_roots) starts
-// with a start stage: the algebraic residual from the given start, smooth,
-// branch-free and nearly convex, so that it lands near the minimum where a
-// branch-labelled residual from the same start may not (on the noise-free
-// numerical case both slide from a start 30 % off to zero damping, a
-// minimum on the damping bound). The first stage then starts from the
-// better of the given start and the start stage's end, rated as above with
-// the stage's own residual, and its note records which and why. Off with
-// algebraic_start_candidate = false.
+// with a start stage: the algebraic residual from the given start. The first
+// stage then starts from the better of the given start and the start stage's
+// end, rated as above with the stage's own residual, and its note records
+// which and why. Off with algebraic_start_candidate = false.
 //
 // Within a stage the bounds (eta_e, mu1, mu2 >= 0) are an active set: an
 // entry resting on its bound is held there (BoundRestWatcher) and the stage
 // solves again without it; a held entry whose cost gradient points into the
-// feasible side is released, once. The vertical stages run without Ceres'
-// projected line search (see RunStage in the .cc). A vertical or all-roots
-// solve that creeps along a weakly determined direction is finished by the
-// valley polish (valley_polish.h; SolverSettings::valley_polish), at most
-// twice a stage, and solved again from where the polish ended; the stage's
-// note says so. The algebraic stage runs with the damping unbounded and
-// reflects its result into the physical range
-// (ReflectDampingIntoPhysicalRange). Residual blocks are evaluated on
-// `solver.num_threads` threads in a fixed order: results do not depend on it.
+// feasible side is released, once. A vertical or all-roots solve that
+// creeps along a weakly determined direction is finished by the valley
+// polish (valley_polish.h), at most twice a stage. The algebraic stage runs
+// with the damping unbounded and reflects its result into the physical range
+// (ReflectDampingIntoPhysicalRange). Results do not depend on
+// `solver.num_threads`.
 //
 // Never aborts on bad input: invalid options or description give
 // FitStatus::kInvalidInput with a message naming the field, and leave the
@@ -100,10 +93,10 @@ struct StageSummary {
   // the branch-stability penalty divided by the dwells), exponents and
   // enforced jumps: what the analysis of the fit reads (profile_likelihood.h).
   PenaltyOptions penalties;
-  int residual_blocks = 0;   // dwell points fitted
-  int iterations = 0;        // over the stage's solves and valley polishes
-  int solves = 0;            // one, and one more per bound held or released and per valley polish
-  bool converged = false;    // its last solve met a convergence test
+  int residual_blocks = 0;  // dwell points fitted
+  int iterations = 0;       // over the stage's solves and valley polishes
+  int solves = 0;           // one, and one more per bound held or released and per valley polish
+  bool converged = false;   // its last solve met a convergence test
   // Bounded entries the stage ended holding on their bound (an active set),
   // as ambient indices of the description (for Identify: ParameterIndex).
   std::vector<int> held_at_bound;

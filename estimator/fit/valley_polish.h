@@ -3,15 +3,10 @@
 //
 // Levenberg-Marquardt steps with the Gauss-Newton model H = J^T J of the
 // Hessian of F = (1/2) sum r^2, whose full Hessian is J^T J + sum r_i
-// d2r_i/dp2. Where the data fix a direction only weakly (delta and alpha
-// over a narrow band: docs/model.md, Identifiability), J^T J is small along
-// it, and the residuals' own curvature term, small elsewhere, is of the
-// same size with the opposite sign: the true curvature along the step is
-// near zero while the model's is not. Every step is then a fraction of the
-// way to the minimum, and the cost falls about twice as much as the model
-// predicts (step-quality ratio rho = actual / predicted decrease near 2; a
-// cost linear along the step gives exactly 2). At 1e5 simulated dwells the
-// vertical stage took 60 such steps.
+// d2r_i/dp2. Along a weakly determined direction (docs/model.md,
+// Identifiability) the second term cancels much of the first, so each step
+// is a fraction of the way to the minimum and the cost falls about twice as
+// much as the model predicts (rho = actual / predicted decrease near 2).
 //
 // CreepWatcher stops a trust-region solve after `steps` successful steps in
 // a row with rho above `min_ratio`. PolishAlongValley then minimises the
@@ -19,11 +14,10 @@
 // J^T J leaves out from the gradients it meets, in coordinates whitened by
 // the Gauss-Newton model at the start: u = R (x [-] x0) with R^T R = J^T J
 // (jacobian_factor.h). There the model's Hessian is the identity, BFGS's
-// first step is the Gauss-Newton step, and its updates only have to learn
-// the correction. Bounds (eta_e, mu1, mu2 >= 0) are not constraints of the
-// polish: a point past one is an evaluation that fails, and the line search
-// steps back. The trust-region solve then resumes from the polished point,
-// so its convergence tests decide the stage as before.
+// first step is the Gauss-Newton step. Bounds (eta_e, mu1, mu2 >= 0) are not
+// constraints of the polish: a point past one is an evaluation that fails,
+// and the line search steps back. The trust-region solve then resumes from
+// the polished point.
 //
 // Deterministic: the same evaluations in the same order on any thread count.
 #ifndef DWELLFIT_ESTIMATOR_FIT_VALLEY_POLISH_H_

@@ -118,8 +118,8 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
         options.method == IntervalMethod::kProfile
             ? EstimateUncertaintyAtMinimum(run.fitted, run.options, study.omega_ref_rad_s, &result,
                                            ResolveThreadCount(run.options.solve.solver.num_threads))
-            : EstimateUncertainty(run.fitted, run.options, result.parameters,
-                                  study.omega_ref_rad_s, &result, options.method);
+            : EstimateUncertainty(run.fitted, run.options, result.parameters, study.omega_ref_rad_s,
+                                  &result, options.method);
     study.refitted += result.final_cost != fitted_cost;
     if (r == 0) {
       study.degrees_of_freedom = u.degrees_of_freedom;

@@ -22,7 +22,6 @@ struct Method {
   std::vector<ResidualKind> stages;
   bool range_penalty = false;  // the bifurcation range (through the roots for all_roots)
   bool phase_bias = false;     // the measured phase is off by the study's bias
-  bool needs_phase = false;
   // Multiplies the config's bifurcation_range.weight: the chapter enforces
   // the ranges through the roots by "a large penalty" (section 3.2.3).
   double range_weight = 1.0;
@@ -30,25 +29,21 @@ struct Method {
 
 // The weight of the root-transition penalty in the all-roots method, in
 // units of the data's cost where the stage starts (docs/model.md): large, as
-// the chapter's; with weight 1 the measured beam's fit loses its jump-downs.
+// the chapter's.
 constexpr double kAllRootsRangeWeight = 1e4;
 
 std::vector<Method> Methods(bool with_phase) {
   using R = ResidualKind;
   std::vector<Method> methods;
   if (with_phase) {
-    methods.push_back({"phase lag", {R::kPhaseLag}, false, false, true});
-    methods.push_back({"phase lag, biased phase", {R::kPhaseLag}, false, true, true});
+    methods.push_back({"phase lag", {R::kPhaseLag}, false, false});
+    methods.push_back({"phase lag, biased phase", {R::kPhaseLag}, false, true});
   }
-  methods.push_back({"least squares (3.11)", {R::kAlgebraic}, false, false, false});
-  methods.push_back({"all roots + ranges",
-                     {R::kAlgebraic, R::kAllRoots},
-                     true,
-                     false,
-                     false,
-                     kAllRootsRangeWeight});
-  methods.push_back({"Newton, no penalty", {R::kAlgebraic, R::kVertical}, false, false, false});
-  methods.push_back({"Newton + ranges", {R::kAlgebraic, R::kVertical}, true, false, false});
+  methods.push_back({"least squares (3.11)", {R::kAlgebraic}, false, false});
+  methods.push_back(
+      {"all roots + ranges", {R::kAlgebraic, R::kAllRoots}, true, false, kAllRootsRangeWeight});
+  methods.push_back({"Newton, no penalty", {R::kAlgebraic, R::kVertical}, false, false});
+  methods.push_back({"Newton + ranges", {R::kAlgebraic, R::kVertical}, true, false});
   return methods;
 }
 

@@ -15,24 +15,19 @@
 // Parameter block: p = [eta_e, mu1, mu2, delta, alpha, omega] (model_parameters.h),
 // omega [rad/s]; Omega_i [rad/s].
 //
-// Root: Newton root refinement embedded in the functor. The root is solved in
-// double by a safeguarded Newton iteration started from the measured a_i on
-// the bracket of its stable branch (stable_root.h), so it cannot diverge nor
-// land on the unstable middle root. The Jet value is then one Newton step in
-// Jet arithmetic from the converged root, whose derivative part is exactly
-// da/dp = -(dG/dp) / (dG/da) (implicit function theorem). Where the measured
-// branch does not reach a_base_i at the current parameters, a_model is the
-// turning point where that branch ends (dG/da = 0), the continuous extension
-// of the branch, so the residual stays continuous as a fold moves past a point.
+// Root: solved in double by a safeguarded Newton iteration from the measured
+// a_i on the bracket of its stable branch (stable_root.h), then lifted to Jet
+// by one Newton step, whose derivative part is da/dp = -(dG/dp) / (dG/da)
+// (implicit function theorem). Where the measured branch does not reach
+// a_base_i at the current parameters, a_model is the turning point where that
+// branch ends (dG/da = 0), so the residual stays continuous as a fold moves
+// past a point.
 //
 // Warm start: on a labelled branch (kLower, kUpper) the Newton iteration
 // starts from this dwell's root at its last evaluation (from a_i at the
-// first), which is near the new root while a solver steps. The start only
-// saves iterations: whether the root found is on the dwell's branch is decided
-// by a certificate (stable_root.h), and the value agrees with a cold start's
-// to within the last bits, not always in them (ForgetRoot restarts cold). A
-// kOnly dwell always starts from a_i, since it takes the stable root nearest
-// a_i where there are two.
+// first). A certificate (stable_root.h) decides that the root is on the
+// dwell's branch; the value agrees with a cold start's to within the last
+// bits (ForgetRoot restarts cold). A kOnly dwell always starts from a_i.
 #ifndef DWELLFIT_RESIDUALS_FUNCTORS_VERTICAL_ERROR_RESIDUAL_H_
 #define DWELLFIT_RESIDUALS_FUNCTORS_VERTICAL_ERROR_RESIDUAL_H_
 

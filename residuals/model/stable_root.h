@@ -41,16 +41,6 @@ inline const char* BranchName(Branch branch) {
   return "only";
 }
 
-inline bool BranchFromName(const std::string& name, Branch* branch) {
-  for (Branch b : {Branch::kLower, Branch::kUpper, Branch::kOnly}) {
-    if (name == BranchName(b)) {
-      *branch = b;
-      return true;
-    }
-  }
-  return false;
-}
-
 // Turning points of G(a) on a > 0 at one drive frequency.
 struct TurningPoints {
   bool exist = false;
