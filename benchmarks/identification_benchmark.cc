@@ -229,44 +229,6 @@ BENCHMARK(BM_ClampedBeamFitBusy)
     ->Iterations(5)
     ->UseRealTime();
 
-// The whole `identify` run on the committed clamped-beam config, in process
-// (RunIdentify: reading the CSV, the fit above, the covariance, the report,
-// predictions.csv, curves.csv and figures.gp written into a temporary
-// directory; no figures rendered, the printed report discarded), with
-// solver.num_threads = state.range(0). Against BM_ClampedBeamFit at the same
-// setting: what the run costs beyond its fit (process start-up aside).
-void BM_ClampedBeamIdentifyRun(benchmark::State& state) {
-  char directory_template[] = "/tmp/dwellfit-benchmark-XXXXXX";
-  const char* directory = mkdtemp(directory_template);
-  if (directory == nullptr) {
-    state.SkipWithError("cannot create a temporary output directory");
-    return;
-  }
-  const IdentifyConfig config =
-      LoadIdentifyConfig(std::string(DWELLFIT_SOURCE_DIR) + "/datasets/clamped-beam-27C/beam.yaml",
-                         {{"output_dir", directory, "benchmark"},
-                          {"solver.num_threads", std::to_string(state.range(0)), "benchmark"}});
-  struct NullBuffer : std::streambuf {
-    int overflow(int c) override { return c; }
-  } null_buffer;
-  std::ostream discard(&null_buffer);
-  IdentifyRunOptions options;
-  options.render_figures = false;
-  for (auto _ : state) {
-    const auto outcome = RunIdentify(config, discard, options);
-    state.counters["iterations"] = outcome->report.result.iterations;
-    state.counters["final_cost"] = outcome->report.result.final_cost;
-  }
-  std::error_code ignored;
-  std::filesystem::remove_all(directory, ignored);
-}
-BENCHMARK(BM_ClampedBeamIdentifyRun)
-    ->ArgName("threads")
-    ->Arg(1)
-    ->Arg(0)
-    ->Unit(benchmark::kMillisecond)
-    ->Iterations(5)
-    ->UseRealTime();
 
 // Two simulated datasets of the thesis model (w = 2 pi 40 and 2 pi 43 rad/s,
 // 1 % noise), one eta_e, mu1, mu2, delta, alpha block shared and one w block

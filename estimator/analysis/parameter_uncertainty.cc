@@ -583,8 +583,22 @@ ParameterUncertainty EstimateUncertaintyAtMinimum(const std::vector<const Sweep*
     u = EstimateUncertainty(fitted, options, result->parameters, omega_ref_rad_s, result,
                             IntervalMethod::kProfile, threads);
     if (!u.profile.found_lower) break;
-    if (round == kMaxRefits ||
-        !MoveToLower(problem, u.profile.lower_point, u.profile.lower_while, result)) {
+    const double before = result->final_cost;
+    if (round < kMaxRefits &&
+        MoveToLower(problem, u.profile.lower_point, u.profile.lower_while, result) &&
+        before - result->final_cost < kReprofileShare * u.profile.threshold) {
+      // A small step down: the profile's ends stand (each within about
+      // kReprofileShare / 2 of its width), beside the linearisation at the
+      // new point.
+      ProfileLikelihood profile = u.profile;
+      profile.found_lower = false;
+      profile.minimum_cost = result->final_cost;
+      u = EstimateUncertainty(fitted, options, result->parameters, omega_ref_rad_s, result,
+                              IntervalMethod::kLinearised, threads);
+      if (u.available) UseProfile(profile, &u);
+      break;
+    }
+    if (round == kMaxRefits || result->final_cost == before) {
       // Still not a minimum: say so, whatever the solver's tests said.
       if (result->status == FitStatus::kConverged) result->status = FitStatus::kNoConvergence;
       result->converged = false;

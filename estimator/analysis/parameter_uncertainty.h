@@ -84,6 +84,10 @@ inline constexpr double kIntervalDisagreement = 1.5;
 // Fits again from a lower point the profile found, at the most
 // (EstimateUncertaintyAtMinimum).
 inline constexpr int kMaxRefits = 3;
+// A fit again from a lower point the profile found that lowers the cost by
+// less than this share of the threshold keeps that profile's intervals;
+// more, and the profiles run again from the new point.
+inline constexpr double kReprofileShare = 0.05;
 // Linearised half-widths below this share of every parameter's value mean
 // data exact to round-off: the profile is not run.
 inline constexpr double kRoundOffShare = 1e-9;
@@ -178,7 +182,8 @@ ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted
 // The profile-likelihood uncertainty of a finished fit that is a minimum of
 // its cost: where a profile finds a lower cost than the fit's (by more than
 // kLowerCostTolerance), the fit's last stage is solved again from there
-// (RefitProfileProblem) and profiled again, up to kMaxRefits times;
+// (RefitProfileProblem) and profiled again (unless the cost fell by less
+// than kReprofileShare of the threshold), up to kMaxRefits times;
 // `result` then holds the new parameters and cost, and its message says so.
 // A point still not a minimum after that is no longer "converged"
 // (kNoConvergence, with the reason) and the uncertainty warns.
