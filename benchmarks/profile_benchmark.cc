@@ -38,19 +38,15 @@ void RunProfile(benchmark::State& state, const std::string& config_name) {
   }
 }
 
-void BM_ClampedBeamProfile(benchmark::State& state) { RunProfile(state, "beam.yaml"); }
-BENCHMARK(BM_ClampedBeamProfile)
+// On threads:1 and the default (0: the machine's), per committed config.
+BENCHMARK_CAPTURE(RunProfile, ClampedBeamProfile, std::string("beam.yaml"))
     ->ArgName("threads")
     ->Arg(1)
     ->Arg(0)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3)
     ->UseRealTime();
-
-void BM_ClampedBeamSelectedProfile(benchmark::State& state) {
-  RunProfile(state, "beam-selected.yaml");
-}
-BENCHMARK(BM_ClampedBeamSelectedProfile)
+BENCHMARK_CAPTURE(RunProfile, ClampedBeamSelectedProfile, std::string("beam-selected.yaml"))
     ->ArgName("threads")
     ->Arg(1)
     ->Arg(0)
