@@ -1,10 +1,9 @@
-// Profile-likelihood intervals of the measured beam (issue bar: at most 3 s
-// on two cores for every free parameter and alpha_e, identify's whole run
-// included: BM_ClampedBeamIdentifyRun in identification_benchmark.cc runs it
-// with the profile). Here the profiles alone, from the committed configs'
-// fits (done once, outside the timing): EstimateUncertaintyAtMinimum with
-// its solve again from the estimate, its profiles and any refit, on
-// state.range(0) threads (0: the machine's).
+// Profile-likelihood intervals of the measured beam (the bar: at most 3 s on
+// two cores for every free parameter and alpha_e, identify's whole run
+// included, BM_ClampedBeamIdentifyRun below). RunProfile times the profiles
+// alone, from the committed configs' fits (done once, outside the timing):
+// EstimateUncertaintyAtMinimum with its solve again from the estimate, its
+// profiles and any refit, on state.range(0) threads (0: the machine's).
 #include <cstdlib>
 #include <filesystem>
 #include <ostream>
