@@ -448,10 +448,9 @@ bool AtRoundOff(const ParameterUncertainty& u, const ParameterVector& estimate) 
 }
 
 // The kind `method` asks for, in `u` (which holds the linearised one).
-void ProfileIntervals(const std::vector<const Sweep*>& fitted,
-                      const IdentificationOptions& options, const ParameterVector& estimate,
-                      const FitSummary* summary, const BlockCovariance& c, int threads,
-                      ParameterUncertainty* u) {
+void ProfileIntervals(const std::vector<const Sweep*>& fitted, const IdentificationOptions& options,
+                      const ParameterVector& estimate, const FitSummary* summary,
+                      const BlockCovariance& c, int threads, ParameterUncertainty* u) {
   if (AtRoundOff(*u, estimate)) {
     u->message_notes.push_back(
         "the residuals are at round-off (exact data): the linearised intervals are reported");
@@ -549,8 +548,8 @@ ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted
   u.message = c.message;
   for (const std::string& note : u.message_notes) u.message += "; " + note;
   if (u.interval_kind == "profile_likelihood") {
-    u.message += StringPrintf("; profile-likelihood intervals from %d constrained fits",
-                              u.profile.fits);
+    u.message +=
+        StringPrintf("; profile-likelihood intervals from %d constrained fits", u.profile.fits);
   }
   if (!u.warnings.empty())
     u.message += StringPrintf("; %d warning(s)", static_cast<int>(u.warnings.size()));
@@ -563,15 +562,16 @@ ParameterUncertainty EstimateUncertaintyAtMinimum(const std::vector<const Sweep*
                                                   IdentificationResult* result, int threads) {
   ProfileProblem problem;
   ParameterUncertainty scratch;
-  scratch.omega_ref_rad_s = omega_ref_rad_s > 0.0 ? omega_ref_rad_s : result->parameters[kNaturalFrequency];
+  scratch.omega_ref_rad_s =
+      omega_ref_rad_s > 0.0 ? omega_ref_rad_s : result->parameters[kNaturalFrequency];
   if (!result->IsSolutionUsable() ||
       !MakeProfileProblem(fitted, options, result, 1.0, 1, &scratch, &problem)) {
     return EstimateUncertainty(fitted, options, result->parameters, omega_ref_rad_s, result,
                                IntervalMethod::kProfile, threads);
   }
   // Exact data: nothing to profile (EstimateUncertainty says so).
-  ParameterUncertainty u = EstimateUncertainty(fitted, options, result->parameters,
-                                               omega_ref_rad_s, result, IntervalMethod::kLinearised);
+  ParameterUncertainty u = EstimateUncertainty(fitted, options, result->parameters, omega_ref_rad_s,
+                                               result, IntervalMethod::kLinearised);
   if (!u.available || AtRoundOff(u, result->parameters)) {
     return EstimateUncertainty(fitted, options, result->parameters, omega_ref_rad_s, result,
                                IntervalMethod::kProfile, threads);
@@ -602,8 +602,8 @@ ParameterUncertainty EstimateUncertaintyAtMinimum(const std::vector<const Sweep*
       // Still not a minimum: say so, whatever the solver's tests said.
       if (result->status == FitStatus::kConverged) result->status = FitStatus::kNoConvergence;
       result->converged = false;
-      result->not_minimum = u.profile.lower_while + StringPrintf(" found a lower cost (%.10g)",
-                                                                 u.profile.lower_cost);
+      result->not_minimum =
+          u.profile.lower_while + StringPrintf(" found a lower cost (%.10g)", u.profile.lower_cost);
       result->message = "not a minimum: " + result->not_minimum + "; " + result->message;
       u.warnings.push_back("the reported point is not a minimum of the cost: " +
                            result->not_minimum);

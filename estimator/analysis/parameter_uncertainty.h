@@ -119,11 +119,11 @@ struct ParameterUncertainty {
   // 2 F / (n - k): s^2 when s is estimated; the goodness of fit (about 1)
   // when every point has a sigma.
   double reduced_chi_square = 0.0;
-  int num_points = 0;                       // n
-  int num_free = 0;                         // k
-  int degrees_of_freedom = 0;               // n - k
-  double interval_quantile = 0.0;           // q: t_{0.975, n-k}, or the normal's 1.95996
-  ParameterVector standard_error{};         // 0 for fixed parameters
+  int num_points = 0;                // n
+  int num_free = 0;                  // k
+  int degrees_of_freedom = 0;        // n - k
+  double interval_quantile = 0.0;    // q: t_{0.975, n-k}, or the normal's 1.95996
+  ParameterVector standard_error{};  // 0 for fixed parameters
   // The reported 95 % intervals: the profile's (interval_kind
   // "profile_likelihood"; +/- infinity at an open end, 0 at a bound), else
   // the linearised estimate -/+ q standard_error.

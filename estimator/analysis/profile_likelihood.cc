@@ -37,7 +37,7 @@ constexpr double kFirstStepShare = 0.25;
 // A profile's constrained fits end when an iteration lowers the cost by less
 // than this share of Delta (relative to the cost: 1e-6 on the measured
 // beam, where Delta is 1e-3 of the cost; the solver's own tolerance, 1e-8,
-// where that is looser): the ends are then found to well within
+// where that is larger): the ends are then found to well within
 // kProfileTolerance at a third fewer iterations.
 constexpr double kProfileCostShare = 1e-3;
 
@@ -123,7 +123,8 @@ double MinimiseHeld(const ProfileProblem& problem, const std::array<bool, kNumPa
     const double cost = stage.DataCost() + stage.PenaltyCost();
     return std::isfinite(cost) ? cost : kInfinity;
   }
-  if (tie) stage.problem()->SetManifold(p->data(), new TiedAlphaManifold(scale, held, AlphaETie(problem)));
+  if (tie)
+    stage.problem()->SetManifold(p->data(), new TiedAlphaManifold(scale, held, AlphaETie(problem)));
   ceres::Solver::Options options = MakeSolverOptions(problem.solver);
   options.max_num_line_search_step_size_iterations = 0;  // as the vertical stage (staged_solve.cc)
   options.function_tolerance = std::max(options.function_tolerance, function_tolerance);
@@ -156,9 +157,9 @@ double ConstrainedMinimum(const ProfileProblem& problem, int quantity, double va
       held[kDelta] = true;
     }
   }
-  const double tolerance =
-      quantity == kNone || !(minimum_cost > 0.0) ? 0.0
-                                                 : kProfileCostShare * problem.threshold / minimum_cost;
+  const double tolerance = quantity == kNone || !(minimum_cost > 0.0)
+                               ? 0.0
+                               : kProfileCostShare * problem.threshold / minimum_cost;
   return MinimiseHeld(problem, held, tie, tolerance, p);
 }
 
@@ -399,8 +400,7 @@ ProfileLikelihood ProfileCost(const ProfileProblem& problem, const ParameterVect
       sides[i] = FitAtEstimate(problem, q, estimate, profile.minimum_cost);
       return;
     }
-    const Side side =
-        MakeSide(problem, q, i % 3 == 0 ? -1.0 : 1.0, estimate, covariance, quantile);
+    const Side side = MakeSide(problem, q, i % 3 == 0 ? -1.0 : 1.0, estimate, covariance, quantile);
     sides[i] = SearchSide(problem, side, profile.minimum_cost);
   };
   tbb::task_arena arena(std::max(problem.threads, 1));
@@ -421,9 +421,8 @@ ProfileLikelihood ProfileCost(const ProfileProblem& problem, const ParameterVect
       profile.found_lower = true;
       profile.lower_cost = side->lower_cost;
       profile.lower_point = side->lower->p;
-      profile.lower_while =
-          StringPrintf("profiling %s at %.6g", q == kEffective ? "alpha_e" : ParameterName(q),
-                       side->lower->t);
+      profile.lower_while = StringPrintf(
+          "profiling %s at %.6g", q == kEffective ? "alpha_e" : ParameterName(q), side->lower->t);
     }
   }
   return profile;

@@ -87,7 +87,7 @@ enum class ProfileEnd {
 const char* ProfileEndName(ProfileEnd end);  // "crossed", "bound", "open"
 
 struct ProfileInterval {
-  bool computed = false;  // false: fixed, or not profiled
+  bool computed = false;         // false: fixed, or not profiled
   double low = 0.0, high = 0.0;  // +/- infinity at an open end
   ProfileEnd low_end = ProfileEnd::kCrossed;
   ProfileEnd high_end = ProfileEnd::kCrossed;

@@ -173,8 +173,8 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
   std::string predictions_csv;
   RunCurves curves;
   ComputeAfterFit(run, result, &outcome->report, &predictions_csv, &curves);
-  AddModelError(run.fitted, run.validation, ResolveThreadCount(run.options.solve.solver.num_threads),
-                &outcome->report);
+  AddModelError(run.fitted, run.validation,
+                ResolveThreadCount(run.options.solve.solver.num_threads), &outcome->report);
   outcome->report.config_in_effect = ConfigToYaml(config, ConfigKeys::kAffectingTheResult);
   MarkUnidentifiable(&outcome->report);
   const IdentificationReport& report = outcome->report;

@@ -116,7 +116,8 @@ TEST_F(UncertaintyThesisNumerical, NoisyFitGivesStudentTIntervalsFromTheResidual
   const std::vector<const Sweep*> fitted = Fitted(noisy);
   const IdentificationResult result = Identify(fitted, config_.identification);
   const ParameterUncertainty u =
-      EstimateUncertainty(fitted, config_.identification, result.parameters, omega_ref_, nullptr, IntervalMethod::kLinearised);
+      EstimateUncertainty(fitted, config_.identification, result.parameters, omega_ref_, nullptr,
+                          IntervalMethod::kLinearised);
   ASSERT_TRUE(u.available) << u.message;
   ExpectAllFinite(u);
   EXPECT_EQ(u.degrees_of_freedom, 260 - 5);
@@ -153,15 +154,16 @@ TEST_F(UncertaintyThesisNumerical, PointSigmasStandardiseTheResidualsAndUseTheNo
   const std::vector<const Sweep*> fitted = Fitted(noisy);
   const IdentificationResult result = Identify(fitted, config_.identification);
   const ParameterUncertainty estimated =
-      EstimateUncertainty(fitted, config_.identification, result.parameters, omega_ref_, nullptr, IntervalMethod::kLinearised);
+      EstimateUncertainty(fitted, config_.identification, result.parameters, omega_ref_, nullptr,
+                          IntervalMethod::kLinearised);
   // The true standard deviation of every amplitude: 1 % of it (ln a: 0.01).
   for (Sweep& sweep : noisy.sweeps) {
     for (DwellPoint& point : sweep.points) point.sigma = 0.01 * point.amplitude;
   }
   IdentificationOptions options = config_.identification;
   options.solve.residual.use_point_sigma = true;
-  const ParameterUncertainty given =
-      EstimateUncertainty(fitted, options, result.parameters, omega_ref_, nullptr, IntervalMethod::kLinearised);
+  const ParameterUncertainty given = EstimateUncertainty(
+      fitted, options, result.parameters, omega_ref_, nullptr, IntervalMethod::kLinearised);
   ASSERT_TRUE(given.available) << given.message;
   ExpectAllFinite(given);
   EXPECT_DOUBLE_EQ(given.noise_sigma, 1.0);
@@ -179,8 +181,8 @@ TEST_F(UncertaintyThesisNumerical, PointSigmasStandardiseTheResidualsAndUseTheNo
 
   // Only some points with a sigma: mixed units, said so.
   for (DwellPoint& point : noisy.sweeps[0].points) point.sigma.reset();
-  const ParameterUncertainty mixed =
-      EstimateUncertainty(fitted, options, result.parameters, omega_ref_, nullptr, IntervalMethod::kLinearised);
+  const ParameterUncertainty mixed = EstimateUncertainty(
+      fitted, options, result.parameters, omega_ref_, nullptr, IntervalMethod::kLinearised);
   EXPECT_THAT(mixed.warnings, ::testing::Contains(HasSubstr("only some points have a sigma")));
   // s estimated from the mixed residuals, not assumed to be 1.
   EXPECT_NE(mixed.noise_sigma, 1.0);
@@ -229,7 +231,8 @@ TEST_F(UncertaintyThesisNumerical, FrequencySweepAloneWarnsButKeepsTheEffectiveN
   const std::vector<const Sweep*> fitted = Named(noisy, {"F0.01"});
   const IdentificationResult result = Identify(fitted, config_.identification);
   const ParameterUncertainty u =
-      EstimateUncertainty(fitted, config_.identification, result.parameters, omega_ref_, nullptr, IntervalMethod::kLinearised);
+      EstimateUncertainty(fitted, config_.identification, result.parameters, omega_ref_, nullptr,
+                          IntervalMethod::kLinearised);
   ASSERT_TRUE(u.available) << u.message;
   ExpectAllFinite(u);
   EXPECT_GT(u.correlation(kDelta, kAlpha), 0.99);
@@ -249,8 +252,8 @@ TEST_F(UncertaintyThesisNumerical, FixedParametersHaveZeroErrorAndStayOutOfWarni
   options.initial[kDelta] = kTruth[kDelta];
   options.fixed[kDelta] = true;
   const IdentificationResult result = Identify(fitted, options);
-  const ParameterUncertainty u =
-      EstimateUncertainty(fitted, options, result.parameters, omega_ref_, nullptr, IntervalMethod::kLinearised);
+  const ParameterUncertainty u = EstimateUncertainty(fitted, options, result.parameters, omega_ref_,
+                                                     nullptr, IntervalMethod::kLinearised);
   ASSERT_TRUE(u.available) << u.message;
   ExpectAllFinite(u);
   EXPECT_EQ(u.num_free, 4);
@@ -274,14 +277,16 @@ TEST_F(UncertaintyThesisNumerical, WarnsWhenTheModelsFoldFallsShortOfMeasuredDwe
   // F0.01/up is on the upper branch at 42.2 Hz, 0.015 Hz below the true
   // jump-down fold; 1 % less alpha moves the model's fold below that dwell.
   const ParameterUncertainty at_truth =
-      EstimateUncertainty(Fitted(exact_), config_.identification, kTruth, omega_ref_, nullptr, IntervalMethod::kLinearised);
+      EstimateUncertainty(Fitted(exact_), config_.identification, kTruth, omega_ref_, nullptr,
+                          IntervalMethod::kLinearised);
   EXPECT_EQ(at_truth.dwells_past_branch_end, 0);
   EXPECT_THAT(at_truth.warnings, ::testing::Each(Not(HasSubstr("past the end of their branch"))));
 
   ParameterVector softer = kTruth;
   softer[kAlpha] *= 0.99;
   const ParameterUncertainty u =
-      EstimateUncertainty(Fitted(exact_), config_.identification, softer, omega_ref_, nullptr, IntervalMethod::kLinearised);
+      EstimateUncertainty(Fitted(exact_), config_.identification, softer, omega_ref_, nullptr,
+                          IntervalMethod::kLinearised);
   ASSERT_TRUE(u.available) << u.message;
   EXPECT_EQ(u.dwells_past_branch_end, 1);
   EXPECT_THAT(u.warnings, ::testing::Contains(AllOf(HasSubstr("1 fitted dwell(s) lie past"),
