@@ -10,7 +10,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/studies/chapter_tables.h"
-#include "dwellfit/tools/tool_flags.h"
+#include "dwellfit/tools/tool_main.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -23,24 +23,19 @@ DEFINE_string(measured, "datasets/clamped-beam-27C/beam.yaml",
 DEFINE_string(output, "docs/chapter-tables.md", "Markdown file to write");
 
 int main(int argc, char** argv) {
-  dwellfit::KeepFreedMemoryForReuse();
-  FLAGS_logtostderr = true;
-  google::InitGoogleLogging(argv[0]);
-  gflags::SetUsageMessage(
+  const dwellfit::ToolSpec tool = {
+      "chapter_tables",
       "writes the chapter's Tables 3.3 and 3.4 (with and without the bifurcation-range "
       "penalty) as Markdown.\n  chapter_tables [--numerical CFG --truth_plan PLAN --measured CFG "
-      "--output FILE]");
-  if (!dwellfit::ParseToolFlags(&argc, &argv, "chapter_tables")) return 2;
-  try {
+      "--output FILE]",
+      __FILE__};
+  return dwellfit::RunTool(argc, argv, tool, [] {
     const std::string markdown =
         dwellfit::ChapterTablesMarkdown(dwellfit::LoadIdentifyConfig(FLAGS_numerical),
                                         dwellfit::ReadDwellPlan(FLAGS_truth_plan).truth,
                                         dwellfit::LoadIdentifyConfig(FLAGS_measured));
     dwellfit::WriteReportAtomically(FLAGS_output, markdown);
     std::cout << "wrote " << FLAGS_output << "\n";
-  } catch (const dwellfit::InputError& error) {
-    std::cerr << "chapter_tables: " << error.what() << "\n";
-    return 1;
-  }
-  return 0;
+    return 0;
+  });
 }

@@ -12,7 +12,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/studies/convergence_family.h"
-#include "dwellfit/tools/tool_flags.h"
+#include "dwellfit/tools/tool_main.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -21,14 +21,12 @@ DEFINE_string(base, "datasets/thesis-numerical/beam.yaml",
 DEFINE_string(output, "docs/convergence-family.md", "Markdown file to write");
 
 int main(int argc, char** argv) {
-  dwellfit::KeepFreedMemoryForReuse();
-  FLAGS_logtostderr = true;
-  google::InitGoogleLogging(argv[0]);
-  gflags::SetUsageMessage(
+  const dwellfit::ToolSpec tool = {
+      "convergence_family",
       "fits the convergence family from the automatic start and writes its report.\n"
-      "  convergence_family [--base CFG --output FILE]");
-  if (!dwellfit::ParseToolFlags(&argc, &argv, "convergence_family")) return 2;
-  try {
+      "  convergence_family [--base CFG --output FILE]",
+      __FILE__};
+  return dwellfit::RunTool(argc, argv, tool, [] {
     const dwellfit::IdentifyConfig base = dwellfit::LoadIdentifyConfig(FLAGS_base);
     std::vector<dwellfit::FamilyOutcome> outcomes;
     for (const dwellfit::FamilyMember& member : dwellfit::ConvergenceFamily()) {
@@ -41,9 +39,6 @@ int main(int argc, char** argv) {
                                       [](const auto& o) { return o.SilentlyWrong(); });
     std::cout << "wrote " << FLAGS_output << ": " << reached << " of " << outcomes.size()
               << " members reach the truth, " << silent << " silently wrong\n";
-    return 100 * reached >= 98 * static_cast<long>(outcomes.size()) && silent == 0 ? 0 : 1;
-  } catch (const dwellfit::InputError& error) {
-    std::cerr << "convergence_family: " << error.what() << "\n";
-    return 1;
-  }
+    return 100 * reached >= 98 * static_cast<long>(outcomes.size()) && silent == 0 ? 0 : 3;
+  });
 }

@@ -17,7 +17,7 @@
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/studies/coverage_study.h"
-#include "dwellfit/tools/tool_flags.h"
+#include "dwellfit/tools/tool_main.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -36,19 +36,18 @@ DEFINE_string(set, "",
               "'initial_guess=auto,fixed=[]'");
 
 int main(int argc, char** argv) {
-  dwellfit::KeepFreedMemoryForReuse();
-  google::InitGoogleLogging(argv[0]);
-  gflags::SetUsageMessage(
+  const dwellfit::ToolSpec tool = {
+      "coverage_study",
       "Coverage of the 95 % parameter intervals over noisy simulated replicas.\n"
       "Usage: coverage_study --config beam.yaml --plan plan.yaml [--replicas 200] "
-      "[--noise 0.01] [--set key.path=value,...]");
-  if (!dwellfit::ParseToolFlags(&argc, &argv, "coverage_study")) return 2;
-  if (FLAGS_config.empty() || FLAGS_plan.empty() || FLAGS_replicas < 1 || !(FLAGS_noise >= 0.0)) {
-    std::cerr << "coverage_study: give --config and --plan, --replicas >= 1, --noise >= 0\n"
-              << gflags::ProgramUsage() << "\n";
-    return 2;
-  }
-  try {
+      "[--noise 0.01] [--set key.path=value,...]",
+      __FILE__};
+  return dwellfit::RunTool(argc, argv, tool, [] {
+    if (FLAGS_config.empty() || FLAGS_plan.empty() || FLAGS_replicas < 1 || !(FLAGS_noise >= 0.0)) {
+      std::cerr << "coverage_study: give --config and --plan, --replicas >= 1, --noise >= 0; see "
+                   "--help\n";
+      return dwellfit::kToolExitUsage;
+    }
     const dwellfit::IdentifyConfig config =
         dwellfit::LoadIdentifyConfig(FLAGS_config, dwellfit::ParseSetFlag(FLAGS_set, "--set"));
     const dwellfit::DwellPlan plan = dwellfit::ReadDwellPlan(FLAGS_plan);
@@ -59,12 +58,9 @@ int main(int argc, char** argv) {
     if (!dwellfit::ParseIntervalMethod(FLAGS_interval_method, &options.method)) {
       std::cerr << "coverage_study: --interval_method '" << FLAGS_interval_method
                 << "': give profile, linearised or data_only\n";
-      return 2;
+      return dwellfit::kToolExitUsage;
     }
     dwellfit::PrintCoverageStudy(dwellfit::RunCoverageStudy(config, plan, options), std::cout);
-  } catch (const dwellfit::InputError& e) {
-    std::cerr << "coverage_study: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+    return 0;
+  });
 }

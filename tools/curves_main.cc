@@ -20,7 +20,7 @@
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/curves/sweep_curves.h"
-#include "dwellfit/tools/tool_flags.h"
+#include "dwellfit/tools/tool_main.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -109,14 +109,13 @@ std::vector<dwellfit::CurveSpec> Specs(const dwellfit::DwellPlan* plan) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  dwellfit::KeepFreedMemoryForReuse();
-  google::InitGoogleLogging(argv[0]);
-  gflags::SetUsageMessage(
+  const dwellfit::ToolSpec tool = {
+      "curves",
       "The model's response curves as CSV.\nUsage: curves (--result result.yaml | --plan "
       "plan.yaml | --eta_e .. --omega_hz ..) [--kind frequency --a_base A --from HZ --to HZ | "
-      "--kind amplitude --freq_hz HZ --from A --to A] [--output curves.csv]");
-  if (!dwellfit::ParseToolFlags(&argc, &argv, "curves")) return 2;
-  try {
+      "--kind amplitude --freq_hz HZ --from A --to A] [--output curves.csv]",
+      __FILE__};
+  return dwellfit::RunTool(argc, argv, tool, [] {
     std::optional<dwellfit::DwellPlan> plan;
     if (!FLAGS_plan.empty()) plan = dwellfit::ReadDwellPlan(FLAGS_plan);
     const dwellfit::DwellPlan* plan_ptr = plan ? &*plan : nullptr;
@@ -134,9 +133,6 @@ int main(int argc, char** argv) {
         throw dwellfit::InputError(FLAGS_output, 0, "--output", "cannot write the file");
       }
     }
-  } catch (const dwellfit::InputError& e) {
-    std::cerr << "curves: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+    return 0;
+  });
 }

@@ -9,7 +9,7 @@
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/identify_run.h"
-#include "dwellfit/tools/tool_flags.h"
+#include "dwellfit/tools/tool_main.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -73,21 +73,17 @@ std::vector<dwellfit::ConfigOverride> OverridesFromFlags() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  dwellfit::KeepFreedMemoryForReuse();
-  FLAGS_logtostderr = true;
-  google::InitGoogleLogging(argv[0]);
-  gflags::SetUsageMessage(
+  const dwellfit::ToolSpec tool = {
+      "identify",
       "identifies a beam mode's parameters from sine-dwell sweeps.\n"
       "  identify --config beam.yaml [--output_dir DIR] [--fix delta,omega] [--set k=v,...]\n"
-      "The config keys are documented in config/README.md.");
-  if (!dwellfit::ParseToolFlags(&argc, &argv, "identify")) return dwellfit::kExitUsage;
-  if (FLAGS_config.empty() || argc > 1) {
-    std::cerr << "identify: give the config file with --config FILE"
-              << (argc > 1 ? std::string(" (unexpected argument '") + argv[1] + "')" : "")
-              << "; see --help\n";
-    return dwellfit::kExitUsage;
-  }
-  try {
+      "The config keys are documented in config/README.md.",
+      __FILE__};
+  return dwellfit::RunTool(argc, argv, tool, [] {
+    if (FLAGS_config.empty()) {
+      std::cerr << "identify: give the config file with --config FILE; see --help\n";
+      return dwellfit::kToolExitUsage;
+    }
     const dwellfit::IdentifyConfig config =
         dwellfit::LoadIdentifyConfig(FLAGS_config, OverridesFromFlags());
     dwellfit::IdentifyRunOptions run_options;
@@ -100,8 +96,5 @@ int main(int argc, char** argv) {
                 << exit_status << "): " << result.message << "\n";
     }
     return exit_status;
-  } catch (const dwellfit::InputError& error) {
-    std::cerr << "identify: " << error.what() << "\n";
-    return dwellfit::kExitInputError;
-  }
+  });
 }

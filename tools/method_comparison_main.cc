@@ -10,7 +10,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/studies/method_comparison.h"
-#include "dwellfit/tools/tool_flags.h"
+#include "dwellfit/tools/tool_main.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -26,15 +26,13 @@ DEFINE_double(phase_bias_deg, 2.0, "Phase error shown with the phase-lag fit [de
 DEFINE_bool(wall_time, false, "Add wall-clock times (not reproducible) to the tables");
 
 int main(int argc, char** argv) {
-  dwellfit::KeepFreedMemoryForReuse();
-  FLAGS_logtostderr = true;
-  google::InitGoogleLogging(argv[0]);
-  gflags::SetUsageMessage(
+  const dwellfit::ToolSpec tool = {
+      "method_comparison",
       "compares the chapter's identification methods and writes the tables as Markdown.\n"
       "  method_comparison [--numerical CFG --truth_plan PLAN --measured CFG --output FILE "
-      "--noise_seeds N --phase_bias_deg D --wall_time]");
-  if (!dwellfit::ParseToolFlags(&argc, &argv, "method_comparison")) return 2;
-  try {
+      "--noise_seeds N --phase_bias_deg D --wall_time]",
+      __FILE__};
+  return dwellfit::RunTool(argc, argv, tool, [] {
     dwellfit::MethodComparisonOptions options;
     options.noise_seeds = FLAGS_noise_seeds;
     options.phase_bias_deg = FLAGS_phase_bias_deg;
@@ -44,9 +42,6 @@ int main(int argc, char** argv) {
         dwellfit::LoadIdentifyConfig(FLAGS_measured), options);
     dwellfit::WriteReportAtomically(FLAGS_output, markdown);
     std::cout << "wrote " << FLAGS_output << "\n";
-  } catch (const dwellfit::InputError& error) {
-    std::cerr << "method_comparison: " << error.what() << "\n";
-    return 1;
-  }
-  return 0;
+    return 0;
+  });
 }

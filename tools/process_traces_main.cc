@@ -23,7 +23,7 @@
 #include "dwellfit/estimator/data/sweep_csv_writer.h"
 #include "dwellfit/estimator/traces/harmonic_balance.h"
 #include "dwellfit/estimator/traces/trace_processing.h"
-#include "dwellfit/tools/tool_flags.h"
+#include "dwellfit/tools/tool_main.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -55,57 +55,62 @@ void Commit(const std::string& staged, const std::string& path) {
   }
 }
 
+// Reads, processes and writes (see the top of this file); returns the exit
+// status. What it stages is listed in `staged`.
+int ProcessAndWrite(std::vector<std::string>* staged) {
+  const dwellfit::RigConfig rig = dwellfit::ReadRigConfig(FLAGS_rig);
+  const auto dwells = dwellfit::ReadTraceSet(FLAGS_traces);
+  const dwellfit::ProcessedTraces processed = dwellfit::ProcessTraces(dwells, rig.processing);
+  for (const std::string& warning : processed.warnings) {
+    std::cerr << "warning: " << warning << "\n";
+  }
+  if (processed.unsettled_dwells > 0 && !FLAGS_allow_unsettled) {
+    std::cerr << "process_traces: " << processed.unsettled_dwells
+              << " dwell(s) look unsettled; nothing written (record them again after a longer "
+                 "wait, or pass --allow_unsettled)\n";
+    return 3;
+  }
+  std::string hb_text;
+  if (!FLAGS_harmonic_balance.empty()) {
+    const dwellfit::HarmonicBalanceResult result =
+        dwellfit::IdentifyHarmonicBalance(processed.harmonics, rig.processing.harmonics,
+                                          dwellfit::HzToRadPerSecond(FLAGS_reference_hz));
+    std::ostringstream yaml;
+    dwellfit::WriteHarmonicBalanceYaml(result, &yaml);
+    hb_text = yaml.str();
+  }
+  // Both files are written in full before either is renamed into place.
+  std::ostringstream csv;
+  dwellfit::WriteSweepsCsv(processed.sweeps, &csv);
+  const std::string staged_csv = Stage(csv.str(), FLAGS_out, staged);
+  const std::string staged_hb =
+      hb_text.empty() ? std::string() : Stage(hb_text, FLAGS_harmonic_balance, staged);
+  Commit(staged_csv, FLAGS_out);
+  if (!staged_hb.empty()) Commit(staged_hb, FLAGS_harmonic_balance);
+  std::cout << "processed " << dwells.size() << " dwells; wrote " << FLAGS_out << "\n";
+  if (!hb_text.empty()) std::cout << hb_text << "wrote " << FLAGS_harmonic_balance << "\n";
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  dwellfit::KeepFreedMemoryForReuse();
-  google::InitGoogleLogging(argv[0]);
-  gflags::SetUsageMessage(
+  const dwellfit::ToolSpec tool = {
+      "process_traces",
       "Dwell points (and optionally harmonic-balance estimates) from sine-dwell time traces.\n"
-      "Usage: process_traces --rig rig.yaml --traces folder --out sweeps.csv");
-  if (!dwellfit::ParseToolFlags(&argc, &argv, "process_traces")) return 2;
-  if (FLAGS_rig.empty() || FLAGS_traces.empty() || FLAGS_out.empty()) {
-    std::cerr << "process_traces: give --rig, --traces and --out\n"
-              << gflags::ProgramUsage() << "\n";
-    return 2;
-  }
-  std::vector<std::string> staged;
-  try {
-    const dwellfit::RigConfig rig = dwellfit::ReadRigConfig(FLAGS_rig);
-    const auto dwells = dwellfit::ReadTraceSet(FLAGS_traces);
-    const dwellfit::ProcessedTraces processed = dwellfit::ProcessTraces(dwells, rig.processing);
-    for (const std::string& warning : processed.warnings) {
-      std::cerr << "warning: " << warning << "\n";
+      "Usage: process_traces --rig rig.yaml --traces folder --out sweeps.csv",
+      __FILE__};
+  return dwellfit::RunTool(argc, argv, tool, [] {
+    if (FLAGS_rig.empty() || FLAGS_traces.empty() || FLAGS_out.empty()) {
+      std::cerr << "process_traces: give --rig, --traces and --out; see --help\n";
+      return dwellfit::kToolExitUsage;
     }
-    if (processed.unsettled_dwells > 0 && !FLAGS_allow_unsettled) {
-      std::cerr << "process_traces: " << processed.unsettled_dwells
-                << " dwell(s) look unsettled; nothing written (record them again after a longer "
-                   "wait, or pass --allow_unsettled)\n";
-      return 3;
+    std::vector<std::string> staged;
+    try {
+      return ProcessAndWrite(&staged);
+    } catch (...) {
+      for (const std::string& name : staged) std::remove(name.c_str());
+      throw;
     }
-    std::string hb_text;
-    if (!FLAGS_harmonic_balance.empty()) {
-      const dwellfit::HarmonicBalanceResult result =
-          dwellfit::IdentifyHarmonicBalance(processed.harmonics, rig.processing.harmonics,
-                                            dwellfit::HzToRadPerSecond(FLAGS_reference_hz));
-      std::ostringstream yaml;
-      dwellfit::WriteHarmonicBalanceYaml(result, &yaml);
-      hb_text = yaml.str();
-    }
-    // Both files are written in full before either is renamed into place.
-    std::ostringstream csv;
-    dwellfit::WriteSweepsCsv(processed.sweeps, &csv);
-    const std::string staged_csv = Stage(csv.str(), FLAGS_out, &staged);
-    const std::string staged_hb =
-        hb_text.empty() ? std::string() : Stage(hb_text, FLAGS_harmonic_balance, &staged);
-    Commit(staged_csv, FLAGS_out);
-    if (!staged_hb.empty()) Commit(staged_hb, FLAGS_harmonic_balance);
-    std::cout << "processed " << dwells.size() << " dwells; wrote " << FLAGS_out << "\n";
-    if (!hb_text.empty()) std::cout << hb_text << "wrote " << FLAGS_harmonic_balance << "\n";
-  } catch (const dwellfit::InputError& e) {
-    for (const std::string& name : staged) std::remove(name.c_str());
-    std::cerr << "process_traces: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+  });
 }

@@ -21,7 +21,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/studies/model_selection.h"
-#include "dwellfit/tools/tool_flags.h"
+#include "dwellfit/tools/tool_main.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -34,17 +34,16 @@ DEFINE_string(output_dir, "",
               "Directory for the two files (default: the config's output_dir/model_selection)");
 
 int main(int argc, char** argv) {
-  dwellfit::KeepFreedMemoryForReuse();
-  google::InitGoogleLogging(argv[0]);
-  gflags::SetUsageMessage(
+  const dwellfit::ToolSpec tool = {
+      "select_model",
       "compares model variants by cost, AIC, BIC and cross-validation.\n"
-      "  select_model --config beam.yaml [--set k=v,...] [--threads N] [--output_dir DIR]");
-  if (!dwellfit::ParseToolFlags(&argc, &argv, "select_model")) return 2;
-  if (FLAGS_config.empty()) {
-    std::cerr << "select_model: --config is required\n";
-    return 1;
-  }
-  try {
+      "  select_model --config beam.yaml [--set k=v,...] [--threads N] [--output_dir DIR]",
+      __FILE__};
+  return dwellfit::RunTool(argc, argv, tool, [] {
+    if (FLAGS_config.empty()) {
+      std::cerr << "select_model: give the config file with --config FILE; see --help\n";
+      return dwellfit::kToolExitUsage;
+    }
     const dwellfit::IdentifyConfig config =
         dwellfit::LoadIdentifyConfig(FLAGS_config, dwellfit::ParseSetFlag(FLAGS_set, "--set"));
     const std::string directory =
@@ -70,11 +69,8 @@ int main(int argc, char** argv) {
     std::cout << "\n";
     if (report.recommended < 0) {
       std::cerr << "select_model: " << report.verdict << "\n";
-      return 2;
+      return 3;
     }
-  } catch (const dwellfit::InputError& error) {
-    std::cerr << "select_model: " << error.what() << "\n";
-    return 1;
-  }
-  return 0;
+    return 0;
+  });
 }

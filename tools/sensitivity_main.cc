@@ -19,7 +19,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/studies/sensitivity_study.h"
-#include "dwellfit/tools/tool_flags.h"
+#include "dwellfit/tools/tool_main.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -81,15 +81,14 @@ dwellfit::SensitivityStudy Run() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  dwellfit::KeepFreedMemoryForReuse();
-  google::InitGoogleLogging(argv[0]);
-  gflags::SetUsageMessage(
+  const dwellfit::ToolSpec tool = {
+      "sensitivity",
       "Many fits of one config varying noise, replicas, starts, penalties, fixed values, fixed "
       "sets or fitted sweeps.\nUsage: sensitivity --config beam.yaml [--plan plan.yaml "
       "--replicas 1000 --noise 0.01] [--vary 'key=v1|v2'] [--threads 2] [--shard k/N] "
-      "--output_dir study/\n       sensitivity --merge dir0,dir1,... --output_dir study/");
-  if (!dwellfit::ParseToolFlags(&argc, &argv, "sensitivity")) return 2;
-  try {
+      "--output_dir study/\n       sensitivity --merge dir0,dir1,... --output_dir study/",
+      __FILE__};
+  return dwellfit::RunTool(argc, argv, tool, [] {
     if (FLAGS_output_dir.empty()) throw dwellfit::InputError("--output_dir", 0, "", "required");
     dwellfit::CheckOutputDirectory(FLAGS_output_dir, "--output_dir");
     const dwellfit::SensitivityStudy study = Run();
@@ -105,9 +104,6 @@ int main(int argc, char** argv) {
       std::cerr << "sensitivity: no fit is usable; see the status column of fits.csv\n";
       return 3;
     }
-  } catch (const dwellfit::InputError& e) {
-    std::cerr << "sensitivity: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+    return 0;
+  });
 }

@@ -12,7 +12,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/data/sweep_csv_writer.h"
 #include "dwellfit/estimator/simulation/dwell_simulator.h"
-#include "dwellfit/tools/tool_flags.h"
+#include "dwellfit/tools/tool_main.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -20,25 +20,20 @@ DEFINE_string(plan, "", "YAML dwell plan: truth parameters, sweeps, noise (requi
 DEFINE_string(out, "", "CSV file to write (sweep,direction,freq_hz,a_base,a) (required).");
 
 int main(int argc, char** argv) {
-  dwellfit::KeepFreedMemoryForReuse();
-  google::InitGoogleLogging(argv[0]);
-  gflags::SetUsageMessage(
-      "Simulates sine-dwell sweeps on the model from a plan.\n"
-      "Usage: simulate_dwell --plan plan.yaml --out sweeps.csv");
-  if (!dwellfit::ParseToolFlags(&argc, &argv, "simulate_dwell")) return 2;
-  if (FLAGS_plan.empty() || FLAGS_out.empty()) {
-    std::cerr << "simulate_dwell: give both --plan and --out\n" << gflags::ProgramUsage() << "\n";
-    return 2;
-  }
-  try {
+  const dwellfit::ToolSpec tool = {"simulate_dwell",
+                                   "Simulates sine-dwell sweeps on the model from a plan.\n"
+                                   "Usage: simulate_dwell --plan plan.yaml --out sweeps.csv",
+                                   __FILE__};
+  return dwellfit::RunTool(argc, argv, tool, [] {
+    if (FLAGS_plan.empty() || FLAGS_out.empty()) {
+      std::cerr << "simulate_dwell: give both --plan and --out; see --help\n";
+      return dwellfit::kToolExitUsage;
+    }
     const dwellfit::DwellPlan plan = dwellfit::ReadDwellPlan(FLAGS_plan);
     const std::vector<dwellfit::Sweep> sweeps = dwellfit::SimulateDwells(plan);
     dwellfit::WriteSweepsCsvFile(sweeps, FLAGS_out);
     dwellfit::DescribeSimulation(plan, sweeps, &std::cout);
     std::cout << "wrote " << FLAGS_out << "\n";
-  } catch (const dwellfit::InputError& e) {
-    std::cerr << "simulate_dwell: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+    return 0;
+  });
 }

@@ -21,7 +21,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/rig/rig_simulator.h"
-#include "dwellfit/tools/tool_flags.h"
+#include "dwellfit/tools/tool_main.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
@@ -41,17 +41,16 @@ void DrawProgress(int done, int total) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  dwellfit::KeepFreedMemoryForReuse();
-  google::InitGoogleLogging(argv[0]);
-  gflags::SetUsageMessage(
+  const dwellfit::ToolSpec tool = {
+      "simulate_rig",
       "Simulates a sine-dwell test on the virtual rig and writes time traces.\n"
-      "Usage: simulate_rig --plan plan.yaml --rig rig.yaml --out traces_folder");
-  if (!dwellfit::ParseToolFlags(&argc, &argv, "simulate_rig")) return 2;
-  if (FLAGS_plan.empty() || FLAGS_rig.empty() || FLAGS_out.empty()) {
-    std::cerr << "simulate_rig: give --plan, --rig and --out\n" << gflags::ProgramUsage() << "\n";
-    return 2;
-  }
-  try {
+      "Usage: simulate_rig --plan plan.yaml --rig rig.yaml --out traces_folder",
+      __FILE__};
+  return dwellfit::RunTool(argc, argv, tool, [] {
+    if (FLAGS_plan.empty() || FLAGS_rig.empty() || FLAGS_out.empty()) {
+      std::cerr << "simulate_rig: give --plan, --rig and --out; see --help\n";
+      return dwellfit::kToolExitUsage;
+    }
     const dwellfit::DwellPlan plan = dwellfit::ReadDwellPlan(FLAGS_plan);
     const dwellfit::RigConfig rig = dwellfit::ReadRigConfig(FLAGS_rig);
     const auto start = std::chrono::steady_clock::now();
@@ -68,8 +67,5 @@ int main(int argc, char** argv) {
         "not settle\nwrote %s\n",
         run.traces.size(), seconds, run.traces.size() / seconds, unsettled, FLAGS_out.c_str());
     return unsettled > 0 ? 3 : 0;
-  } catch (const dwellfit::InputError& e) {
-    std::cerr << "simulate_rig: " << e.what() << "\n";
-    return 1;
-  }
+  });
 }

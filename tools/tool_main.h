@@ -1,0 +1,228 @@
+// Every tool's main(): its command-line manners and its error policy, in one
+// place (RunTool).
+//
+// Manners: `--help` prints the tool's usage and its own flags and exits 0
+// (`--helpfull` every flag, glog's and gflags' included); `--version` prints
+// dwellfit's version and those of the libraries it was built with, and exits
+// 0; an unknown flag, a flag given twice, a flag value of the wrong type or a
+// stray argument is a usage error (exit 2), with a did-you-mean for a
+// misspelt flag.
+//
+// Error policy: the tool's body runs inside RunTool's handlers, so that no
+// tool aborts on an exception. Bad input (InputError, naming file, line and
+// field) exits 1; memory, threads, disk or file size running out exit 6 with
+// what ran out; anything else is a defect of the tool and exits 7 with its
+// text. A tool's own outcomes (a fit that did not converge, ...) are exit
+// codes of its body, 3 to 5 (README, "Exit status").
+//
+// Each tool is one translation unit (tools/CMakeLists.txt), so these inline
+// functions and tool_flags.h's flag are defined once per program.
+#ifndef DWELLFIT_TOOLS_TOOL_MAIN_H_
+#define DWELLFIT_TOOLS_TOOL_MAIN_H_
+
+#include <algorithm>
+#include <cerrno>
+#include <csignal>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <iostream>
+#include <new>
+#include <optional>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/memory_policy.h"
+#include "dwellfit/estimator/common/version.h"
+#include "dwellfit/tools/tool_flags.h"
+#include "gflags/gflags.h"
+#include "glog/logging.h"
+
+namespace dwellfit {
+
+// Exit statuses every tool shares; identify's own are in
+// estimator/run/identify_run.h.
+inline constexpr int kToolExitInput = 1;     // bad input: a file, the config, a flag's value
+inline constexpr int kToolExitUsage = 2;     // bad command line
+inline constexpr int kToolExitResource = 6;  // memory, threads, disk or file size ran out
+inline constexpr int kToolExitDefect = 7;    // an error the tool has no words for (a bug)
+
+struct ToolSpec {
+  const char* name;   // "identify"
+  const char* usage;  // what it does, then its synopsis
+  const char* file;   // __FILE__ of its main: --help lists the flags defined there
+};
+
+// The number of single-character edits between a and b (Levenshtein), for
+// the did-you-mean of a misspelt flag.
+inline std::size_t EditDistance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// True for the flags a tool lists in --help: those of its main file and of
+// tool_flags.h.
+inline bool OwnFlag(const gflags::CommandLineFlagInfo& flag, const ToolSpec& tool) {
+  const auto base = [](const std::string& path) {
+    return std::filesystem::path(path).filename().string();
+  };
+  const std::string file = base(flag.filename);
+  return file == base(tool.file) || file == "tool_flags.h";
+}
+
+// "--figures" for a misspelt "figure": the tool's own flag nearest to
+// `name`, within a third of its length in edits; empty when none is.
+inline std::string NearestFlag(const std::string& name, const ToolSpec& tool) {
+  std::vector<gflags::CommandLineFlagInfo> flags;
+  gflags::GetAllFlags(&flags);
+  std::string nearest;
+  std::size_t best = std::max<std::size_t>(2, name.size() / 3) + 1;
+  for (const gflags::CommandLineFlagInfo& flag : flags) {
+    const std::size_t distance = EditDistance(name, flag.name);
+    if (OwnFlag(flag, tool) && distance < best) {
+      best = distance;
+      nearest = flag.name;
+    }
+  }
+  return nearest;
+}
+
+// What is wrong with the command line `args` (argv without the program), in
+// words; none when gflags can parse it as given. Sets each flag it meets
+// (gflags' parse later sets the same values again). A flag is `-name` or
+// `--name`, with `=value` or (not for a bool) the value as the next argument;
+// `--noname` is a bool's false; nothing after `--` is a flag.
+inline std::optional<std::string> CommandLineProblem(const std::vector<std::string>& args,
+                                                     const ToolSpec& tool) {
+  std::vector<std::string> seen;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    if (arg == "--") break;
+    if (arg.size() < 2 || arg[0] != '-') return "unexpected argument '" + arg + "'";
+    const std::string body = arg.substr(arg[1] == '-' ? 2 : 1);
+    const std::string::size_type equals = body.find('=');
+    std::string name = body.substr(0, equals);
+    std::optional<std::string> value;
+    if (equals != std::string::npos) value = body.substr(equals + 1);
+    gflags::CommandLineFlagInfo info;
+    if (!gflags::GetCommandLineFlagInfo(name.c_str(), &info) && name.rfind("no", 0) == 0 &&
+        gflags::GetCommandLineFlagInfo(name.substr(2).c_str(), &info) && info.type == "bool" &&
+        !value) {
+      name = name.substr(2);
+      value = "false";
+    }
+    if (info.name != name) {
+      const std::string nearest = NearestFlag(name, tool);
+      return "unknown flag --" + name +
+             (nearest.empty() ? "" : "; did you mean --" + nearest + "?");
+    }
+    if (std::find(seen.begin(), seen.end(), name) != seen.end()) {
+      return "--" + name + " is given more than once, and only its last value would count; " +
+             "give it once" +
+             (name == "set" ? " (several overrides in one --set: --set a=1,b=2)" : "");
+    }
+    seen.push_back(name);
+    if (!value && info.type == "bool") value = "true";
+    if (!value && ++i == args.size()) return "--" + name + " needs a value";
+    if (!value) value = args[i];
+    if (gflags::SetCommandLineOption(name.c_str(), value->c_str()).empty()) {
+      return "--" + name + " '" + *value + "' is not a valid " + info.type + " value";
+    }
+  }
+  return std::nullopt;
+}
+
+// --help: the usage, then the tool's own flags with their defaults.
+inline void PrintToolHelp(const ToolSpec& tool) {
+  std::cout << tool.name << ": " << tool.usage << "\n\nFlags:\n";
+  std::vector<gflags::CommandLineFlagInfo> flags;
+  gflags::GetAllFlags(&flags);
+  // The tool's own flags first, then --verbose (tool_flags.h).
+  std::stable_partition(flags.begin(), flags.end(), [&tool](const auto& flag) {
+    return OwnFlag(flag, tool) && flag.filename.find("tool_flags.h") == std::string::npos;
+  });
+  for (const gflags::CommandLineFlagInfo& flag : flags) {
+    if (!OwnFlag(flag, tool)) continue;
+    std::cout << "  --" << flag.name << " (" << flag.type << ", default '" << flag.default_value
+              << "')\n      " << flag.description << "\n";
+  }
+  std::cout << "  --help, --helpfull (every flag, glog's included), --version\n";
+}
+
+// --version: dwellfit's and its libraries' versions (as built).
+inline void PrintToolVersion(const ToolSpec& tool) {
+  std::cout << "dwellfit " << DwellfitVersion() << " (" << tool.name << ")\nbuilt with "
+            << DWELLFIT_DEPENDENCY_VERSIONS << "\n";
+}
+
+// True when a gflags bool flag such as "help" is set.
+inline bool BoolFlagSet(const char* name) {
+  std::string value;
+  return gflags::GetCommandLineOption(name, &value) && value == "true";
+}
+
+// Parses the command line: -1 to go on, else the exit status (help and
+// version printed, or a usage error said).
+inline int ParseToolCommandLine(int* argc, char*** argv, const ToolSpec& tool) {
+  QuietLibraryLogging(tool.name);
+  const std::vector<std::string> args(*argv + 1, *argv + *argc);
+  if (const auto problem = CommandLineProblem(args, tool)) {
+    std::cerr << tool.name << ": " << *problem << " (see --help)\n";
+    return kToolExitUsage;
+  }
+  gflags::ParseCommandLineNonHelpFlags(argc, argv, /*remove_flags=*/true);
+  if (BoolFlagSet("help")) return PrintToolHelp(tool), 0;
+  if (BoolFlagSet("version")) return PrintToolVersion(tool), 0;
+  if (BoolFlagSet("helpfull")) return gflags::ShowUsageWithFlags((*argv)[0]), 0;
+  gflags::HandleCommandLineHelpFlags();  // --helpshort, --helpmatch=S, ...: print and exit
+  return -1;
+}
+
+// Runs a tool: parses its command line (ParseToolCommandLine), then `body`
+// under the error policy at the top of this file. Returns the exit status.
+inline int RunTool(int argc, char** argv, const ToolSpec& tool, const std::function<int()>& body) {
+  // A file size limit (ulimit -f) stops a write with EFBIG, reported as an
+  // I/O error, rather than killing the process with SIGXFSZ.
+  std::signal(SIGXFSZ, SIG_IGN);
+  KeepFreedMemoryForReuse();
+  google::InitGoogleLogging(argv[0]);
+  gflags::SetUsageMessage(tool.usage);
+  const auto say = [&tool](const std::string& text) {
+    std::cerr << tool.name << ": " << text << "\n";
+  };
+  try {
+    const int parsed = ParseToolCommandLine(&argc, &argv, tool);
+    return parsed >= 0 ? parsed : body();
+  } catch (const InputError& error) {
+    say(error.what());
+    return kToolExitInput;
+  } catch (const std::bad_alloc&) {
+    say("out of memory: the run needs more than this process may allocate (ulimit -v, or the "
+        "machine's memory); give it a smaller input, study or thread count");
+    return kToolExitResource;
+  } catch (const std::system_error& error) {  // I/O (std::ios_base::failure), threads, files
+    say(std::string("the system refused: ") + error.what() + " (" + error.code().message() +
+        "); check the disk space, the file size limit and the thread limit");
+    return kToolExitResource;
+  } catch (const std::exception& error) {
+    say(std::string("internal error: ") + error.what() +
+        "; this is a defect of dwellfit: please report it with the command line");
+    return kToolExitDefect;
+  }
+}
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_TOOLS_TOOL_MAIN_H_
