@@ -64,6 +64,10 @@ dwellfit::ParameterVector Parameters(const dwellfit::DwellPlan* plan) {
       }
       continue;
     }
+    if (!std::isfinite(flags[i])) {
+      throw InputError("--" + std::string(i == kNaturalFrequency ? "omega_hz" : ParameterName(i)),
+                       0, "", "is not a finite number; give a finite value");
+    }
     p[i] = i == kNaturalFrequency ? HzToRadPerSecond(flags[i]) : flags[i];
   }
   return p;
@@ -119,8 +123,19 @@ int main(int argc, char** argv) {
     std::optional<dwellfit::DwellPlan> plan;
     if (!FLAGS_plan.empty()) plan = dwellfit::ReadDwellPlan(FLAGS_plan);
     const dwellfit::DwellPlan* plan_ptr = plan ? &*plan : nullptr;
-    const std::string csv =
-        dwellfit::CurvesToCsv(dwellfit::TraceCurves(Parameters(plan_ptr), Specs(plan_ptr)));
+    const std::vector<dwellfit::ResponseCurve> curves =
+        dwellfit::TraceCurves(Parameters(plan_ptr), Specs(plan_ptr));
+    for (const dwellfit::ResponseCurve& curve : curves) {
+      // Parameters or a range far outside a structure's (1e300, 1e-300)
+      // leave no finite response to trace: an error, not an empty file.
+      if (curve.points.size() < 2) {
+        throw dwellfit::InputError(
+            "curve '" + curve.spec.name + "'", 0, "",
+            "the model has no finite response over the range for these parameters; check their "
+            "values and units and the range (--from, --to, --a_base, --freq_hz)");
+      }
+    }
+    const std::string csv = dwellfit::CurvesToCsv(curves);
     if (FLAGS_output.empty()) {
       std::cout << csv;
     } else {

@@ -10,11 +10,16 @@
 // Warnings (unsettled dwells, strong harmonics, base levels off the sweep's
 // mean) are printed. With an unsettled dwell nothing is written and the exit
 // code is 3, unless --allow_unsettled; bad input exits 1.
+#include <unistd.h>
+
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dwellfit/config/rig_config_reader.h"
@@ -40,7 +45,8 @@ namespace {
 // run fails); Commit renames it into place.
 std::string Stage(const std::string& text, const std::string& path,
                   std::vector<std::string>* staged) {
-  const std::string name = path + ".partial";
+  // The process id keeps two runs into one --out from sharing a staged file.
+  const std::string name = path + ".partial." + std::to_string(::getpid());
   staged->push_back(name);
   std::ofstream file(name, std::ios::binary | std::ios::trunc);
   file << text;
@@ -55,9 +61,43 @@ void Commit(const std::string& staged, const std::string& path) {
   }
 }
 
+// Throws InputError, before anything is read or written, when an output
+// flag names a folder, both outputs name one file, or an output is an input;
+// or when --reference_hz is negative or not finite.
+void CheckFlags() {
+  namespace fs = std::filesystem;
+  if (!(FLAGS_reference_hz >= 0.0 && std::isfinite(FLAGS_reference_hz))) {
+    throw dwellfit::InputError("--reference_hz", 0, "",
+                               "give a frequency >= 0 in Hz (0: the identified omega)");
+  }
+  const auto same = [](const std::string& a, const std::string& b) {
+    return fs::weakly_canonical(a) == fs::weakly_canonical(b);
+  };
+  const fs::path traces(FLAGS_traces);
+  const std::vector<std::string> inputs = {FLAGS_rig, (traces / "traces.csv").string(),
+                                           (traces / "traces.f32").string()};
+  for (const auto& [flag, path] :
+       {std::pair{"--out", FLAGS_out}, std::pair{"--harmonic_balance", FLAGS_harmonic_balance}}) {
+    if (path.empty()) continue;
+    if (fs::is_directory(path)) {
+      throw dwellfit::InputError(path, 0, flag, "is a folder; give a file name");
+    }
+    for (const std::string& input : inputs) {
+      if (same(path, input)) {
+        throw dwellfit::InputError(path, 0, flag, "is an input of this run; give another file");
+      }
+    }
+  }
+  if (!FLAGS_harmonic_balance.empty() && same(FLAGS_out, FLAGS_harmonic_balance)) {
+    throw dwellfit::InputError(FLAGS_out, 0, "--harmonic_balance",
+                               "names the same file as --out; give two files");
+  }
+}
+
 // Reads, processes and writes (see the top of this file); returns the exit
 // status. What it stages is listed in `staged`.
 int ProcessAndWrite(std::vector<std::string>* staged) {
+  CheckFlags();
   const dwellfit::RigConfig rig = dwellfit::ReadRigConfig(FLAGS_rig);
   const auto dwells = dwellfit::ReadTraceSet(FLAGS_traces);
   const dwellfit::ProcessedTraces processed = dwellfit::ProcessTraces(dwells, rig.processing);
