@@ -99,7 +99,6 @@ ceres::CostFunction* ProblemBuilder::MakeResidual(
 
 void ProblemBuilder::Add(ceres::CostFunction* cost, const ParameterLayout& layout,
                          ceres::Problem* problem, ParallelResidualEvaluator* evaluator) const {
-  // The one-block case reads the block directly: no adapter in between.
   if (!layout.IsIdentity()) cost = new MappedCostFunction(cost, layout);
   if (evaluator != nullptr) cost = evaluator->Wrap(cost, layout.blocks);
   problem->AddResidualBlock(cost, nullptr, layout.blocks);
@@ -184,6 +183,9 @@ bool FoldExists(const Sweep& sweep, const JumpBracket& jump, const ParameterVect
   return penalty.SolveFold(p).exists;
 }
 
+namespace {
+
+// The algebraic fold condition of one measured jump (FoldConditionResidual).
 ceres::CostFunction* MakeFoldCondition(const Sweep& sweep, const JumpBracket& jump) {
   const DwellPoint& before = sweep.points[jump.index_before];
   const bool frequency = sweep.kind == SweepKind::kFrequency;
@@ -193,6 +195,8 @@ ceres::CostFunction* MakeFoldCondition(const Sweep& sweep, const JumpBracket& ju
                                        frequency ? before.a_base : jump.centre(),
                                        jump.amplitude_before, weight);
 }
+
+}  // namespace
 
 int ProblemBuilder::AddPenalties(const Sweep& sweep, double* parameters, ceres::Problem* problem,
                                  ParallelResidualEvaluator* evaluator) const {
