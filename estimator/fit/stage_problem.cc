@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -23,15 +24,27 @@ ceres::Problem::Options StageProblem::ProblemOptions(ParallelResidualEvaluator* 
   return options;
 }
 
-void StageProblem::OwnCostFunctions(const ceres::Problem& problem,
-                                    const std::vector<ceres::ResidualBlockId>& blocks, size_t first,
-                                    bool may_share) {
-  std::unordered_set<const ceres::CostFunction*> owned;
-  cost_functions_.reserve(cost_functions_.size() + blocks.size() - first);
-  for (size_t i = first; i < blocks.size(); ++i) {
-    const ceres::CostFunction* cost = problem.GetCostFunctionForResidualBlock(blocks[i]);
-    if (!may_share || owned.insert(cost).second) cost_functions_.emplace_back(cost);
+std::vector<ceres::ResidualBlockId> StageProblem::AddOwned(ceres::Problem* problem, bool may_share,
+                                                           const std::function<void()>& add) {
+  const size_t before = problem->NumResidualBlocks();
+  std::vector<ceres::ResidualBlockId> all;
+  const auto own = [&] {
+    problem->GetResidualBlocks(&all);
+    std::unordered_set<const ceres::CostFunction*> owned;
+    cost_functions_.reserve(cost_functions_.size() + all.size() - before);
+    for (size_t i = before; i < all.size(); ++i) {
+      const ceres::CostFunction* cost = problem->GetCostFunctionForResidualBlock(all[i]);
+      if (!may_share || owned.insert(cost).second) cost_functions_.emplace_back(cost);
+    }
+  };
+  try {
+    add();
+  } catch (...) {  // what was added before the throw is owned all the same
+    own();
+    throw;
   }
+  own();
+  return {all.begin() + before, all.end()};
 }
 
 std::vector<ParallelResidualEvaluator::Block> StageProblem::EvaluatedBlocks(
@@ -88,36 +101,28 @@ StageProblem::StageProblem(const FitDescription& fit, const StageSetup& setup)
 
 void StageProblem::AddDwells() {
   ceres::Problem* problem = dwell_problem();
-  try {
+  dwell_blocks_ = AddOwned(problem, false, [&] {
     for (const FitDataset& dataset : fit_.datasets) {
       layouts_.push_back(LayoutOf(fit_, dataset.parameters));
       for (const Sweep* sweep : dataset.sweeps) {
         dwells_ += builder_.AddSweep(*sweep, layouts_.back(), problem, Evaluator(), &warm_started_);
       }
     }
-  } catch (...) {  // a sweep the residual cannot take: the earlier ones' blocks are owned
-    problem->GetResidualBlocks(&dwell_blocks_);
-    OwnCostFunctions(*problem, dwell_blocks_, 0, false);
-    throw;
-  }
-  problem->GetResidualBlocks(&dwell_blocks_);
-  OwnCostFunctions(*problem, dwell_blocks_, 0, false);
+  });
 }
 
 void StageProblem::AddPenalties(const PenaltyOptions& penalties) {
   ProblemBuilderOptions options = builder_.options();
   options.penalties = penalties;
   const ProblemBuilder penalty_builder(options);
-  const int before = problem_.NumResidualBlocks();
-  for (size_t d = 0; d < fit_.datasets.size(); ++d) {
-    for (const Sweep* sweep : fit_.datasets[d].sweeps) {
-      penalty_builder.AddPenalties(*sweep, layouts_[d], &problem_, Evaluator());
+  const std::vector<ceres::ResidualBlockId> added = AddOwned(&problem_, false, [&] {
+    for (size_t d = 0; d < fit_.datasets.size(); ++d) {
+      for (const Sweep* sweep : fit_.datasets[d].sweeps) {
+        penalty_builder.AddPenalties(*sweep, layouts_[d], &problem_, Evaluator());
+      }
     }
-  }
-  std::vector<ceres::ResidualBlockId> all;
-  problem_.GetResidualBlocks(&all);
-  OwnCostFunctions(problem_, all, before, false);
-  penalty_blocks_.insert(penalty_blocks_.end(), all.begin() + before, all.end());
+  });
+  penalty_blocks_.insert(penalty_blocks_.end(), added.begin(), added.end());
 }
 
 ParameterVector StageProblem::ValuesOf(const ParameterLayout& layout) {
@@ -148,18 +153,7 @@ std::vector<std::string> StageProblem::MissingFolds(const BifurcationRangeOption
 
 void StageProblem::AddCallerResiduals() {
   if (!fit_.add_residuals) return;
-  const int before = problem_.NumResidualBlocks();
-  std::vector<ceres::ResidualBlockId> all;
-  try {
-    fit_.add_residuals(&problem_);
-  } catch (...) {  // what it added before it threw is owned all the same
-    problem_.GetResidualBlocks(&all);
-    OwnCostFunctions(problem_, all, before, true);
-    throw;
-  }
-  problem_.GetResidualBlocks(&all);
-  OwnCostFunctions(problem_, all, before, true);
-  caller_blocks_.assign(all.begin() + before, all.end());
+  caller_blocks_ = AddOwned(&problem_, true, [this] { fit_.add_residuals(&problem_); });
 }
 
 bool StageProblem::IsBounded(int entry) const {

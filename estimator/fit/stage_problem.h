@@ -9,6 +9,7 @@
 #ifndef DWELLFIT_ESTIMATOR_FIT_STAGE_PROBLEM_H_
 #define DWELLFIT_ESTIMATOR_FIT_STAGE_PROBLEM_H_
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -99,11 +100,11 @@ class StageProblem {
 
   static ceres::Problem::Options ProblemOptions(ParallelResidualEvaluator* evaluator,
                                                 bool threaded);
-  // Takes ownership of the cost functions of `blocks` from `first` on (each
-  // once when `may_share`: a caller's may serve several blocks).
-  void OwnCostFunctions(const ceres::Problem& problem,
-                        const std::vector<ceres::ResidualBlockId>& blocks, size_t first,
-                        bool may_share);
+  // Runs `add`, then owns the cost functions of the blocks it added to
+  // `problem` (each once when `may_share`: a caller's may serve several
+  // blocks), even when it throws; returns those blocks.
+  std::vector<ceres::ResidualBlockId> AddOwned(ceres::Problem* problem, bool may_share,
+                                               const std::function<void()>& add);
   void AddDwells();
   static std::vector<ParallelResidualEvaluator::Block> EvaluatedBlocks(const FitDescription& fit);
   ParallelResidualEvaluator* Evaluator() {
