@@ -46,7 +46,6 @@ using ParameterMap = std::array<ParameterSlot, kNumParameters>;
 // Parameter i in entry i of the one 6-double block `parameters`.
 ParameterMap IdentityMap(double* parameters);
 
-// One parameter block the caller owns.
 struct FitBlock {
   double* values = nullptr;  // `size` doubles; must outlive every solve on it
   int size = 0;
@@ -57,8 +56,8 @@ struct FitBlock {
   std::vector<double> scale;             // step unit; default |value at the start|, 1 for 0
 };
 
-// One dataset: its sweeps (jumps and branch labels as DetectJumps leaves them)
-// and where its six parameters live.
+// One dataset: its sweeps (as DetectJumps leaves them) and where its six
+// parameters live.
 struct FitDataset {
   std::string name;  // in messages
   std::vector<const Sweep*> sweeps;
@@ -110,9 +109,9 @@ struct ParameterLayout {
   bool IsIdentity() const;
 };
 
-// The layout of `map` over the blocks of `fit` (every slot described).
+// The layout of `map` over the blocks of `fit` (every slot described), and
+// the identity layout on one 6-double block.
 ParameterLayout LayoutOf(const FitDescription& fit, const ParameterMap& map);
-// The identity layout on one 6-double block.
 ParameterLayout SingleBlockLayout(double* parameters);
 
 }  // namespace dwellfit

@@ -28,8 +28,7 @@ bool ErrorMeasureFromName(const std::string& name, ErrorMeasure* measure);
 
 struct ResidualOptions {
   ErrorMeasure error = ErrorMeasure::kAbsolute;
-  // Divide each point's residual by its `sigma` column when the data has one.
-  bool use_point_sigma = true;
+  bool use_point_sigma = true;  // divide by a point's `sigma` where given
   // f of the relative error ln(a_i + f) - ln(a_model + f), in the data's
   // amplitude unit: the measurement's noise floor (0: purely relative).
   double amplitude_floor = 0.0;
@@ -69,8 +68,8 @@ void SetConvergenceTests(const SolverSettings& settings, CeresOptions* options) 
   options->parameter_tolerance = settings.parameter_tolerance;
 }
 
-// The jumps a bifurcation-range penalty can enforce: the sweep kind and
-// which fold (jump-up: the lower branch ends; jump-down: the upper one ends).
+// The jumps a bifurcation-range penalty can enforce (jump-up: the lower
+// branch ends; jump-down: the upper one).
 enum class JumpTarget {
   kFrequencyJumpUp,
   kFrequencyJumpDown,
@@ -89,8 +88,7 @@ struct BifurcationRangeOptions {
   bool enabled = false;
   int exponent = 10;  // n of eq. (3.17): even, >= 2
   double weight = 1.0;
-  // The chapter enforces the frequency sweep's jump-down and the amplitude
-  // sweep's jump-up.
+  // As the chapter.
   std::vector<JumpTarget> enforce = {JumpTarget::kFrequencyJumpDown, JumpTarget::kAmplitudeJumpUp};
   bool IsValid(std::string* error) const;
 };
@@ -133,9 +131,7 @@ struct IdentificationOptions {
   // Parameters held at their initial value.
   std::array<bool, kNumParameters> fixed = {false, false, false, false, false, false};
   StagedSolveOptions solve;
-  // `initial` alone: finite, and inside the model's range.
-  bool InitialIsValid(std::string* error) const;
-  // InitialIsValid and solve.IsValid.
+  bool InitialIsValid(std::string* error) const;  // finite, in the model's range
   bool IsValid(std::string* error) const;
 };
 

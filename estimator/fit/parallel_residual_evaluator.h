@@ -53,11 +53,9 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   static constexpr int kMinRowsPerThread = 512;
 
   // `blocks`: every parameter block a wrapped cost function reads, distinct.
-  // `num_threads` >= 1 (ResolveThreadCount). `min_rows_per_thread` >= 1:
-  // kMinRowsPerThread but where a benchmark measures the threads on less.
+  // `num_threads` >= 1; `min_rows_per_thread` >= 1 (less for benchmarks).
   ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads,
                             int min_rows_per_thread = kMinRowsPerThread);
-  // One block of `size` doubles that every wrapped cost function reads.
   ParallelResidualEvaluator(const double* parameters, int size, int num_threads,
                             int min_rows_per_thread = kMinRowsPerThread);
   ~ParallelResidualEvaluator() override;
@@ -66,7 +64,7 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   // blocks); returns its replaying wrapper, owned by the caller.
   ceres::CostFunction* Wrap(ceres::CostFunction* cost_function,
                             const std::vector<double*>& parameter_blocks);
-  // The same for a cost function of the first watched block alone.
+  // The same on the first watched block alone.
   ceres::CostFunction* Wrap(ceres::CostFunction* cost_function);
   // The one residual block that stands in for every wrapper made so far
   // (above; at most once): `size + 1` residuals on every watched block.

@@ -138,11 +138,6 @@ int ProblemBuilder::ResidualBlocks(const Sweep& sweep) const {
                                                 : dwells);
 }
 
-int ProblemBuilder::AddSweep(const Sweep& sweep, double* parameters, ceres::Problem* problem,
-                             ParallelResidualEvaluator* evaluator) const {
-  return AddSweep(sweep, SingleBlockLayout(parameters), problem, evaluator);
-}
-
 JumpTarget TargetOf(const Sweep& sweep, const JumpBracket& jump) {
   const bool up = jump.kind == JumpKind::kJumpUp;
   if (sweep.kind == SweepKind::kFrequency) {
@@ -197,11 +192,6 @@ ceres::CostFunction* MakeFoldCondition(const Sweep& sweep, const JumpBracket& ju
 }
 
 }  // namespace
-
-int ProblemBuilder::AddPenalties(const Sweep& sweep, double* parameters, ceres::Problem* problem,
-                                 ParallelResidualEvaluator* evaluator) const {
-  return AddPenalties(sweep, SingleBlockLayout(parameters), problem, evaluator);
-}
 
 int ProblemBuilder::AddPenalties(const Sweep& sweep, const ParameterLayout& layout,
                                  ceres::Problem* problem,

@@ -60,9 +60,6 @@ class ProblemBuilder {
   int AddSweep(const Sweep& sweep, const ParameterLayout& layout, ceres::Problem* problem,
                ParallelResidualEvaluator* evaluator = nullptr,
                std::vector<VerticalErrorResidual*>* warm_started = nullptr) const;
-  // The same on one 6-double block `parameters` (SingleBlockLayout).
-  int AddSweep(const Sweep& sweep, double* parameters, ceres::Problem* problem,
-               ParallelResidualEvaluator* evaluator = nullptr) const;
 
   // Adds the enabled penalties for `sweep`: a BifurcationRangePenalty per
   // enforced measured jump, a BranchStabilityPenalty per dwell labelled
@@ -70,8 +67,6 @@ class ProblemBuilder {
   // unweighted FoldConditionResidual instead, and no branch-stability term.
   // Returns the number of blocks added.
   int AddPenalties(const Sweep& sweep, const ParameterLayout& layout, ceres::Problem* problem,
-                   ParallelResidualEvaluator* evaluator = nullptr) const;
-  int AddPenalties(const Sweep& sweep, double* parameters, ceres::Problem* problem,
                    ParallelResidualEvaluator* evaluator = nullptr) const;
 
   // The residual blocks AddSweep adds for `sweep`.

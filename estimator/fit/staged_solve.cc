@@ -7,6 +7,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dwellfit/estimator/fit/bound_rest_watcher.h"
@@ -271,9 +272,7 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
   // (ProblemBuilder::AddPenalties); the all-roots stage the penalties.
   const bool fold_conditions =
       kind == ResidualKind::kAlgebraic && penalties.bifurcation_range.enabled;
-  const bool with_penalties =
-      (kind == ResidualKind::kVertical || kind == ResidualKind::kAllRoots) &&
-      PenaltiesEnabled(penalties);
+  const bool with_penalties = IsBranchLabelled(kind) && PenaltiesEnabled(penalties);
   const int entries = context.fit.NumEntries();
   setup.held.assign(entries, false);
   std::vector<bool> released(entries, false);
@@ -282,8 +281,8 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
   std::unique_ptr<StageProblem> assembled =
       rated != nullptr ? std::move(rated) : std::make_unique<StageProblem>(context.fit, setup);
   StageProblem& problem = *assembled;
-  PenaltyOptions weighted = penalties;
-  if (with_penalties) weighted = WeighPenalties(penalties, &problem, stage);
+  const PenaltyOptions weighted =
+      with_penalties ? WeighPenalties(penalties, &problem, stage) : penalties;
   if (with_penalties || fold_conditions) problem.AddPenalties(weighted);
   if (with_penalties) stage->penalties = weighted;
   problem.AddCallerResiduals();
@@ -395,10 +394,8 @@ struct StartRating {
   double data_cost = 0.0;
 
   bool BetterThan(const StartRating& other) const {
-    if (missing_folds.size() != other.missing_folds.size()) {
-      return missing_folds.size() < other.missing_folds.size();
-    }
-    return data_cost < other.data_cost;
+    return std::make_pair(missing_folds.size(), data_cost) <
+           std::make_pair(other.missing_folds.size(), other.data_cost);
   }
 };
 

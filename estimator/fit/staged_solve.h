@@ -53,13 +53,10 @@ namespace dwellfit {
 enum class FitStatus {
   kConverged,       // the last stage met a convergence test
   kNoConvergence,   // the last stage stopped at its iteration limit: usable, not a proven minimum
-  kFailure,         // not usable: a stage's solve failed (the model could not be
-                    // evaluated; the blocks hold where that solve stopped), or the fit
-                    // ended without an enforced fold, with a cost dominated by the
-                    // penalties, or with values that are not finite
+  kFailure,         // not usable: a solve could not evaluate the model, or the fit ended
+                    // in a failure the header lists
   kInvalidInput,    // invalid options or description: nothing solved, blocks untouched
-  kUnidentifiable,  // set by the analysis (not SolveStaged): the solve ended, but the
-                    // data cannot tell the free parameters apart (no covariance)
+  kUnidentifiable,  // set by the analysis: the data cannot tell the free parameters apart
 };
 const char* FitStatusName(FitStatus status);  // "converged", "no_convergence", ...
 
@@ -80,8 +77,7 @@ struct StageSummary {
   int iterations = 0;       // over the stage's solves and valley polishes
   int solves = 0;           // one, and one more per bound held or released and per valley polish
   bool converged = false;   // its last solve met a convergence test
-  // Bounded entries the stage ended holding on their bound (an active set),
-  // as ambient indices of the description (for Identify: ParameterIndex).
+  // Entries the stage ended holding on their bound, as ambient indices.
   std::vector<int> held_at_bound;
   // Penalties' cost at the end and the enforced jumps whose fold the model
   // lacks there (StageProblem::MissingFolds).
@@ -111,8 +107,7 @@ struct FitSummary {
   // where it stopped, no fit.
   bool evaluation_failed = false;
 
-  // The blocks hold a solution (converged, or stopped at the iteration limit;
-  // not a unique one when unidentifiable).
+  // The blocks hold a solution (not a unique one when unidentifiable).
   bool IsSolutionUsable() const {
     return status == FitStatus::kConverged || status == FitStatus::kNoConvergence ||
            status == FitStatus::kUnidentifiable;
