@@ -205,11 +205,13 @@ std::vector<bool> FitDescription::FixedEntries() const {
   return fixed;
 }
 
-std::vector<bool> FitDescription::EntriesHolding(int parameter) const {
+std::vector<bool> FitDescription::EntriesHolding(std::initializer_list<int> parameters) const {
   std::vector<bool> holding(NumEntries(), false);
   for (const FitDataset& dataset : datasets) {
-    const int entry = AmbientIndex(dataset.parameters[parameter]);
-    if (entry >= 0) holding[entry] = true;
+    for (int parameter : parameters) {
+      const int entry = AmbientIndex(dataset.parameters[parameter]);
+      if (entry >= 0) holding[entry] = true;
+    }
   }
   return holding;
 }

@@ -25,6 +25,7 @@
 
 #include <array>
 #include <functional>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -88,8 +89,8 @@ struct FitDescription {
   std::vector<double> Values() const;  // ambient order
   void SetValues(const std::vector<double>& values) const;
   std::vector<bool> FixedEntries() const;  // per ambient entry
-  // Per ambient entry: whether some dataset maps parameter `parameter` there.
-  std::vector<bool> EntriesHolding(int parameter) const;
+  // Per ambient entry: whether some dataset maps one of `parameters` there.
+  std::vector<bool> EntriesHolding(std::initializer_list<int> parameters) const;
   int NumDwells() const;
 };
 

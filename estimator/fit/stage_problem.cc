@@ -69,14 +69,12 @@ StageProblem::StageProblem(const FitDescription& fit, const StageSetup& setup)
       held_(setup.held),
       held_constant_(fit.blocks.size(), false),
       builder_(Batched(setup.residuals)),
-      eta_e_entries_(fit.EntriesHolding(kEtaE)),
-      damping_entries_(fit.EntriesHolding(kMu1)),
+      eta_e_entries_(fit.EntriesHolding({kEtaE})),
+      damping_entries_(fit.EntriesHolding({kMu1, kMu2})),
       fixed_(fit.FixedEntries()),
       evaluator_(EvaluatedBlocks(fit), setup.num_threads),
       problem_(ProblemOptions(&evaluator_, setup.threaded_evaluation)),
       dwell_problem_(ProblemOptions(nullptr, false)) {
-  const std::vector<bool> mu2 = fit.EntriesHolding(kMu2);
-  for (size_t i = 0; i < mu2.size(); ++i) damping_entries_[i] = damping_entries_[i] || mu2[i];
   CHECK_EQ(setup.scale.size(), fixed_.size());
   for (const FitBlock& block : fit.blocks) problem_.AddParameterBlock(block.values, block.size);
   int blocks = 0;

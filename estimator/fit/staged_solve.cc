@@ -165,19 +165,9 @@ PenaltyOptions WeighPenalties(const PenaltyOptions& penalties, StageProblem* pro
   return weighted;
 }
 
-// Per ambient entry: whether it holds one of `parameters` in some dataset.
-std::vector<bool> Holding(const FitDescription& fit, std::initializer_list<int> parameters) {
-  std::vector<bool> holding(fit.NumEntries(), false);
-  for (int parameter : parameters) {
-    const std::vector<bool> one = fit.EntriesHolding(parameter);
-    for (size_t i = 0; i < one.size(); ++i) holding[i] = holding[i] || one[i];
-  }
-  return holding;
-}
-
 // The entries of `fit` that hold one of `parameters` in some dataset, each once.
 std::vector<double*> EntriesOf(const FitDescription& fit, std::initializer_list<int> parameters) {
-  const std::vector<bool> holding = Holding(fit, parameters);
+  const std::vector<bool> holding = fit.EntriesHolding(parameters);
   std::vector<double*> entries;
   for (size_t b = 0; b < fit.blocks.size(); ++b) {
     for (int i = 0; i < fit.blocks[b].size; ++i) {
@@ -208,7 +198,7 @@ void RecordSolve(const ceres::Solver::Summary& summary, int round, const Penalty
 // "eta_e 100, mu1 0.2, ..., omega 251.3 rad/s": every entry of `fit` at
 // `values`, natural frequencies with their unit.
 std::string DescribeValues(const FitDescription& fit, const std::vector<double>& values) {
-  const std::vector<bool> natural_frequency = fit.EntriesHolding(kNaturalFrequency);
+  const std::vector<bool> natural_frequency = fit.EntriesHolding({kNaturalFrequency});
   std::ostringstream text;
   for (size_t i = 0; i < values.size(); ++i) {
     text << (i > 0 ? ", " : "") << fit.EntryName(static_cast<int>(i)) << " " << values[i]
@@ -548,7 +538,7 @@ std::optional<Descent> FindDescent(const SolveContext& context, const StageSumma
   if (!std::isfinite(base)) return std::nullopt;
   const double tolerance = kMinimumCheckTolerances * context.options.solver.function_tolerance;
   const std::vector<bool> fixed = context.fit.FixedEntries();
-  const std::vector<bool> bounded = Holding(context.fit, {kEtaE, kMu1, kMu2});
+  const std::vector<bool> bounded = context.fit.EntriesHolding({kEtaE, kMu1, kMu2});
   std::optional<Descent> best;
   for (size_t i = 0; i < start.size(); ++i) {
     if (fixed[i]) continue;
@@ -654,15 +644,13 @@ void Conclude(const FitDescription& fit, FitSummary* summary) {
           << last.brief_report;
   // G depends on w only through w^2: a negative w is the same model.
   for (double* w : EntriesOf(fit, {kNaturalFrequency})) *w = std::abs(*w);
-  std::vector<double> eta_e_values;
-  for (const double* eta_e : EntriesOf(fit, {kEtaE})) eta_e_values.push_back(*eta_e);
+  const std::vector<double*> eta_e = EntriesOf(fit, {kEtaE});
   const std::vector<double> values = fit.Values();
   std::string failure;
   if (!std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); }) ||
       !std::isfinite(summary->final_cost)) {
     failure = "the fit ended at values that are not finite";
-  } else if (std::any_of(eta_e_values.begin(), eta_e_values.end(),
-                         [](double eta_e) { return !(eta_e > 0.0); })) {
+  } else if (std::any_of(eta_e.begin(), eta_e.end(), [](const double* e) { return !(*e > 0.0); })) {
     failure = "the fit ended at eta_e = 0, where the model has no forcing";
   } else if (!last.missing_folds.empty()) {
     failure = "the fit ended without the enforced fold(s) " + JoinLines(last.missing_folds) +
