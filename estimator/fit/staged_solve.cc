@@ -696,17 +696,14 @@ FitSummary SolveStaged(const FitDescription& fit, const StagedSolveOptions& opti
       previous_start = fit.Values();
       after_start_stage = RunStartStage(context, kind, &summary);
     }
-    const bool choose = kind == ResidualKind::kVertical || (s == 0 && after_start_stage);
-    if (choose) {
+    if (kind == ResidualKind::kVertical || (s == 0 && after_start_stage)) {
       chosen = ChooseStart(context, {kind, after_start_stage || s > 0 ? &previous_start : nullptr,
                                      s == 0 && after_start_stage, fold_stage_ran});
       if (chosen.fold_stage) {
         summary.stages.push_back(std::move(*chosen.fold_stage));
         fold_stage_ran = true;
       }
-      if (!chosen.ok) {
-        return EvaluationFailed(chosen.failure, &summary);
-      }
+      if (!chosen.ok) return EvaluationFailed(chosen.failure, &summary);
     }
     previous_start = fit.Values();
     // The algebraic stage fits the dwells alone.
