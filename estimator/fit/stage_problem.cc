@@ -7,7 +7,6 @@
 #include <memory>
 #include <sstream>
 #include <unordered_set>
-#include <utility>
 
 #include "ceres/loss_function.h"
 #include "dwellfit/estimator/common/string_printf.h"
