@@ -1,15 +1,10 @@
 // BatchedCostFunction: several cost functions on the same parameter blocks,
 // stacked into one residual block.
 //
-// The residuals are the members' residuals in order, r = [r_1; r_2; ...; r_m],
-// and so is each parameter block's Jacobian (row-major, the members' rows
-// stacked). Ceres' work per residual block (bookkeeping, the Jacobian's
-// projection onto the manifold, the validity checks) is then paid once per
-// batch instead of once per dwell. Each member keeps its own definition.
-//
-// The cost of a batch is (1/2) sum_i |r_i|^2, the sum of its members' costs;
-// no loss function may be attached to a batch (it would act on the sum).
-// Evaluate fails when any member fails.
+// r = [r_1; ...; r_m] and each block's Jacobian stack the members' rows, so
+// Ceres' work per residual block is paid once per batch, not per dwell. The
+// cost (1/2) sum_i |r_i|^2 is the members' sum; no loss function may be
+// attached (it would act on the sum). Evaluate fails when any member fails.
 #ifndef DWELLFIT_ESTIMATOR_FIT_BATCHED_COST_FUNCTION_H_
 #define DWELLFIT_ESTIMATOR_FIT_BATCHED_COST_FUNCTION_H_
 
@@ -45,15 +40,11 @@ class BatchedCostFunction : public ceres::CostFunction {
   std::vector<int> first_row_;  // of each member in the batch
 };
 
-// FunctorBatch: the same stacking for dwells whose cost function would be a
-// ceres::AutoDiffCostFunction<Functor, 1, kNumParameters> each, with the
-// functors held side by side instead of a cost function object per dwell.
-// Functor's operator() is Functor::Evaluate on the parameters'
-// terms (ParameterTerms); a batch forms the terms once for all its members,
-// from the parameters with Jacobians as Jets seeded by Ceres'
-// Make1stOrderPerturbations (as AutoDifferentiate seeds them per call), and
-// takes each member's residual and Jacobian row as AutoDifferentiate takes
-// them, so they are the numbers AutoDiffCostFunction gives.
+// FunctorBatch: the same for functors whose cost function would be an
+// AutoDiffCostFunction<Functor, 1, kNumParameters> each, held side by side.
+// The parameters' terms (ParameterTerms) are formed once per batch, on Jets
+// seeded as AutoDifferentiate seeds them, so each member's residual and
+// Jacobian row are the numbers AutoDiffCostFunction gives.
 template <typename Functor>
 class FunctorBatch : public ceres::CostFunction {
  public:
@@ -77,9 +68,6 @@ class FunctorBatch : public ceres::CostFunction {
       }
       return true;
     }
-    // The parameters as Jets, seeded as AutoDifferentiate seeds them, and
-    // their terms, once for every member; then each member's residual and
-    // Jacobian row as AutoDifferentiate takes them.
     using Dims = ceres::internal::StaticParameterDims<kNumParameters>;
     using JetT = ceres::Jet<double, kNumParameters>;
     std::array<JetT, kNumParameters> point;
@@ -100,9 +88,8 @@ class FunctorBatch : public ceres::CostFunction {
   }
 
  private:
-  // A deque: members stay where they are as more are added (a vertical
-  // error's functor is also reached through its address), and a functor
-  // with an atomic member need not be movable.
+  // A deque: members keep their address as more are added, and need not be
+  // movable.
   std::deque<Functor> functors_;
 };
 

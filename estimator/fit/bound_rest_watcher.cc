@@ -6,20 +6,6 @@
 
 namespace dwellfit {
 
-std::vector<BoundRestWatcher::Entry> BoundRestWatcher::EntriesOf(
-    const double* parameters, const std::vector<Bound>& watched) {
-  CHECK(parameters != nullptr);
-  std::vector<Entry> entries;
-  for (const Bound& bound : watched) {
-    entries.push_back({parameters + bound.index, bound.lower, bound.index});
-  }
-  return entries;
-}
-
-BoundRestWatcher::BoundRestWatcher(const double* parameters, const std::vector<Bound>& watched,
-                                   int steps)
-    : BoundRestWatcher(EntriesOf(parameters, watched), steps) {}
-
 BoundRestWatcher::BoundRestWatcher(std::vector<Entry> watched, int steps)
     : watched_(std::move(watched)),
       steps_(steps),

@@ -205,11 +205,13 @@ std::vector<bool> FitDescription::FixedEntries() const {
   return fixed;
 }
 
-std::vector<bool> FitDescription::EntriesHolding(int parameter) const {
+std::vector<bool> FitDescription::EntriesHolding(std::initializer_list<int> parameters) const {
   std::vector<bool> holding(NumEntries(), false);
   for (const FitDataset& dataset : datasets) {
-    const int entry = AmbientIndex(dataset.parameters[parameter]);
-    if (entry >= 0) holding[entry] = true;
+    for (int parameter : parameters) {
+      const int entry = AmbientIndex(dataset.parameters[parameter]);
+      if (entry >= 0) holding[entry] = true;
+    }
   }
   return holding;
 }
@@ -248,12 +250,9 @@ bool ParameterLayout::IsIdentity() const {
 ParameterLayout LayoutOf(const FitDescription& fit, const ParameterMap& map) {
   ParameterLayout layout;
   for (int i = 0; i < kNumParameters; ++i) {
-    int position = 0;
-    while (position < static_cast<int>(layout.blocks.size()) &&
-           layout.blocks[position] != map[i].block) {
-      ++position;
-    }
-    if (position == static_cast<int>(layout.blocks.size())) {
+    const auto found = std::find(layout.blocks.begin(), layout.blocks.end(), map[i].block);
+    const int position = static_cast<int>(found - layout.blocks.begin());
+    if (found == layout.blocks.end()) {
       const int b = fit.BlockOf(map[i].block);
       CHECK_GE(b, 0) << ParameterName(i) << " is mapped to a block the description lacks";
       layout.blocks.push_back(map[i].block);

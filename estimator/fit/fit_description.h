@@ -1,12 +1,10 @@
 // FitDescription: what a staged solve (staged_solve.h) optimises.
 //
-// The caller owns the parameter blocks. Each dataset (a set of sweeps of one
-// beam mode) reads its six model parameters eta_e, mu1, mu2, delta, alpha, w
-// (model_parameters.h) from entries of those blocks, through a ParameterMap:
-// two datasets that share eta_e map it to the same entry, and give each its
-// own w in its own block. The caller's own residual blocks (priors, other
-// measurements) join every problem the solve assembles through
-// `add_residuals`.
+// The caller owns the parameter blocks. Each dataset (sweeps of one beam
+// mode) reads its six model parameters from entries of those blocks through
+// a ParameterMap: two datasets sharing eta_e map it to the same entry. The
+// caller's own residual blocks (priors, other measurements) join every
+// problem the solve assembles through `add_residuals`.
 //
 //   double shared[1] = {90.0};             // eta_e of both datasets
 //   double beam_a[5] = {...}, beam_b[5] = {...};  // mu1, mu2, delta, alpha, w
@@ -27,6 +25,7 @@
 
 #include <array>
 #include <functional>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -48,7 +47,6 @@ using ParameterMap = std::array<ParameterSlot, kNumParameters>;
 // Parameter i in entry i of the one 6-double block `parameters`.
 ParameterMap IdentityMap(double* parameters);
 
-// One parameter block the caller owns.
 struct FitBlock {
   double* values = nullptr;  // `size` doubles; must outlive every solve on it
   int size = 0;
@@ -59,8 +57,8 @@ struct FitBlock {
   std::vector<double> scale;             // step unit; default |value at the start|, 1 for 0
 };
 
-// One dataset: its sweeps (jumps and branch labels as DetectJumps leaves them)
-// and where its six parameters live.
+// One dataset: its sweeps (as DetectJumps leaves them) and where its six
+// parameters live.
 struct FitDataset {
   std::string name;  // in messages
   std::vector<const Sweep*> sweeps;
@@ -70,54 +68,39 @@ struct FitDataset {
 struct FitDescription {
   std::vector<FitBlock> blocks;
   std::vector<FitDataset> datasets;
-  // The caller's own residual blocks: called once every time a problem is
-  // assembled (each solve of each stage, and the covariance), after the
-  // dwells and penalties. Create the cost functions inside it: the problem
-  // takes ownership of them. They may read the blocks above and blocks of
-  // the caller's own (which are then free and unscaled, and held constant by
-  // the covariance).
+  // Adds the caller's own residual blocks each time a problem is assembled
+  // (every solve and the covariance), after the dwells and penalties; the
+  // problem owns the cost functions created inside. They may also read
+  // blocks of the caller's own (free, unscaled, constant in the covariance).
   std::function<void(ceres::Problem*)> add_residuals;
 
   // False, with a message naming the dataset, block or entry, when the
-  // description cannot be solved: no dataset or no dwell, a slot outside
-  // the blocks, overlapping blocks, optional vectors of the wrong length,
-  // non-positive scales, values that are not finite, or values outside the
-  // model's range (eta_e and w > 0; mu1, mu2 >= 0).
+  // description cannot be solved (no dwell, a slot outside the blocks,
+  // overlapping blocks, wrong lengths, bad scales or values).
   bool IsValid(std::string* error) const;
 
-  // Entries over all blocks (the ambient size).
-  int NumEntries() const;
-  // The ambient index of entry 0 of block `block`.
-  int Offset(int block) const;
-  // The block whose values are `values`, or -1.
-  int BlockOf(const double* values) const;
-  // The ambient index of a slot, or -1 when the slot is not described.
-  int AmbientIndex(const ParameterSlot& slot) const;
+  int NumEntries() const;                             // over all blocks (the ambient size)
+  int Offset(int block) const;                        // ambient index of the block's entry 0
+  int BlockOf(const double* values) const;            // or -1
+  int AmbientIndex(const ParameterSlot& slot) const;  // or -1 when not described
   // For messages: entry_names[index] or "name[index]" ("name" for a 1-block).
   std::string EntryName(int block, int index) const;
   std::string EntryName(int ambient) const;
-  // Every entry's value, blocks in order.
-  std::vector<double> Values() const;
-  // Writes `values` (Values() order, NumEntries() of them) into the blocks.
+  std::vector<double> Values() const;  // ambient order
   void SetValues(const std::vector<double>& values) const;
-  // Per ambient entry: fixed (FitBlock::fixed).
-  std::vector<bool> FixedEntries() const;
-  // Per ambient entry: whether some dataset maps parameter `parameter` there.
-  std::vector<bool> EntriesHolding(int parameter) const;
-  // Dwells of every dataset.
+  std::vector<bool> FixedEntries() const;  // per ambient entry
+  // Per ambient entry: whether some dataset maps one of `parameters` there.
+  std::vector<bool> EntriesHolding(std::initializer_list<int> parameters) const;
   int NumDwells() const;
 };
 
-// The description of the single-dataset fit: one 6-double block
-// `parameters` (named "parameters", entries named as ParameterName) with
-// `fixed`, mapped by IdentityMap, fitted to `sweeps`.
+// The single-dataset fit: one 6-double block `parameters` with `fixed`.
 FitDescription SingleBlockFit(const std::vector<const Sweep*>& sweeps,
                               const std::array<bool, kNumParameters>& fixed,
                               ParameterVector* parameters);
 
-// The blocks a dataset's six parameters live in, as a residual block lists
-// them: the distinct blocks in order of first use by eta_e, ..., w, and the
-// position and entry of each parameter among them.
+// The distinct blocks a dataset's six parameters live in, in order of first
+// use, and the position and entry of each parameter among them.
 struct ParameterLayout {
   std::vector<double*> blocks;
   std::vector<int> sizes;
@@ -127,9 +110,9 @@ struct ParameterLayout {
   bool IsIdentity() const;
 };
 
-// The layout of `map` over the blocks of `fit` (every slot described).
+// The layout of `map` over the blocks of `fit` (every slot described), and
+// the identity layout on one 6-double block.
 ParameterLayout LayoutOf(const FitDescription& fit, const ParameterMap& map);
-// The identity layout on one 6-double block.
 ParameterLayout SingleBlockLayout(double* parameters);
 
 }  // namespace dwellfit

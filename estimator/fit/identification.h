@@ -1,9 +1,6 @@
 // Identification: the staged solve (staged_solve.h) of one dataset whose six
-// parameters form one block, from options.initial: the default multi-stage
-// fit of the chapter's final algorithm (section 3.2.4) on a set of fitted
-// sweeps. The tools, studies and multi-start call it; an embedder with
-// shared parameters, blocks of its own or priors describes its problem as a
-// FitDescription and calls SolveStaged.
+// parameters form one block. An embedder with shared parameters or priors
+// describes a FitDescription and calls SolveStaged.
 #ifndef DWELLFIT_ESTIMATOR_FIT_IDENTIFICATION_H_
 #define DWELLFIT_ESTIMATOR_FIT_IDENTIFICATION_H_
 
@@ -23,9 +20,8 @@ struct IdentificationResult : FitSummary {
   ParameterVector parameters{};  // physical units, omega in rad/s
 };
 
-// Runs the configured stages on `fitted` from options.initial
-// (SingleBlockFit). Never aborts: invalid options give kInvalidInput. The
-// options are validated here, once (options.solve by SolveStaged).
+// Runs the configured stages on `fitted` from options.initial. Invalid
+// options give kInvalidInput.
 IdentificationResult Identify(const std::vector<const Sweep*>& fitted,
                               const IdentificationOptions& options);
 

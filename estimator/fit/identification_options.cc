@@ -1,10 +1,41 @@
 #include "dwellfit/estimator/fit/identification_options.h"
 
 #include <cmath>
+#include <initializer_list>
 #include <sstream>
 #include <utility>
 
 namespace dwellfit {
+namespace {
+
+// The value of `all` whose name is `name`, into *value; false when none.
+template <typename Enum>
+bool FromName(const std::string& name, std::initializer_list<Enum> all,
+              const char* (*name_of)(Enum), Enum* value) {
+  for (Enum candidate : all) {
+    if (name == name_of(candidate)) {
+      *value = candidate;
+      return true;
+    }
+  }
+  return false;
+}
+
+template <typename T>
+std::string ToText(const T& value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
+// Whether `value` is a non-negative number; else *error names `field`.
+bool IsNonNegative(const std::string& field, double value, std::string* error) {
+  if (value >= 0.0 && std::isfinite(value)) return true;
+  *error = field + " must be a non-negative number (>= 0), got " + ToText(value);
+  return false;
+}
+
+}  // namespace
 
 const char* ResidualKindName(ResidualKind kind) {
   switch (kind) {
@@ -21,14 +52,10 @@ const char* ResidualKindName(ResidualKind kind) {
 }
 
 bool ResidualKindFromName(const std::string& name, ResidualKind* kind) {
-  for (ResidualKind k : {ResidualKind::kAlgebraic, ResidualKind::kVertical, ResidualKind::kPhaseLag,
-                         ResidualKind::kAllRoots}) {
-    if (name == ResidualKindName(k)) {
-      *kind = k;
-      return true;
-    }
-  }
-  return false;
+  return FromName(name,
+                  {ResidualKind::kAlgebraic, ResidualKind::kVertical, ResidualKind::kPhaseLag,
+                   ResidualKind::kAllRoots},
+                  ResidualKindName, kind);
 }
 
 const char* ErrorMeasureName(ErrorMeasure measure) {
@@ -36,33 +63,12 @@ const char* ErrorMeasureName(ErrorMeasure measure) {
 }
 
 bool ErrorMeasureFromName(const std::string& name, ErrorMeasure* measure) {
-  for (ErrorMeasure m : {ErrorMeasure::kAbsolute, ErrorMeasure::kRelative}) {
-    if (name == ErrorMeasureName(m)) {
-      *measure = m;
-      return true;
-    }
-  }
-  return false;
+  return FromName(name, {ErrorMeasure::kAbsolute, ErrorMeasure::kRelative}, ErrorMeasureName,
+                  measure);
 }
-
-namespace {
-
-template <typename T>
-std::string ToText(const T& value) {
-  std::ostringstream text;
-  text << value;
-  return text.str();
-}
-
-}  // namespace
 
 bool ResidualOptions::IsValid(std::string* error) const {
-  if (!(amplitude_floor >= 0.0) || !std::isfinite(amplitude_floor)) {
-    *error = "residual.amplitude_floor must be a non-negative number (>= 0), got " +
-             ToText(amplitude_floor);
-    return false;
-  }
-  return true;
+  return IsNonNegative("residual.amplitude_floor", amplitude_floor, error);
 }
 
 bool SolverSettings::IsValid(std::string* error) const {
@@ -76,11 +82,7 @@ bool SolverSettings::IsValid(std::string* error) const {
       {"gradient_tolerance", gradient_tolerance},
       {"parameter_tolerance", parameter_tolerance}};
   for (const auto& [name, value] : tolerances) {
-    if (!(value >= 0.0) || !std::isfinite(value)) {
-      *error = std::string("solver.") + name + " must be a non-negative number (>= 0), got " +
-               ToText(value);
-      return false;
-    }
+    if (!IsNonNegative(std::string("solver.") + name, value, error)) return false;
   }
   if (num_threads < 0) {
     *error = "solver.num_threads must be at least 0 (0: one per processor available)";
@@ -104,14 +106,10 @@ const char* JumpTargetName(JumpTarget target) {
 }
 
 bool JumpTargetFromName(const std::string& name, JumpTarget* target) {
-  for (JumpTarget t : {JumpTarget::kFrequencyJumpUp, JumpTarget::kFrequencyJumpDown,
-                       JumpTarget::kAmplitudeJumpUp, JumpTarget::kAmplitudeJumpDown}) {
-    if (name == JumpTargetName(t)) {
-      *target = t;
-      return true;
-    }
-  }
-  return false;
+  return FromName(name,
+                  {JumpTarget::kFrequencyJumpUp, JumpTarget::kFrequencyJumpDown,
+                   JumpTarget::kAmplitudeJumpUp, JumpTarget::kAmplitudeJumpDown},
+                  JumpTargetName, target);
 }
 
 bool BifurcationRangeOptions::IsValid(std::string* error) const {
@@ -119,11 +117,7 @@ bool BifurcationRangeOptions::IsValid(std::string* error) const {
     *error = "penalties.bifurcation_range.exponent must be an even integer >= 2";
     return false;
   }
-  if (!(weight >= 0.0) || !std::isfinite(weight)) {
-    *error = "penalties.bifurcation_range.weight must be a non-negative number";
-    return false;
-  }
-  return true;
+  return IsNonNegative("penalties.bifurcation_range.weight", weight, error);
 }
 
 bool BranchStabilityOptions::IsValid(std::string* error) const {
@@ -131,11 +125,7 @@ bool BranchStabilityOptions::IsValid(std::string* error) const {
     *error = "penalties.branch_stability.lambda must be a positive number";
     return false;
   }
-  if (!(weight >= 0.0) || !std::isfinite(weight)) {
-    *error = "penalties.branch_stability.weight must be a non-negative number";
-    return false;
-  }
-  return true;
+  return IsNonNegative("penalties.branch_stability.weight", weight, error);
 }
 
 bool PenaltyOptions::IsValid(std::string* error) const {

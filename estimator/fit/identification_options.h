@@ -1,6 +1,5 @@
-// Options of one identification run, one struct per component, each with
-// defaults in the body and `bool IsValid(std::string* error) const`, whose
-// message names the field (as the config spells it) and the bound it breaks.
+// Options of one identification run, one struct per component; each
+// IsValid message names the field (as the config spells it) and its bound.
 #ifndef DWELLFIT_ESTIMATOR_FIT_IDENTIFICATION_OPTIONS_H_
 #define DWELLFIT_ESTIMATOR_FIT_IDENTIFICATION_OPTIONS_H_
 
@@ -29,8 +28,7 @@ bool ErrorMeasureFromName(const std::string& name, ErrorMeasure* measure);
 
 struct ResidualOptions {
   ErrorMeasure error = ErrorMeasure::kAbsolute;
-  // Divide each point's residual by its `sigma` column when the data has one.
-  bool use_point_sigma = true;
+  bool use_point_sigma = true;  // divide by a point's `sigma` where given
   // f of the relative error ln(a_i + f) - ln(a_model + f), in the data's
   // amplitude unit: the measurement's noise floor (0: purely relative).
   double amplitude_floor = 0.0;
@@ -40,34 +38,28 @@ struct ResidualOptions {
 struct SolverSettings {
   int max_iterations = 200;
   // Convergence tests of ceres::Solver::Options. The gradient and parameter
-  // tests are off in effect: parameters span nine orders of magnitude. A
-  // relative cost change of 1e-8 resolves a fit far below its statistics
-  // (noise moves the cost by about 1/N of itself).
+  // tests are off in effect (parameters span nine decades); a relative cost
+  // change of 1e-8 is far below the noise's 1/N.
   double function_tolerance = 1e-8;
-  // The same test for an algebraic stage whose end only starts a later stage
-  // (the start stage, a fold stage, an algebraic stage before the last):
-  // its minimum is not the estimate (docs/performance.md).
+  // The same for an algebraic stage whose end only starts a later stage
+  // (docs/performance.md).
   double start_function_tolerance = 1e-5;
   double gradient_tolerance = 1e-30;
   double parameter_tolerance = 1e-20;
-  // Threads that evaluate the residual blocks (ParallelResidualEvaluator),
-  // 0 for one per processor this process may run on. Results do not depend
-  // on it.
+  // Threads that evaluate the residual blocks, 0 for one per processor
+  // available. Results do not depend on it.
   int num_threads = 0;
-  // Let the trust region accept steps that raise the cost for a while
-  // (ceres::Solver::Options::use_nonmonotonic_steps): faster along the
-  // narrow valleys of measured data with penalties.
+  // ceres::Solver::Options::use_nonmonotonic_steps: faster along the narrow
+  // valleys of measured data with penalties.
   bool nonmonotonic_steps = false;
-  // Finish a vertical or all-roots solve that creeps along a weakly
-  // determined direction with a quasi-Newton polish (valley_polish.h).
-  // false: Levenberg-Marquardt alone.
+  // Finish a vertical or all-roots solve that creeps with a quasi-Newton
+  // polish (valley_polish.h).
   bool valley_polish = true;
   bool IsValid(std::string* error) const;
 };
 
-// Sets the iteration limit and the convergence tests of `settings` on the
-// options of a Ceres solver: ceres::Solver::Options (the trust-region
-// stages) or ceres::GradientProblemSolver::Options (the valley polish).
+// Sets the iteration limit and convergence tests of `settings` on
+// ceres::Solver::Options or ceres::GradientProblemSolver::Options.
 template <typename CeresOptions>
 void SetConvergenceTests(const SolverSettings& settings, CeresOptions* options) {
   options->max_num_iterations = settings.max_iterations;
@@ -76,8 +68,8 @@ void SetConvergenceTests(const SolverSettings& settings, CeresOptions* options) 
   options->parameter_tolerance = settings.parameter_tolerance;
 }
 
-// The jumps a bifurcation-range penalty can enforce: the sweep kind and
-// which fold (jump-up: the lower branch ends; jump-down: the upper one ends).
+// The jumps a bifurcation-range penalty can enforce (jump-up: the lower
+// branch ends; jump-down: the upper one).
 enum class JumpTarget {
   kFrequencyJumpUp,
   kFrequencyJumpDown,
@@ -96,8 +88,7 @@ struct BifurcationRangeOptions {
   bool enabled = false;
   int exponent = 10;  // n of eq. (3.17): even, >= 2
   double weight = 1.0;
-  // The chapter enforces the frequency sweep's jump-down and the amplitude
-  // sweep's jump-up.
+  // As the chapter.
   std::vector<JumpTarget> enforce = {JumpTarget::kFrequencyJumpDown, JumpTarget::kAmplitudeJumpUp};
   bool IsValid(std::string* error) const;
 };
@@ -122,33 +113,25 @@ struct PenaltyOptions {
 
 // The stages of a staged solve (staged_solve.h) and how each is solved.
 struct StagedSolveOptions {
-  // Fit stages run in order, each starting where the previous one ended.
   std::vector<ResidualKind> stages = {ResidualKind::kAlgebraic, ResidualKind::kVertical};
   ResidualOptions residual;
-  // Soft constraints added to every vertical-error stage.
-  PenaltyOptions penalties;
+  PenaltyOptions penalties;  // added to every vertical-error stage
   SolverSettings solver;
-  // When the first stage is branch-labelled (vertical or all_roots), an
-  // algebraic stage from the given start runs first and the first stage
-  // starts from the better of the given start and where that ended
-  // (staged_solve.h, "start stage"). false: the first stage starts at the
-  // given start, as written (for studying a residual's own basin).
+  // Run the start stage before a branch-labelled first stage
+  // (staged_solve.h). false: the first stage starts at the given start (for
+  // studying a residual's own basin).
   bool algebraic_start_candidate = true;
   bool IsValid(std::string* error) const;
 };
 
-// The single-dataset identification (Identify, identification.h): its
-// start and fixed parameters, and the staged solve's options.
+// The single-dataset identification (Identify, identification.h).
 struct IdentificationOptions {
   // Starting point, ParameterIndex order, physical units (omega in rad/s).
   ParameterVector initial = {0, 0, 0, 0, 0, 0};
   // Parameters held at their initial value.
   std::array<bool, kNumParameters> fixed = {false, false, false, false, false, false};
-  // The stages and how each is solved.
   StagedSolveOptions solve;
-  // `initial` alone: finite, and inside the model's range.
-  bool InitialIsValid(std::string* error) const;
-  // InitialIsValid and solve.IsValid.
+  bool InitialIsValid(std::string* error) const;  // finite, in the model's range
   bool IsValid(std::string* error) const;
 };
 

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
+#include <numeric>
 #include <optional>
 #include <string>
 #include <vector>
@@ -77,9 +77,7 @@ bool HasSpread(const std::vector<double>& x) {
 }
 
 double Mean(const std::vector<double>& x) {
-  double sum = 0.0;
-  for (double v : x) sum += v;
-  return sum / static_cast<double>(x.size());
+  return std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
 }
 
 // A dwell where Q ~ 0 and P ~ a_base (step 1 of the header).
@@ -319,13 +317,13 @@ std::string RadPerSecondText(double rad_s) {
   return StringPrintf("%.6g rad/s (%.4f Hz)", rad_s, RadPerSecondToHz(rad_s));
 }
 
-}  // namespace
-
-namespace {
-
-// "eta_e = 100: given".
-std::string GivenStep(const KnownParameters& known, int index) {
-  return StringPrintf("%s = %.6g: given", ParameterName(index), *known[index]);
+// Takes parameter `index` as given, when it is ("eta_e = 100: given");
+// returns whether it was.
+bool TakeGiven(const KnownParameters& known, int index, InitialGuessReport* report) {
+  if (!known[index]) return false;
+  report->guess[index] = *known[index];
+  report->steps.push_back(StringPrintf("%s = %.6g: given", ParameterName(index), *known[index]));
+  return true;
 }
 
 // Step 1: one backbone point per level that resonates in the band.
@@ -426,19 +424,13 @@ void SetStiffness(const BackboneFit& fit, const KnownParameters& known,
                                  RadPerSecondText(guess[kNaturalFrequency]).c_str(),
                                  fit.how.c_str()));
   }
-  if (known[kAlpha]) {
-    guess[kAlpha] = *known[kAlpha];
-    steps.push_back(GivenStep(known, kAlpha));
-  } else {
+  if (!TakeGiven(known, kAlpha, report)) {
     guess[kAlpha] = fit.b / 0.75;
     steps.push_back(StringPrintf(
         "alpha = %.4g: %s; alpha is the slope in a^2 over 3/4%s", guess[kAlpha], fit.how.c_str(),
         known[kDelta] && *known[kDelta] != 0.0 ? "" : " (with delta = 0 it is alpha_e)"));
   }
-  if (known[kDelta]) {
-    guess[kDelta] = *known[kDelta];
-    steps.push_back(GivenStep(known, kDelta));
-  } else {
+  if (!TakeGiven(known, kDelta, report)) {
     guess[kDelta] = 0.0;
     steps.push_back(
         "delta = 0: over a narrow band only alpha_e = alpha - (2/3) delta Omega^2 is "
@@ -450,9 +442,8 @@ void SetStiffness(const BackboneFit& fit, const KnownParameters& known,
 void SetForcing(const BackboneFit& fit, const std::vector<OffResonanceDwell>& off_resonance,
                 const KnownParameters& known, InitialGuessReport* report) {
   ParameterVector& guess = report->guess;
-  if (known[kEtaE]) {
-    guess[kEtaE] = *known[kEtaE];
-    report->steps.push_back(GivenStep(known, kEtaE));
+  if (TakeGiven(known, kEtaE, report)) {
+    // as given
   } else if (fit.joint_e) {
     guess[kEtaE] = 0.5 * *fit.joint_e;
     report->steps.push_back(StringPrintf("eta_e = %.4g: %s", guess[kEtaE], fit.how.c_str()));
@@ -489,17 +480,11 @@ void SetDamping(const std::vector<BackbonePoint>& backbone, const KnownParameter
   const std::string how =
       "peak heights a_base_k / (Omega_k a_k) = (mu1 + c mu2 a_k) / eta_e, c = 4 / (3 pi): " +
       damping.how;
-  if (known[kMu1]) {
-    guess[kMu1] = *known[kMu1];
-    report->steps.push_back(GivenStep(known, kMu1));
-  } else {
+  if (!TakeGiven(known, kMu1, report)) {
     guess[kMu1] = damping.m1 * eta;
     report->steps.push_back(StringPrintf("mu1 = %.4g 1/s: %s", guess[kMu1], how.c_str()));
   }
-  if (known[kMu2]) {
-    guess[kMu2] = *known[kMu2];
-    report->steps.push_back(GivenStep(known, kMu2));
-  } else {
+  if (!TakeGiven(known, kMu2, report)) {
     guess[kMu2] = damping.m2 * eta / kQuadraticDampingFactor;
     report->steps.push_back(StringPrintf("mu2 = %.4g: %s", guess[kMu2], how.c_str()));
   }

@@ -3,10 +3,8 @@
 // that live in entries of the caller's blocks (fit_description.h).
 //
 // Evaluate gathers p_i = blocks[layout.block[i]][layout.index[i]], evaluates
-// the wrapped function at p, and scatters its Jacobian dr/dp (rows x 6) onto
-// the blocks: dr/d(block b, entry e) = sum of dr/dp_i over the parameters i
-// that live in (b, e). The wrapped function keeps its own definition (for a
-// dwell the autodiff VerticalErrorResidual with its Newton root solve).
+// the wrapped function at p, and scatters dr/dp onto the blocks:
+// dr/d(block b, entry e) = sum of dr/dp_i over the p_i that live in (b, e).
 #ifndef DWELLFIT_ESTIMATOR_FIT_MAPPED_COST_FUNCTION_H_
 #define DWELLFIT_ESTIMATOR_FIT_MAPPED_COST_FUNCTION_H_
 
@@ -19,9 +17,8 @@ namespace dwellfit {
 
 class MappedCostFunction : public ceres::CostFunction {
  public:
-  // Takes ownership of `model_cost`, which must read one block of
-  // kNumParameters. The residual block's parameter blocks are
-  // `layout.blocks`, in that order.
+  // Takes ownership of `model_cost` (one block of kNumParameters); the
+  // residual block's parameter blocks are `layout.blocks`.
   MappedCostFunction(ceres::CostFunction* model_cost, const ParameterLayout& layout);
 
   bool Evaluate(double const* const* parameters, double* residuals,

@@ -58,8 +58,7 @@ std::vector<ParameterVector> MultiStartPoints(const IdentificationOptions& optio
 
 namespace {
 
-// A fit that solved (converged or stopped at its iteration limit) to finite
-// parameters: only such a fit can be the best.
+// A fit that solved to finite parameters: only such can be the best.
 bool Usable(const IdentificationResult& fit) {
   return fit.IsSolutionUsable() && std::all_of(fit.parameters.begin(), fit.parameters.end(),
                                                [](double v) { return std::isfinite(v); });
@@ -86,8 +85,7 @@ MultiStartResult IdentifyMultiStart(const std::vector<const Sweep*>& fitted,
   const int n = static_cast<int>(result.starts.size());
   std::vector<IdentificationResult> fits(n);
   const int parallel_starts = std::min(multi_start.threads, n);
-  // The starts share the machine's threads (the result does not depend on
-  // how many evaluate each start's residuals).
+  // The starts share the machine's threads.
   IdentificationOptions per_start = options;
   per_start.solve.solver.num_threads = std::max(
       1, ResolveThreadCount(options.solve.solver.num_threads) / std::max(parallel_starts, 1));
@@ -112,9 +110,7 @@ MultiStartResult IdentifyMultiStart(const std::vector<const Sweep*>& fitted,
       ++result.failed;
       continue;
     }
-    // Lowest cost wins; ties go to the earlier start, so the result does not
-    // depend on scheduling. A failed start is never the best, unless every
-    // start failed (then the best is start 0 and carries its failure).
+    // Lowest cost wins; ties go to the earlier start.
     if (best_usable < 0 || fits[i].final_cost < fits[best_usable].final_cost) best_usable = i;
   }
   result.best_start = std::max(best_usable, 0);

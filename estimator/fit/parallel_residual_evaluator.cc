@@ -28,13 +28,10 @@ int ResolveThreadCount(int num_threads) {
   return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 }
 
-// The threads beside the caller's that run an evaluation's units with it:
-// each unit goes to whichever thread asks next (an atomic counter), and the
-// caller returns once every unit has run. A thread without work sleeps on a
-// condition variable at once, without spinning: woken for the next
-// evaluation, it gets the processor back at once from a program that shares
-// its core (TBB's workers spin before they sleep; docs/performance.md). A
-// thread that wakes late finds the units taken and sleeps again.
+// The threads beside the caller's that run an evaluation's units with it,
+// each unit to whichever thread asks next. A thread without work sleeps at
+// once, without spinning, so that a program sharing its core gets the
+// processor back (TBB's workers spin first; docs/performance.md).
 class ParallelResidualEvaluator::Workers {
  public:
   explicit Workers(int threads) {
@@ -62,8 +59,7 @@ class ParallelResidualEvaluator::Workers {
     }
     wake_.notify_all();
     Work(batch.get());
-    // The units still running on the threads: waited for on the processor,
-    // then, after about a millisecond, asleep.
+    // Wait for the units still running: spinning, after about 1 ms asleep.
     int spins = 0;
     while (batch->done.load() < units && ++spins < kCallerSpins) {
     }
@@ -117,22 +113,19 @@ class ParallelResidualEvaluator::Workers {
   std::vector<std::thread> threads_;
 };
 
-// Owns one wrapped cost function. The values it had at the last point the
-// evaluator saw live in the evaluator's storage_, contiguous per wrapper and
-// wrappers in order (no allocation of their own): the point (the wrapped
-// function's parameter blocks concatenated), its residuals, and its Jacobian
-// (per parameter block, row-major, num_residuals x the block's size). Where
-// each of its parameter blocks starts in the evaluator's point is in the
-// evaluator's block_offsets_, from first_offset_ on.
+// Owns one wrapped cost function. Its values at the evaluator's last point
+// live in the evaluator's storage_: the point (its parameter blocks
+// concatenated), residuals, and Jacobian (per block, row-major). Where its
+// blocks start in the evaluator's point: block_offsets_ from first_offset_.
 class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunction {
  public:
   // `offsets`: where each of the wrapped function's parameter blocks starts
-  // in the evaluator's point. Appends the wrapper's offsets and storage to
-  // the evaluator's.
+  // in the evaluator's point.
   ReplayingCostFunction(ceres::CostFunction* wrapped, const std::vector<int>& offsets,
                         ParallelResidualEvaluator* owner)
       : wrapped_(wrapped), owner_(owner) {
     CHECK_EQ(wrapped->parameter_block_sizes().size(), offsets.size());
+    CHECK_LE(offsets.size(), kMaxBlocks);
     set_num_residuals(wrapped->num_residuals());
     *mutable_parameter_block_sizes() = wrapped->parameter_block_sizes();
     rows_ = wrapped->num_residuals();
@@ -152,9 +145,8 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
     return true;
   }
 
-  // Writes the precomputed rows into `a` from row `row` on: the Jacobian in
-  // the point's columns, the residuals in the last column (a's other
-  // entries are left as they are); false if the evaluation failed.
+  // Writes the precomputed Jacobian into `a`'s point columns and the
+  // residuals into its last, from row `row` on; false if the evaluation failed.
   bool WriteRows(Eigen::MatrixXd* a, int row) const {
     if (!ok_) return false;
     ForEachJacobianEntry([&](int i, int column, double value) { (*a)(row + i, column) = value; });
@@ -170,31 +162,25 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
   }
 
   int rows() const { return rows_; }
-  // Whether the values at the precomputed point came out.
-  bool ok() const { return ok_; }
 
-  // Computes the values at `point` (the evaluator's thread for this block).
+  // Computes the values at `point` (on the evaluator's threads).
   void Precompute(const double* point) {
     valid_ = true;
-    if (NumBlocks() == 1) {  // one parameter block: no per-block bookkeeping
-      std::copy(point + Offset(0), point + Offset(0) + total_, Point());
-      const double* blocks[] = {Point()};
-      double* jacobians[] = {Jacobian()};
-      ok_ = wrapped_->Evaluate(blocks, Residuals(), jacobians);
-      return;
-    }
     const std::vector<int32_t>& sizes = parameter_block_sizes();
+    std::array<const double*, kMaxBlocks> blocks;
+    std::array<double*, kMaxBlocks> jacobians;
     int start = 0;
     for (size_t j = 0; j < sizes.size(); ++j) {
       std::copy(point + Offset(j), point + Offset(j) + sizes[j], Point() + start);
+      blocks[j] = Point() + start;
+      jacobians[j] = Jacobian() + rows_ * start;
       start += sizes[j];
     }
-    ok_ = EvaluateAtOwnPoint();
+    ok_ = wrapped_->Evaluate(blocks.data(), Residuals(), jacobians.data());
   }
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
-    if (NumBlocks() == 1) return EvaluateOneBlock(parameters, residuals, jacobians);
     if (!valid_ || !AtPoint(parameters)) {
       ++owner_->evaluated_directly_;
       return wrapped_->Evaluate(parameters, residuals, jacobians);
@@ -231,11 +217,9 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
     }
   }
 
-  // Parameter blocks whose pointers fit on the stack (every dwellfit
-  // residual reads at most six).
-  static constexpr size_t kStackBlocks = 8;
+  // Parameter blocks at the most (every dwellfit residual reads at most six).
+  static constexpr size_t kMaxBlocks = 8;
 
-  size_t NumBlocks() const { return parameter_block_sizes().size(); }
   // Where the wrapped function's parameter block j starts in the evaluator's point.
   int Offset(size_t j) const { return owner_->block_offsets_[first_offset_ + j]; }
   double* Point() { return owner_->storage_.data() + storage_offset_; }
@@ -244,47 +228,6 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
   const double* Residuals() const { return Point() + total_; }
   double* Jacobian() { return Point() + total_ + rows_; }
   const double* Jacobian() const { return Point() + total_ + rows_; }
-
-  // The wrapped function at Point(), into Residuals() and Jacobian().
-  bool EvaluateAtOwnPoint() {
-    const std::vector<int32_t>& sizes = parameter_block_sizes();
-    std::array<const double*, kStackBlocks> block_array;
-    std::array<double*, kStackBlocks> jacobian_array;
-    std::vector<const double*> block_vector;
-    std::vector<double*> jacobian_vector;
-    const double** blocks = block_array.data();
-    double** jacobians = jacobian_array.data();
-    if (sizes.size() > kStackBlocks) {
-      block_vector.resize(sizes.size());
-      jacobian_vector.resize(sizes.size());
-      blocks = block_vector.data();
-      jacobians = jacobian_vector.data();
-    }
-    int start = 0;
-    for (size_t j = 0; j < sizes.size(); ++j) {
-      blocks[j] = Point() + start;
-      jacobians[j] = Jacobian() + rows_ * start;
-      start += sizes[j];
-    }
-    return wrapped_->Evaluate(blocks, Residuals(), jacobians);
-  }
-
-  // Evaluate for a function of one parameter block (every dwell on one
-  // 6-double block): the same, without the per-block bookkeeping.
-  bool EvaluateOneBlock(double const* const* parameters, double* residuals,
-                        double** jacobians) const {
-    if (!valid_ || !std::equal(Point(), Point() + total_, parameters[0])) {
-      ++owner_->evaluated_directly_;
-      return wrapped_->Evaluate(parameters, residuals, jacobians);
-    }
-    ++owner_->replayed_;
-    if (!ok_) return false;
-    std::copy(Residuals(), Residuals() + rows_, residuals);
-    if (jacobians != nullptr && jacobians[0] != nullptr) {
-      std::copy(Jacobian(), Jacobian() + rows_ * total_, jacobians[0]);
-    }
-    return true;
-  }
 
   // `parameters` are the precomputed point.
   bool AtPoint(double const* const* parameters) const {
@@ -386,12 +329,7 @@ ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_f
 }
 
 ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_function) {
-  CHECK_EQ(cost_function->parameter_block_sizes().size(), 1u);
-  CHECK_EQ(cost_function->parameter_block_sizes()[0], blocks_[0].size);
-  auto* wrapper = new ReplayingCostFunction(cost_function, {0}, this);
-  wrappers_.push_back(wrapper);
-  rows_ += cost_function->num_residuals();
-  return wrapper;
+  return Wrap(cost_function, {const_cast<double*>(blocks_[0].values)});
 }
 
 void ParallelResidualEvaluator::Reserve(int wrappers, int residuals) {
@@ -414,14 +352,12 @@ const double* ParallelResidualEvaluator::IterateEntry(const double* value) const
 
 void ParallelResidualEvaluator::PrepareForEvaluation(bool evaluate_jacobians,
                                                      bool /*new_evaluation_point*/) {
-  // Ceres has copied the point into the caller's blocks. The same point
-  // again (the Jacobian at an accepted step, a line search's trial step and
-  // the trust-region candidate): the values, Jacobians included, are there.
+  // Ceres has copied the point into the caller's blocks; at the same point
+  // again the values, Jacobians included, are there.
   if (!computed_ || !AtLastPoint(BlockValues())) {
     CopyToPoint(BlockValues(), &last_point_);
     PrecomputeAll();
   }
-  // last_point_ now holds the caller's blocks either way.
   if (evaluate_jacobians) std::copy(last_point_.begin(), last_point_.end(), iterate_.begin());
 }
 
@@ -436,9 +372,7 @@ void ParallelResidualEvaluator::PrecomputeAll() {
   if (threads == 1) {
     for (int unit = 0; unit < units; ++unit) PrecomputeUnit(unit, copy);
   } else {
-    // Idle workers sleep, and the units are split down to single ones that
-    // an idle thread steals: a worker the machine is slow to run holds up
-    // at most the unit it is in.
+    // Units are single, so a worker the machine runs slowly holds up one.
     if (workers_ == nullptr) workers_ = std::make_unique<Workers>(num_threads_ - 1);
     workers_->Run(units, [this, copy](int unit) { PrecomputeUnit(unit, copy); });
   }

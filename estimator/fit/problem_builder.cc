@@ -99,7 +99,6 @@ ceres::CostFunction* ProblemBuilder::MakeResidual(
 
 void ProblemBuilder::Add(ceres::CostFunction* cost, const ParameterLayout& layout,
                          ceres::Problem* problem, ParallelResidualEvaluator* evaluator) const {
-  // The one-block case reads the block directly: no adapter in between.
   if (!layout.IsIdentity()) cost = new MappedCostFunction(cost, layout);
   if (evaluator != nullptr) cost = evaluator->Wrap(cost, layout.blocks);
   problem->AddResidualBlock(cost, nullptr, layout.blocks);
@@ -139,11 +138,6 @@ int ProblemBuilder::ResidualBlocks(const Sweep& sweep) const {
                                                 : dwells);
 }
 
-int ProblemBuilder::AddSweep(const Sweep& sweep, double* parameters, ceres::Problem* problem,
-                             ParallelResidualEvaluator* evaluator) const {
-  return AddSweep(sweep, SingleBlockLayout(parameters), problem, evaluator);
-}
-
 JumpTarget TargetOf(const Sweep& sweep, const JumpBracket& jump) {
   const bool up = jump.kind == JumpKind::kJumpUp;
   if (sweep.kind == SweepKind::kFrequency) {
@@ -157,33 +151,16 @@ bool IsEnforced(const BifurcationRangeOptions& range, const Sweep& sweep, const 
                                     TargetOf(sweep, jump)) != range.enforce.end();
 }
 
-ceres::CostFunction* MakeBifurcationRangePenalty(const Sweep& sweep, const JumpBracket& jump,
-                                                 const BifurcationRangeOptions& options,
-                                                 ResidualKind residual) {
+namespace {
+
+// The control the sweep holds at the dwell before the jump, which sits on
+// the branch that ends: a_base of a frequency sweep, Omega of an amplitude one.
+double HeldControl(const Sweep& sweep, const JumpBracket& jump) {
   const DwellPoint& before = sweep.points[jump.index_before];
-  const bool frequency = sweep.kind == SweepKind::kFrequency;
-  if (residual == ResidualKind::kAllRoots) {
-    // The all-roots method enforces the range through the roots (section 3.2.3).
-    return new RootTransitionPenalty(
-        sweep.kind, jump.kind, frequency ? before.a_base : before.drive_frequency_rad_s,
-        jump.control_before, jump.control_after, jump.amplitude_before, options.weight);
-  }
-  // The dwell before the jump sits on the branch that ends.
-  return BifurcationRangePenalty::Create(sweep.kind, jump.kind,
-                                         frequency ? before.a_base : before.drive_frequency_rad_s,
-                                         jump.control_before, jump.control_after,
-                                         jump.amplitude_before, options.exponent, options.weight);
+  return sweep.kind == SweepKind::kFrequency ? before.a_base : before.drive_frequency_rad_s;
 }
 
-bool FoldExists(const Sweep& sweep, const JumpBracket& jump, const ParameterVector& p) {
-  const DwellPoint& before = sweep.points[jump.index_before];
-  const bool frequency = sweep.kind == SweepKind::kFrequency;
-  const BifurcationRangePenalty penalty(
-      sweep.kind, jump.kind, frequency ? before.a_base : before.drive_frequency_rad_s,
-      jump.control_before, jump.control_after, jump.amplitude_before, 2, 1.0);
-  return penalty.SolveFold(p).exists;
-}
-
+// The algebraic fold condition of one measured jump (FoldConditionResidual).
 ceres::CostFunction* MakeFoldCondition(const Sweep& sweep, const JumpBracket& jump) {
   const DwellPoint& before = sweep.points[jump.index_before];
   const bool frequency = sweep.kind == SweepKind::kFrequency;
@@ -194,9 +171,27 @@ ceres::CostFunction* MakeFoldCondition(const Sweep& sweep, const JumpBracket& ju
                                        jump.amplitude_before, weight);
 }
 
-int ProblemBuilder::AddPenalties(const Sweep& sweep, double* parameters, ceres::Problem* problem,
-                                 ParallelResidualEvaluator* evaluator) const {
-  return AddPenalties(sweep, SingleBlockLayout(parameters), problem, evaluator);
+}  // namespace
+
+ceres::CostFunction* MakeBifurcationRangePenalty(const Sweep& sweep, const JumpBracket& jump,
+                                                 const BifurcationRangeOptions& options,
+                                                 ResidualKind residual) {
+  if (residual == ResidualKind::kAllRoots) {
+    // The all-roots method enforces the range through the roots (section 3.2.3).
+    return new RootTransitionPenalty(sweep.kind, jump.kind, HeldControl(sweep, jump),
+                                     jump.control_before, jump.control_after, jump.amplitude_before,
+                                     options.weight);
+  }
+  return BifurcationRangePenalty::Create(sweep.kind, jump.kind, HeldControl(sweep, jump),
+                                         jump.control_before, jump.control_after,
+                                         jump.amplitude_before, options.exponent, options.weight);
+}
+
+bool FoldExists(const Sweep& sweep, const JumpBracket& jump, const ParameterVector& p) {
+  const BifurcationRangePenalty penalty(sweep.kind, jump.kind, HeldControl(sweep, jump),
+                                        jump.control_before, jump.control_after,
+                                        jump.amplitude_before, 2, 1.0);
+  return penalty.SolveFold(p).exists;
 }
 
 int ProblemBuilder::AddPenalties(const Sweep& sweep, const ParameterLayout& layout,

@@ -11,12 +11,9 @@
 // (residuals/functors/algebraic_residual.h) or the vertical error of section
 // 3.2.4 (residuals/functors/vertical_error_residual.h).
 //
-// The six parameters may live in one 6-double block (the residual blocks
-// then read it directly) or in entries of several blocks, shared between
-// datasets (a ParameterLayout, fit_description.h; the residual blocks then
-// read those blocks through a MappedCostFunction). Bounds, fixed entries and
-// scaling are set by StageProblem (stage_problem.h), which assembles every
-// problem the staged solve and the covariance use.
+// The six parameters live in one 6-double block or in entries of several
+// blocks shared between datasets (a ParameterLayout, read through a
+// MappedCostFunction). StageProblem sets bounds, fixed entries and scaling.
 #ifndef DWELLFIT_ESTIMATOR_FIT_PROBLEM_BUILDER_H_
 #define DWELLFIT_ESTIMATOR_FIT_PROBLEM_BUILDER_H_
 
@@ -37,79 +34,58 @@ struct ProblemBuilderOptions {
   ResidualKind residual = ResidualKind::kVertical;
   ResidualOptions residual_options;
   // Multiplies every dwell's residual (on top of its point sigma): the
-  // covariance weighs the dwells by 1/s, s the residual noise, against the
-  // caller's standardised residual blocks. > 0.
+  // covariance's 1/s against the caller's standardised blocks. > 0.
   double dwell_weight = 1.0;
-  // Soft constraints of eqs. (3.17) and (3.19); AddPenalties adds them.
-  PenaltyOptions penalties;
-  // AddSweep puts up to ProblemBuilder::kDwellsPerBatch consecutive dwells in
-  // one residual block (FunctorBatch, BatchedCostFunction) instead of one
-  // block per dwell.
+  PenaltyOptions penalties;  // eqs. (3.17) and (3.19), for AddPenalties
+  // Up to kDwellsPerBatch consecutive dwells per residual block.
   bool batch_dwells = false;
   bool IsValid(std::string* error) const;
 };
 
 class ProblemBuilder {
  public:
-  // Dwells per residual block with `batch_dwells`: enough that Ceres' work
-  // per block is small beside the dwells', few enough that a sweep's batches
-  // spread over the threads.
+  // Dwells per batch: enough that Ceres' work per block is small beside
+  // theirs, few enough that a sweep's batches spread over the threads.
   static constexpr size_t kDwellsPerBatch = 32;
 
-  // `options` should be valid (IsValid); the staged solve checks them.
+  // `options` should be valid; the staged solve checks them.
   explicit ProblemBuilder(const ProblemBuilderOptions& options);
 
-  // Adds the residuals of every dwell of `sweep` (one each, two for
-  // kPhaseLag, which throws InputError naming the dwell when one has no
-  // measured phase), each reading the six parameters where `layout` puts
-  // them (the blocks are owned by the caller and must outlive `problem`):
-  // one residual block per dwell, in order, or with `batch_dwells` up to
-  // kDwellsPerBatch consecutive dwells per residual block. With an
-  // `evaluator` (the problem's evaluation callback, watching the layout's
-  // blocks) the blocks are evaluated through it, on its threads. With
-  // `warm_started`, the vertical error's functors (whose root solves start
-  // where the last ended) are appended to it. Returns the number of dwells
-  // added.
+  // Adds the residuals of every dwell of `sweep` (two each for kPhaseLag,
+  // which throws InputError naming a dwell without a measured phase) on the
+  // blocks of `layout` (which must outlive `problem`), in order, batched
+  // with `batch_dwells`; through `evaluator` (the problem's evaluation
+  // callback) when given. The vertical error's functors are appended to
+  // `warm_started`, when given. Returns the number of dwells added.
   int AddSweep(const Sweep& sweep, const ParameterLayout& layout, ceres::Problem* problem,
                ParallelResidualEvaluator* evaluator = nullptr,
                std::vector<VerticalErrorResidual*>* warm_started = nullptr) const;
-  // The same on one 6-double block `parameters` (SingleBlockLayout).
-  int AddSweep(const Sweep& sweep, double* parameters, ceres::Problem* problem,
-               ParallelResidualEvaluator* evaluator = nullptr) const;
 
-  // Adds the enabled penalties for `sweep`: one BifurcationRangePenalty per
-  // measured jump whose target is enforced, one BranchStabilityPenalty per
-  // dwell labelled lower or upper. On the algebraic residual the enforced
-  // jumps get their FoldConditionResidual instead (the algebraic form of
-  // eq. 3.17; the weights of `penalties` are not used) and there is no
-  // branch-stability term. Returns the number of blocks added.
+  // Adds the enabled penalties for `sweep`: a BifurcationRangePenalty per
+  // enforced measured jump, a BranchStabilityPenalty per dwell labelled
+  // lower or upper. On the algebraic residual the enforced jumps get their
+  // unweighted FoldConditionResidual instead, and no branch-stability term.
+  // Returns the number of blocks added.
   int AddPenalties(const Sweep& sweep, const ParameterLayout& layout, ceres::Problem* problem,
                    ParallelResidualEvaluator* evaluator = nullptr) const;
-  int AddPenalties(const Sweep& sweep, double* parameters, ceres::Problem* problem,
-                   ParallelResidualEvaluator* evaluator = nullptr) const;
 
-  // The residual blocks AddSweep adds for `sweep`: one per dwell, or with
-  // `batch_dwells` one per kDwellsPerBatch dwells begun.
+  // The residual blocks AddSweep adds for `sweep`.
   int ResidualBlocks(const Sweep& sweep) const;
 
-  // The cost function of one dwell on one 6-double block (owned by the
-  // caller; Ceres takes it); a vertical error's functor is appended to
-  // `warm_started`, when given.
+  // The cost function of one dwell on one 6-double block, owned by the
+  // caller; a vertical error's functor is appended to `warm_started`.
   ceres::CostFunction* MakeResidual(
       const DwellPoint& point, std::vector<VerticalErrorResidual*>* warm_started = nullptr) const;
 
   const ProblemBuilderOptions& options() const { return options_; }
 
  private:
-  // The weight of a dwell's amplitude error: dwell_weight, and 1/sigma of the
-  // error measured where the dwell carries its sigma and it is used.
+  // dwell_weight, times 1/sigma of the error where the dwell's sigma is used.
   double AmplitudeWeight(const DwellPoint& point) const;
-  // The residual block of dwells [first, end) of `points` (batch_dwells):
-  // the algebraic and the vertical error as a FunctorBatch, any other
-  // residual as a BatchedCostFunction of MakeResidual's cost functions.
+  // The residual block of dwells [first, end) of `points`: a FunctorBatch
+  // (algebraic, vertical) or a BatchedCostFunction of MakeResidual's.
   ceres::CostFunction* MakeBatch(const std::vector<DwellPoint>& points, size_t first, size_t end,
                                  std::vector<VerticalErrorResidual*>* warm_started) const;
-  // Adds `cost` (on one 6-double block) as a residual block on `layout`.
   void Add(ceres::CostFunction* cost, const ParameterLayout& layout, ceres::Problem* problem,
            ParallelResidualEvaluator* evaluator) const;
 
@@ -123,20 +99,14 @@ JumpTarget TargetOf(const Sweep& sweep, const JumpBracket& jump);
 bool IsEnforced(const BifurcationRangeOptions& range, const Sweep& sweep, const JumpBracket& jump);
 
 // The bifurcation-range penalty of one measured jump (eq. 3.17; for the
-// all-roots residual, RootTransitionPenalty: the range enforced through the
-// roots), owned by the caller; Ceres takes it.
+// all-roots residual a RootTransitionPenalty), owned by the caller.
 ceres::CostFunction* MakeBifurcationRangePenalty(const Sweep& sweep, const JumpBracket& jump,
                                                  const BifurcationRangeOptions& options,
                                                  ResidualKind residual = ResidualKind::kVertical);
 
-// Whether the model at `p` has the fold of `jump` (the fold the
-// bifurcation-range penalty measures, within a factor 2 of the bracket).
+// Whether the model at `p` has the fold the jump's bifurcation-range
+// penalty measures (within a factor 2 of the bracket).
 bool FoldExists(const Sweep& sweep, const JumpBracket& jump, const ParameterVector& p);
-
-// The algebraic fold condition of one measured jump (FoldConditionResidual),
-// weighted by the square root of its sweep's dwell count; owned by the
-// caller.
-ceres::CostFunction* MakeFoldCondition(const Sweep& sweep, const JumpBracket& jump);
 
 }  // namespace dwellfit
 

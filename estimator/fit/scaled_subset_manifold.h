@@ -1,14 +1,13 @@
 // ScaledSubsetManifold: the tangent space the solver steps in, for a
 // parameter block of any size.
 //
-// The parameters span nine orders of magnitude (mu1 ~ 0.1, alpha ~ 1e9) and
-// some are held fixed. The parameter block stays in physical units; the
-// solver's step t has one entry per free entry, in units of that entry's
-// scale s:
+// The parameters span nine decades (mu1 ~ 0.1, alpha ~ 1e9) and some are
+// fixed. The block stays in physical units; the step t has one entry per
+// free entry, in units of its scale s:
 //   x [+] t = x + S t,   S (n x k): S(free[j], j) = s_free[j], zero elsewhere
 //   y [-] x = S^+ (y - x) = ((y - x)_free[j] / s_free[j])_j
 // so every step entry is a relative change of order one, and fixed entries
-// never move. Covariances in the ambient space carry zeros for fixed entries.
+// never move.
 #ifndef DWELLFIT_ESTIMATOR_FIT_SCALED_SUBSET_MANIFOLD_H_
 #define DWELLFIT_ESTIMATOR_FIT_SCALED_SUBSET_MANIFOLD_H_
 
@@ -20,9 +19,7 @@ namespace dwellfit {
 
 class ScaledSubsetManifold : public ceres::Manifold {
  public:
-  // One `scale` and one `fixed` flag per entry of the block; scales of free
-  // entries must be positive, and at least one entry must be free (hold a
-  // block with none free constant instead).
+  // Per entry; free scales positive, at least one entry free.
   ScaledSubsetManifold(std::vector<double> scale, const std::vector<bool>& fixed);
 
   int AmbientSize() const override { return static_cast<int>(scale_.size()); }

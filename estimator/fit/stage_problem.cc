@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <sstream>
 #include <unordered_set>
-#include <utility>
 
 #include "ceres/loss_function.h"
 #include "dwellfit/estimator/common/string_printf.h"
@@ -23,15 +23,27 @@ ceres::Problem::Options StageProblem::ProblemOptions(ParallelResidualEvaluator* 
   return options;
 }
 
-void StageProblem::OwnCostFunctions(const ceres::Problem& problem,
-                                    const std::vector<ceres::ResidualBlockId>& blocks, size_t first,
-                                    bool may_share) {
-  std::unordered_set<const ceres::CostFunction*> owned;
-  cost_functions_.reserve(cost_functions_.size() + blocks.size() - first);
-  for (size_t i = first; i < blocks.size(); ++i) {
-    const ceres::CostFunction* cost = problem.GetCostFunctionForResidualBlock(blocks[i]);
-    if (!may_share || owned.insert(cost).second) cost_functions_.emplace_back(cost);
+std::vector<ceres::ResidualBlockId> StageProblem::AddOwned(ceres::Problem* problem, bool may_share,
+                                                           const std::function<void()>& add) {
+  const size_t before = problem->NumResidualBlocks();
+  std::vector<ceres::ResidualBlockId> all;
+  const auto own = [&] {
+    problem->GetResidualBlocks(&all);
+    std::unordered_set<const ceres::CostFunction*> owned;
+    cost_functions_.reserve(cost_functions_.size() + all.size() - before);
+    for (size_t i = before; i < all.size(); ++i) {
+      const ceres::CostFunction* cost = problem->GetCostFunctionForResidualBlock(all[i]);
+      if (!may_share || owned.insert(cost).second) cost_functions_.emplace_back(cost);
+    }
+  };
+  try {
+    add();
+  } catch (...) {  // what was added before the throw is owned all the same
+    own();
+    throw;
   }
+  own();
+  return {all.begin() + before, all.end()};
 }
 
 std::vector<ParallelResidualEvaluator::Block> StageProblem::EvaluatedBlocks(
@@ -56,14 +68,12 @@ StageProblem::StageProblem(const FitDescription& fit, const StageSetup& setup)
       held_(setup.held),
       held_constant_(fit.blocks.size(), false),
       builder_(Batched(setup.residuals)),
-      eta_e_entries_(fit.EntriesHolding(kEtaE)),
-      damping_entries_(fit.EntriesHolding(kMu1)),
+      eta_e_entries_(fit.EntriesHolding({kEtaE})),
+      damping_entries_(fit.EntriesHolding({kMu1, kMu2})),
       fixed_(fit.FixedEntries()),
       evaluator_(EvaluatedBlocks(fit), setup.num_threads),
       problem_(ProblemOptions(&evaluator_, setup.threaded_evaluation)),
       dwell_problem_(ProblemOptions(nullptr, false)) {
-  const std::vector<bool> mu2 = fit.EntriesHolding(kMu2);
-  for (size_t i = 0; i < mu2.size(); ++i) damping_entries_[i] = damping_entries_[i] || mu2[i];
   CHECK_EQ(setup.scale.size(), fixed_.size());
   for (const FitBlock& block : fit.blocks) problem_.AddParameterBlock(block.values, block.size);
   int blocks = 0;
@@ -88,36 +98,28 @@ StageProblem::StageProblem(const FitDescription& fit, const StageSetup& setup)
 
 void StageProblem::AddDwells() {
   ceres::Problem* problem = dwell_problem();
-  try {
+  dwell_blocks_ = AddOwned(problem, false, [&] {
     for (const FitDataset& dataset : fit_.datasets) {
       layouts_.push_back(LayoutOf(fit_, dataset.parameters));
       for (const Sweep* sweep : dataset.sweeps) {
         dwells_ += builder_.AddSweep(*sweep, layouts_.back(), problem, Evaluator(), &warm_started_);
       }
     }
-  } catch (...) {  // a sweep the residual cannot take: the earlier ones' blocks are owned
-    problem->GetResidualBlocks(&dwell_blocks_);
-    OwnCostFunctions(*problem, dwell_blocks_, 0, false);
-    throw;
-  }
-  problem->GetResidualBlocks(&dwell_blocks_);
-  OwnCostFunctions(*problem, dwell_blocks_, 0, false);
+  });
 }
 
 void StageProblem::AddPenalties(const PenaltyOptions& penalties) {
   ProblemBuilderOptions options = builder_.options();
   options.penalties = penalties;
   const ProblemBuilder penalty_builder(options);
-  const int before = problem_.NumResidualBlocks();
-  for (size_t d = 0; d < fit_.datasets.size(); ++d) {
-    for (const Sweep* sweep : fit_.datasets[d].sweeps) {
-      penalty_builder.AddPenalties(*sweep, layouts_[d], &problem_, Evaluator());
+  const std::vector<ceres::ResidualBlockId> added = AddOwned(&problem_, false, [&] {
+    for (size_t d = 0; d < fit_.datasets.size(); ++d) {
+      for (const Sweep* sweep : fit_.datasets[d].sweeps) {
+        penalty_builder.AddPenalties(*sweep, layouts_[d], &problem_, Evaluator());
+      }
     }
-  }
-  std::vector<ceres::ResidualBlockId> all;
-  problem_.GetResidualBlocks(&all);
-  OwnCostFunctions(problem_, all, before, false);
-  penalty_blocks_.insert(penalty_blocks_.end(), all.begin() + before, all.end());
+  });
+  penalty_blocks_.insert(penalty_blocks_.end(), added.begin(), added.end());
 }
 
 ParameterVector StageProblem::ValuesOf(const ParameterLayout& layout) {
@@ -148,18 +150,7 @@ std::vector<std::string> StageProblem::MissingFolds(const BifurcationRangeOption
 
 void StageProblem::AddCallerResiduals() {
   if (!fit_.add_residuals) return;
-  const int before = problem_.NumResidualBlocks();
-  std::vector<ceres::ResidualBlockId> all;
-  try {
-    fit_.add_residuals(&problem_);
-  } catch (...) {  // what it added before it threw is owned all the same
-    problem_.GetResidualBlocks(&all);
-    OwnCostFunctions(problem_, all, before, true);
-    throw;
-  }
-  problem_.GetResidualBlocks(&all);
-  OwnCostFunctions(problem_, all, before, true);
-  caller_blocks_.assign(all.begin() + before, all.end());
+  caller_blocks_ = AddOwned(&problem_, true, [this] { fit_.add_residuals(&problem_); });
 }
 
 bool StageProblem::IsBounded(int entry) const {

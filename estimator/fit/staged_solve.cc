@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dwellfit/estimator/fit/bound_rest_watcher.h"
@@ -38,9 +40,8 @@ ceres::Solver::Options MakeSolverOptions(const SolverSettings& settings) {
   options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
   options.linear_solver_type = ceres::DENSE_QR;
   SetConvergenceTests(settings, &options);
-  // One thread: the residual blocks are evaluated on threads, in a fixed
-  // order, by ParallelResidualEvaluator (ceres' own threads sum in an order
-  // that varies between runs).
+  // ParallelResidualEvaluator evaluates on threads in a fixed order; Ceres'
+  // own threads would sum in an order that varies between runs.
   options.num_threads = 1;
   options.logging_type = ceres::SILENT;
   options.minimizer_progress_to_stdout = false;
@@ -80,11 +81,8 @@ bool PenaltiesEnabled(const PenaltyOptions& penalties) {
   return penalties.bifurcation_range.enabled || penalties.branch_stability.enabled;
 }
 
-// Successful steps an entry sits on its bound before it is held there.
-constexpr int kStepsAtBoundBeforeHolding = 5;
-// Solves in one stage at the most (see RunStage).
+constexpr int kStepsAtBoundBeforeHolding = 5;  // successful steps before an entry is held
 constexpr int kMaxSolvesPerStage = 12;
-// Valley polishes in one stage at the most (see RunStage).
 constexpr int kMaxPolishesPerStage = 2;
 
 // The stage-independent part of a staged solve.
@@ -95,45 +93,46 @@ struct SolveContext {
   int threads = 1;
 };
 
-// One solve of `problem`, with the active set's watcher; `*resting` is the
-// entry that stopped it by resting on its bound.
-// `creep`, when given, stops a solve that creeps (valley_polish.h).
+bool IsBranchLabelled(ResidualKind kind) {
+  return kind == ResidualKind::kVertical || kind == ResidualKind::kAllRoots;
+}
+
+// The solver options of a stage of residual `kind`.
+ceres::Solver::Options StageSolverOptions(ResidualKind kind, const SolverSettings& settings) {
+  ceres::Solver::Options options = MakeSolverOptions(settings);
+  // No projected line search: on the vertical error, whose gradient spans
+  // some twenty decades, its interpolation now and then cuts a good step to
+  // nothing and ends the solve far from a minimum (the measured beam: in a
+  // basin of ten times the cost). Ceres still projects steps onto the
+  // bounds. The algebraic stage keeps it: its full steps from a rough
+  // start overshoot by orders of magnitude.
+  if (IsBranchLabelled(kind)) options.max_num_line_search_step_size_iterations = 0;
+  return options;
+}
+
+// One solve of `problem`; `*resting` is the entry that stopped it by
+// resting on its bound; `creep`, when given, stops a solve that creeps.
 ceres::Solver::Summary SolveOnce(ResidualKind kind, const SolverSettings& settings,
                                  StageProblem* problem, std::optional<int>* resting,
                                  CreepWatcher* creep) {
   problem->Configure();
   BoundRestWatcher watcher(problem->WatchedBounds(), kStepsAtBoundBeforeHolding);
-  ceres::Solver::Options options = MakeSolverOptions(settings);
-  if (kind == ResidualKind::kVertical || kind == ResidualKind::kAllRoots) {
-    // No projected line search. With bounds set (eta_e, mu1, mu2 >= 0)
-    // Ceres runs an Armijo search along every trust-region step; on the
-    // vertical error, whose gradient spans some twenty decades (root
-    // solves, folds, penalties), its polynomial interpolation now and then
-    // cuts a good step to nothing, which ends the solve on the function
-    // tolerance far from a minimum (on the measured beam: in a basin of
-    // ten times the cost). The bounds are still enforced: Ceres projects
-    // the step onto them. The algebraic stage keeps the search: from a
-    // rough start its full steps overshoot by orders of magnitude and the
-    // backtracking rescues them.
-    options.max_num_line_search_step_size_iterations = 0;
-  }
+  ceres::Solver::Options options = StageSolverOptions(kind, settings);
   options.callbacks.push_back(&watcher);
   if (creep != nullptr) options.callbacks.push_back(creep);
   options.update_state_every_iteration = true;
   ceres::Solver::Summary summary;
   ceres::Solve(options, problem->problem(), &summary);
   *resting = watcher.resting();
-  // The iterate of a non-monotonic excursion rested on the bound, the best
-  // point so far (what Ceres returns) did not: the solve with the entry held
-  // goes on from where it rests. On the measured beam that takes 11 steps;
-  // from the best point, with the entry set to its bound, about 100.
+  // A non-monotonic excursion rested on the bound, the best point so far
+  // did not: go on from where it rests (the measured beam: 11 steps, against
+  // about 100 from the best point).
   if (watcher.resting_at_iterate()) problem->MoveToIterate();
   return summary;
 }
 
-// Releases, once each, the held entries whose cost gradient points into the
-// feasible side (the cost falls as they leave their bound: d cost / d p < 0
-// at p = 0). Returns whether any was released.
+// Releases, once each, the held entries whose cost falls as they leave
+// their bound (d cost / d p < 0 at p = 0). Returns whether any was.
 bool ReleaseHeld(StageProblem* problem, std::vector<bool>* held, std::vector<bool>* released) {
   bool releasable = false;  // without such an entry the gradient is not needed
   for (size_t i = 0; i < held->size(); ++i)
@@ -152,10 +151,9 @@ bool ReleaseHeld(StageProblem* problem, std::vector<bool>* held, std::vector<boo
   return released_any;
 }
 
-// Weighs the penalties in the data's own units, taken where the stage
-// starts: a few bifurcation-range terms against the data's sum of squared
-// residuals, one branch-stability term per dwell against the mean squared
-// residual of a dwell.
+// The penalties weighed in the data's units where the stage starts: the
+// bifurcation-range terms against the dwells' sum of squares, each
+// branch-stability term (one per dwell) against a dwell's mean square.
 PenaltyOptions WeighPenalties(const PenaltyOptions& penalties, StageProblem* problem,
                               StageSummary* stage) {
   stage->penalty_unit = 2.0 * problem->DataCost();
@@ -167,8 +165,9 @@ PenaltyOptions WeighPenalties(const PenaltyOptions& penalties, StageProblem* pro
   return weighted;
 }
 
-// The entries whose `holding` flag (ambient order) is set.
-std::vector<double*> EntriesMarked(const FitDescription& fit, const std::vector<bool>& holding) {
+// The entries of `fit` that hold one of `parameters` in some dataset, each once.
+std::vector<double*> EntriesOf(const FitDescription& fit, std::initializer_list<int> parameters) {
+  const std::vector<bool> holding = fit.EntriesHolding(parameters);
   std::vector<double*> entries;
   for (size_t b = 0; b < fit.blocks.size(); ++b) {
     for (int i = 0; i < fit.blocks[b].size; ++i) {
@@ -178,20 +177,9 @@ std::vector<double*> EntriesMarked(const FitDescription& fit, const std::vector<
   return entries;
 }
 
-// The entries of `fit` that hold `parameter` in some dataset, each once.
-std::vector<double*> EntriesOf(const FitDescription& fit, int parameter) {
-  return EntriesMarked(fit, fit.EntriesHolding(parameter));
-}
-
-// The entries of `fit` holding eta_e of some dataset, or with `damping` its
-// mu1 or mu2, each once.
-std::vector<double*> EntriesHolding(const FitDescription& fit, bool damping) {
-  std::vector<bool> holding = fit.EntriesHolding(damping ? kMu1 : kEtaE);
-  if (damping) {
-    const std::vector<bool> mu2 = fit.EntriesHolding(kMu2);
-    for (size_t i = 0; i < holding.size(); ++i) holding[i] = holding[i] || mu2[i];
-  }
-  return EntriesMarked(fit, holding);
+// ReflectDampingIntoPhysicalRange on the entries of `fit`.
+bool ReflectDamping(const FitDescription& fit) {
+  return ReflectDampingIntoPhysicalRange(EntriesOf(fit, {kEtaE}), EntriesOf(fit, {kMu1, kMu2}));
 }
 
 void RecordSolve(const ceres::Solver::Summary& summary, int round, const PenaltyOptions& penalties,
@@ -210,13 +198,23 @@ void RecordSolve(const ceres::Solver::Summary& summary, int round, const Penalty
 // "eta_e 100, mu1 0.2, ..., omega 251.3 rad/s": every entry of `fit` at
 // `values`, natural frequencies with their unit.
 std::string DescribeValues(const FitDescription& fit, const std::vector<double>& values) {
-  const std::vector<bool> natural_frequency = fit.EntriesHolding(kNaturalFrequency);
+  const std::vector<bool> natural_frequency = fit.EntriesHolding({kNaturalFrequency});
   std::ostringstream text;
   for (size_t i = 0; i < values.size(); ++i) {
     text << (i > 0 ? ", " : "") << fit.EntryName(static_cast<int>(i)) << " " << values[i]
          << (natural_frequency[i] ? " rad/s" : "");
   }
   return text.str();
+}
+
+// Whether a solve from `start` could not evaluate its cost (`*failure`).
+bool SolveFailed(const ceres::Solver::Summary& summary, ResidualKind kind,
+                 const FitDescription& fit, const std::vector<double>& start, StageProblem* problem,
+                 std::string* failure) {
+  if (summary.IsSolutionUsable() && std::isfinite(summary.final_cost)) return false;
+  *failure = std::string("the ") + ResidualKindName(kind) + " stage cannot evaluate its cost at " +
+             DescribeValues(fit, start) + ": " + problem->DescribeFailure(summary.message);
+  return true;
 }
 
 StageSetup MakeSetup(const SolveContext& context, ResidualKind kind) {
@@ -229,13 +227,7 @@ StageSetup MakeSetup(const SolveContext& context, ResidualKind kind) {
   return setup;
 }
 
-bool IsBranchLabelled(ResidualKind kind) {
-  return kind == ResidualKind::kVertical || kind == ResidualKind::kAllRoots;
-}
-
-// The valley polish (valley_polish.h) of a solve that crept, on the
-// described blocks with a free entry; recorded in the stage's note and
-// iterations.
+// The valley polish of a solve that crept, recorded in the stage.
 void Polish(const SolveContext& context, const SolverSettings& settings, StageProblem* problem,
             StageSummary* stage) {
   std::vector<double*> blocks;
@@ -253,38 +245,24 @@ void Polish(const SolveContext& context, const SolverSettings& settings, StagePr
 }
 
 // One stage: the residual `kind` (with `penalties` on a vertical stage) from
-// the blocks' values, which it updates. False when a solve failed
-// (`*failure` says why). `rated`, when given, is a problem of the dwells
-// alone made with MakeSetup(context, kind) (the one ChooseStart rated the
-// start on): the stage solves on it instead of assembling its own.
-// `start_only`: the stage's end only starts a later stage, and its solves
-// end on SolverSettings::start_function_tolerance.
-//
-// Active set: a bounded entry that rests on its bound is held there
-// (BoundRestWatcher) and the stage solves again without it; when that solve
-// ends, a held entry whose cost gradient points into the feasible side is
-// released, once, and the stage solves again. A solve that ends on a
-// convergence test with nothing to release ends the stage. Every solve of a
-// stage runs on the same problem (the held entries reconfigured, StageProblem::
-// Hold): the same residual blocks each time, so the same values as a problem
-// assembled anew, and the values at the point where the last solve ended are
-// not evaluated again.
-// `weighted`: `penalties` carry the weights of an earlier stage, in the
-// cost's own units (StageSummary::penalties), and are not weighed again.
+// the blocks' values, which it updates, with the active set of the header.
+// False when a solve failed (`*failure`). `rated`, when given, is the
+// problem of the dwells alone ChooseStart rated the start on, solved on
+// instead of a new one. `start_only`: its end only starts a later stage
+// (SolverSettings::start_function_tolerance). Every solve runs on the same
+// problem, held entries reconfigured (StageProblem::Hold), so the values
+// where the last solve ended are not evaluated again.
 bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptions& penalties,
               bool start_only, StageSummary* stage, std::string* failure,
-              std::unique_ptr<StageProblem> rated = nullptr, bool weighted_given = false) {
+              std::unique_ptr<StageProblem> rated = nullptr) {
   StageSetup setup = MakeSetup(context, kind);
   SolverSettings settings = context.options.solver;
   if (start_only) settings.function_tolerance = settings.start_function_tolerance;
-  // The algebraic stage takes the enforced jumps' fold conditions
-  // (ProblemBuilder::AddPenalties), unweighted by the data's cost; the
-  // all-roots stage takes the penalties too, its range through the roots.
+  // The algebraic stage takes the enforced jumps' fold conditions, unweighted
+  // (ProblemBuilder::AddPenalties); the all-roots stage the penalties.
   const bool fold_conditions =
       kind == ResidualKind::kAlgebraic && penalties.bifurcation_range.enabled;
-  const bool with_penalties =
-      (kind == ResidualKind::kVertical || kind == ResidualKind::kAllRoots) &&
-      PenaltiesEnabled(penalties);
+  const bool with_penalties = IsBranchLabelled(kind) && PenaltiesEnabled(penalties);
   const int entries = context.fit.NumEntries();
   setup.held.assign(entries, false);
   std::vector<bool> released(entries, false);
@@ -293,16 +271,14 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
   std::unique_ptr<StageProblem> assembled =
       rated != nullptr ? std::move(rated) : std::make_unique<StageProblem>(context.fit, setup);
   StageProblem& problem = *assembled;
-  PenaltyOptions weighted = penalties;
-  if (with_penalties && !weighted_given) weighted = WeighPenalties(penalties, &problem, stage);
+  const PenaltyOptions weighted =
+      with_penalties ? WeighPenalties(penalties, &problem, stage) : penalties;
   if (with_penalties || fold_conditions) problem.AddPenalties(weighted);
   if (with_penalties) stage->penalties = weighted;
   problem.AddCallerResiduals();
   stage->residual_blocks = problem.dwells();
   for (int round = 0;; ++round) {
     problem.Hold(setup.held);
-    // Each later solve starts from the values a problem assembled for it
-    // would give.
     if (round > 0) problem.EvaluateAfresh();
     std::optional<int> resting;
     const std::vector<double> start = context.fit.Values();
@@ -314,15 +290,11 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
     VLOG(2) << ResidualKindName(kind) << " stage, solve " << round + 1 << ": "
             << summary.BriefReport();
     RecordSolve(summary, round, with_penalties ? penalties : PenaltyOptions{}, &problem, stage);
-    if (!summary.IsSolutionUsable() || !std::isfinite(summary.final_cost)) {
+    if (SolveFailed(summary, kind, context.fit, start, &problem, failure)) {
       stage->converged = false;
-      *failure = std::string("the ") + ResidualKindName(kind) +
-                 " stage cannot evaluate its cost at " + DescribeValues(context.fit, start) + ": " +
-                 problem.DescribeFailure(summary.message);
       return false;
     }
-    // Each bounded entry is held at most twice and released at most once,
-    // so this bound is never reached in practice.
+    // Each entry is held at most twice and released once: never reached.
     if (round + 1 >= kMaxSolvesPerStage) break;
     if (resting) {
       setup.held[*resting] = true;
@@ -340,8 +312,7 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
   for (int i = 0; i < entries; ++i) {
     if (setup.held[i]) stage->held_at_bound.push_back(i);
   }
-  if (!setup.bound_damping && ReflectDampingIntoPhysicalRange(EntriesHolding(context.fit, false),
-                                                              EntriesHolding(context.fit, true))) {
+  if (!setup.bound_damping && ReflectDamping(context.fit)) {
     VLOG(1) << "reflected the " << ResidualKindName(kind) << " stage's damping";
   }
   stage->values = context.fit.Values();
@@ -349,12 +320,10 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
   return true;
 }
 
-// A step unit for a parameter that starts at 0, from the dataset's other
-// parameters and its largest measured amplitude a_max, so that the fit does
-// not depend on the units of a or of time (docs/model.md, "Units"): delta
-// like |alpha| / w^2 (the two nonlinear terms alike), alpha like w^2 / a_max^2
-// over ten (a tenth of the linear stiffness at the largest amplitude), mu2
-// like mu1 / a_max, mu1 like w / 1000 (a damping ratio of 1e-3).
+// A step unit for a parameter that starts at 0, independent of the units of
+// a and time (docs/model.md, "Units"): delta like |alpha| / w^2, alpha like
+// w^2 / a_max^2 / 10 (a tenth of the linear stiffness at the largest
+// amplitude), mu2 like mu1 / a_max, mu1 like w / 1000.
 double NaturalScale(int parameter, const ParameterVector& p, double a_max) {
   const double w = std::abs(p[kNaturalFrequency]);
   const double mu1 = p[kMu1] != 0.0 ? std::abs(p[kMu1]) : 1e-3 * w;
@@ -372,9 +341,8 @@ double NaturalScale(int parameter, const ParameterVector& p, double a_max) {
   }
 }
 
-// The step unit of every entry: its scale when given, else the magnitude of
-// its value at the start, or for a value 0 its NaturalScale in the first
-// dataset that maps it (1 when none does or it is not finite and positive).
+// The step unit of every entry: its scale when given, else |value at the
+// start|, for 0 its NaturalScale in the first dataset that maps it (else 1).
 std::vector<double> StartScale(const FitDescription& fit) {
   std::vector<double> scale = fit.Values();
   for (double& value : scale) value = std::abs(value);
@@ -410,23 +378,19 @@ std::string JoinLines(const std::vector<std::string>& lines) {
 }
 
 // How good a point is as the start of a branch-labelled stage: fewer
-// enforced folds missing first, then a lower cost of the dwells under the
-// stage's own residual.
+// enforced folds missing, then a lower cost of the dwells.
 struct StartRating {
   std::vector<std::string> missing_folds;
   double data_cost = 0.0;
 
   bool BetterThan(const StartRating& other) const {
-    if (missing_folds.size() != other.missing_folds.size()) {
-      return missing_folds.size() < other.missing_folds.size();
-    }
-    return data_cost < other.data_cost;
+    return std::make_pair(missing_folds.size(), data_cost) <
+           std::make_pair(other.missing_folds.size(), other.data_cost);
   }
 };
 
-// Rates `values` (written into the blocks) as the start of a stage whose
-// problem of the dwells alone is `problem`, as a problem assembled for them
-// would (StageProblem::EvaluateAfresh).
+// Rates `values` (written into the blocks) on `problem`, the stage's
+// problem of the dwells alone.
 StartRating RateStart(const SolveContext& context, StageProblem* problem,
                       const std::vector<double>& values, const PenaltyOptions& penalties) {
   context.fit.SetValues(values);
@@ -442,11 +406,9 @@ std::string DescribeRating(ResidualKind kind, const StartRating& rating) {
   return text.str();
 }
 
-// The start stage of a run whose first stage is branch-labelled: the
-// algebraic residual (eq. 3.11, the dwells alone) from the given start,
-// whose end is a candidate start for that first stage (ChooseStart). A
-// start stage that cannot evaluate its cost is recorded and passed over:
-// the blocks go back to the given start. Returns whether it ended usably.
+// The start stage (header). One that cannot evaluate its cost is recorded
+// and passed over, the blocks back at the given start. Returns whether it
+// ended usably.
 bool RunStartStage(const SolveContext& context, ResidualKind first, FitSummary* summary) {
   const std::vector<double> given = context.fit.Values();
   summary->stages.emplace_back();
@@ -483,17 +445,10 @@ std::string StartNote(ResidualKind kind, bool after_start_stage, bool previous_c
                          : "";
 }
 
-// Where a branch-labelled stage of residual `kind` starts. Of the points
-// the previous stage started and ended at, the better (StartRating): a
-// stage may end where the next one does worse (the algebraic residual does
-// not know branches, and an enforced fold may vanish on its way). When the
-// previous stage is the start stage (RunStartStage) the choice is recorded
-// either way. When a vertical stage's start still lacks an enforced fold, a
-// fold stage (the algebraic residual with the enforced jumps' fold
-// conditions, FoldConditionResidual) runs from it first, once per solve,
-// and the better of its start and end is taken. Leaves the blocks at the
-// chosen start, and in `rated` the problem the points were rated on, for
-// the stage to solve on (RunStage).
+// Where a branch-labelled stage starts (the header's choice between where
+// the previous stage started and ended, and the fold stage, once per
+// solve). Leaves the blocks at the chosen start, and in `rated` the problem
+// the points were rated on, for RunStage.
 struct StartRequest {
   ResidualKind kind = ResidualKind::kVertical;  // the stage's residual
   // Where the previous stage started; null when there is none to compare.
@@ -517,9 +472,8 @@ ChosenStart ChooseStart(const SolveContext& context, const StartRequest& request
   std::vector<double> best = context.fit.Values();
   chosen.rated = std::make_unique<StageProblem>(context.fit, MakeSetup(context, kind));
   StageProblem* problem = chosen.rated.get();
-  // The previous start first: the stage usually starts where the previous
-  // one ended, and the problem then holds the values there that a problem
-  // assembled for the stage would compute first.
+  // The previous start first, so that the problem ends holding the values
+  // at the usual start, where the previous stage ended.
   std::optional<StartRating> earlier;
   if (previous_start != nullptr) earlier = RateStart(context, problem, *previous_start, penalties);
   StartRating rating = RateStart(context, problem, best, penalties);
@@ -559,18 +513,15 @@ ChosenStart ChooseStart(const SolveContext& context, const StartRequest& request
   return chosen;
 }
 
-// The minimum check's step along an entry: this share of its step unit.
+// The minimum check's step along an entry, in its step unit.
 constexpr double kMinimumCheckStep = 1e-4;
-// A cost below the fit's by more than this many times the solver's
-// function tolerance (its share of the cost) is a lower point: less is
-// within the convergence test the fit ended on (1e-7 of the cost at the
-// default 1e-8).
+// A cost lower by more than this many function tolerances (shares of the
+// cost) is a lower point; less is within the convergence test.
 constexpr double kMinimumCheckTolerances = 10.0;
 
 // The lowest cost a step of kMinimumCheckStep along one free entry, either
-// way, reaches from where the fit ended (bounds kept), with its point and
-// entry, when lower than the cost there; else nullopt. The fit's blocks are
-// left as they were.
+// way, reaches from where the fit ended (bounds kept), when lower than the
+// cost there; else nullopt. The blocks are left as they were.
 struct Descent {
   std::vector<double> values;
   double cost = 0.0;
@@ -587,17 +538,14 @@ std::optional<Descent> FindDescent(const SolveContext& context, const StageSumma
   if (!std::isfinite(base)) return std::nullopt;
   const double tolerance = kMinimumCheckTolerances * context.options.solver.function_tolerance;
   const std::vector<bool> fixed = context.fit.FixedEntries();
-  const std::vector<bool> eta_e = context.fit.EntriesHolding(kEtaE);
-  std::vector<bool> damping = context.fit.EntriesHolding(kMu1);
-  const std::vector<bool> mu2 = context.fit.EntriesHolding(kMu2);
+  const std::vector<bool> bounded = context.fit.EntriesHolding({kEtaE, kMu1, kMu2});
   std::optional<Descent> best;
   for (size_t i = 0; i < start.size(); ++i) {
     if (fixed[i]) continue;
-    const bool bounded = eta_e[i] || damping[i] || mu2[i];
     for (double sign : {-1.0, 1.0}) {
       std::vector<double> point = start;
       point[i] += sign * kMinimumCheckStep * context.scale[i];
-      if (bounded && point[i] < 0.0) point[i] = 0.0;
+      if (bounded[i] && point[i] < 0.0) point[i] = 0.0;
       if (point[i] == start[i]) continue;
       context.fit.SetValues(point);
       problem.EvaluateAfresh();
@@ -612,13 +560,11 @@ std::optional<Descent> FindDescent(const SolveContext& context, const StageSumma
 }
 
 // The last stage solved again from a point the minimum check found lower:
-// one Levenberg-Marquardt solve with the stage's penalties at their
-// weights, stepped in units of where it stands now (the start's units can
-// be decades off after a long fit: alpha of the measured beam, 7.85e11 at
-// the start, 1.5e11 at the end), without the active set: Ceres projects
-// onto the bounds. Where the stage's own solves stop on the function
-// tolerance along a valley (the measured beam: 81.59563 -> 81.59556), this
-// one goes on to the valley's floor (81.5887). False when it cannot
+// one solve with the stage's weighed penalties, without the active set,
+// stepped in units of where it stands (the start's can be decades off: the
+// measured beam's alpha goes from 7.85e11 to 1.5e11). Where the stage
+// stopped on the function tolerance along a valley (the measured beam:
+// 81.59556), this reaches its floor (81.5887). False when it cannot
 // evaluate the cost (`*failure`).
 bool SolveFromDescent(const SolveContext& context, const StageSummary& last, StageSummary* again,
                       std::string* failure) {
@@ -630,31 +576,20 @@ bool SolveFromDescent(const SolveContext& context, const StageSummary& last, Sta
   problem.AddCallerResiduals();
   problem.Configure();
   const std::vector<double> start = context.fit.Values();
-  ceres::Solver::Options options = MakeSolverOptions(context.options.solver);
-  if (IsBranchLabelled(last.residual)) options.max_num_line_search_step_size_iterations = 0;
+  const ceres::Solver::Options options = StageSolverOptions(last.residual, context.options.solver);
   ceres::Solver::Summary summary;
   ceres::Solve(options, problem.problem(), &summary);
   again->residual = last.residual;
   RecordSolve(summary, 0, last.penalties, &problem, again);
   again->residual_blocks = problem.dwells();
-  if (!summary.IsSolutionUsable() || !std::isfinite(summary.final_cost)) {
-    *failure = std::string("the ") + ResidualKindName(last.residual) +
-               " stage cannot evaluate its cost at " + DescribeValues(context.fit, start) + ": " +
-               problem.DescribeFailure(summary.message);
-    return false;
-  }
-  // The algebraic residual's damping is unbounded (RunStage).
-  if (last.residual == ResidualKind::kAlgebraic) {
-    ReflectDampingIntoPhysicalRange(EntriesHolding(context.fit, false),
-                                    EntriesHolding(context.fit, true));
-  }
+  if (SolveFailed(summary, last.residual, context.fit, start, &problem, failure)) return false;
+  if (last.residual == ResidualKind::kAlgebraic) ReflectDamping(context.fit);
   again->values = context.fit.Values();
   return true;
 }
 
-// The minimum check at the end of a fit: a step along each free entry both
-// ways; where one lowers the cost, the last stage solves again from there
-// (with its penalties' weights), and the check runs once more. Returns why
+// The minimum check: where a step lowers the cost (FindDescent), the last
+// stage solves again from there, and the check runs once more. Returns why
 // the point is not a minimum ("" when it is). False in `*solved` when that
 // solve failed (`*failure`).
 std::string CheckMinimum(const SolveContext& context, FitSummary* summary, bool* solved,
@@ -684,8 +619,7 @@ std::string CheckMinimum(const SolveContext& context, FitSummary* summary, bool*
   return "";
 }
 
-// The summary of a solve that could not evaluate its cost: `why`, the
-// blocks where that solve stopped.
+// The summary of a solve that could not evaluate its cost.
 FitSummary EvaluationFailed(const std::string& why, FitSummary* summary) {
   summary->status = FitStatus::kFailure;
   summary->evaluation_failed = true;
@@ -694,9 +628,7 @@ FitSummary EvaluationFailed(const std::string& why, FitSummary* summary) {
   return std::move(*summary);
 }
 
-// Status and message from how the last stage ended: a failure when an
-// enforced fold is missing, the penalties dominate the cost, or a value is
-// not finite; else converged or not.
+// Status and message from how the last stage ended (header).
 void Conclude(const FitDescription& fit, FitSummary* summary) {
   const StageSummary& last = summary->stages.back();
   for (const StageSummary& stage : summary->stages) summary->iterations += stage.iterations;
@@ -711,16 +643,14 @@ void Conclude(const FitDescription& fit, FitSummary* summary) {
           << (last.converged ? "converged" : "stopped without meeting a convergence test") << ": "
           << last.brief_report;
   // G depends on w only through w^2: a negative w is the same model.
-  for (double* w : EntriesOf(fit, kNaturalFrequency)) *w = std::abs(*w);
-  std::vector<double> eta_e_values;
-  for (const double* eta_e : EntriesOf(fit, kEtaE)) eta_e_values.push_back(*eta_e);
+  for (double* w : EntriesOf(fit, {kNaturalFrequency})) *w = std::abs(*w);
+  const std::vector<double*> eta_e = EntriesOf(fit, {kEtaE});
   const std::vector<double> values = fit.Values();
   std::string failure;
   if (!std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); }) ||
       !std::isfinite(summary->final_cost)) {
     failure = "the fit ended at values that are not finite";
-  } else if (std::any_of(eta_e_values.begin(), eta_e_values.end(),
-                         [](double eta_e) { return !(eta_e > 0.0); })) {
+  } else if (std::any_of(eta_e.begin(), eta_e.end(), [](const double* e) { return !(*e > 0.0); })) {
     failure = "the fit ended at eta_e = 0, where the model has no forcing";
   } else if (!last.missing_folds.empty()) {
     failure = "the fit ended without the enforced fold(s) " + JoinLines(last.missing_folds) +
@@ -766,29 +696,23 @@ FitSummary SolveStaged(const FitDescription& fit, const StagedSolveOptions& opti
       previous_start = fit.Values();
       after_start_stage = RunStartStage(context, kind, &summary);
     }
-    const bool choose = kind == ResidualKind::kVertical || (s == 0 && after_start_stage);
-    if (choose) {
+    if (kind == ResidualKind::kVertical || (s == 0 && after_start_stage)) {
       chosen = ChooseStart(context, {kind, after_start_stage || s > 0 ? &previous_start : nullptr,
                                      s == 0 && after_start_stage, fold_stage_ran});
       if (chosen.fold_stage) {
         summary.stages.push_back(std::move(*chosen.fold_stage));
         fold_stage_ran = true;
       }
-      if (!chosen.ok) {
-        return EvaluationFailed(chosen.failure, &summary);
-      }
+      if (!chosen.ok) return EvaluationFailed(chosen.failure, &summary);
     }
     previous_start = fit.Values();
-    // The algebraic stage fits the dwells alone: a fold stage adds the fold
-    // conditions when a vertical stage needs them (ChooseVerticalStart).
+    // The algebraic stage fits the dwells alone.
     std::vector<PenaltyOptions> runs = {kind == ResidualKind::kAlgebraic ? PenaltyOptions{}
                                                                          : options.penalties};
     const BifurcationRangeOptions& range = options.penalties.bifurcation_range;
     if (kind == ResidualKind::kVertical && range.enabled && range.exponent > 2) {
-      // Continuation: u^n with n = 10 is flat near the bracket and so stiff
-      // far from it that Levenberg-Marquardt creeps; the quadratic penalty
-      // first brings each fold near its bracket, then the configured one
-      // holds it.
+      // Continuation: u^10 is flat near the bracket and so stiff far from it
+      // that Levenberg-Marquardt creeps; u^2 first brings each fold near.
       runs.insert(runs.begin(), options.penalties);
       runs.front().bifurcation_range.exponent = 2;
     }

@@ -110,7 +110,8 @@ Outcome SolveFrom(const PullOnX& pull, int steps) {
   options.callbacks.push_back(&recorder);  // first: it sees the step that stops the solve
   std::optional<BoundRestWatcher> watcher;
   if (steps > 0) {
-    watcher.emplace(p, std::vector<BoundRestWatcher::Bound>{{kX, 0.0}, {kY, -50.0}}, steps);
+    watcher.emplace(std::vector<BoundRestWatcher::Entry>{{p + kX, 0.0, kX}, {p + kY, -50.0, kY}},
+                    steps);
     options.callbacks.push_back(&*watcher);
   }
   ceres::Solve(options, &problem, &outcome.summary);

@@ -107,8 +107,8 @@ TEST_F(ClampedBeamIdentification, Mu2IsHeldOnItsBoundWhereTheCostPushesItOutward
   const ProblemBuilder builder(options);
   ceres::Problem problem;
   for (const Sweep* sweep : data_->fitted) {
-    builder.AddSweep(*sweep, p.data(), &problem);
-    builder.AddPenalties(*sweep, p.data(), &problem);
+    builder.AddSweep(*sweep, SingleBlockLayout(p.data()), &problem);
+    builder.AddPenalties(*sweep, SingleBlockLayout(p.data()), &problem);
   }
   double cost = 0.0;
   std::vector<double> gradient;

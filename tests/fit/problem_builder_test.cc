@@ -108,7 +108,8 @@ TEST(ProblemBuilder, AddsOneResidualBlockPerDwellOnACallerOwnedProblem) {
   problem.AddParameterBlock(other_block, 1);
   ParameterVector p = kTruth;
   int blocks = 0;
-  for (const Sweep& sweep : sweeps) blocks += builder.AddSweep(sweep, p.data(), &problem);
+  for (const Sweep& sweep : sweeps)
+    blocks += builder.AddSweep(sweep, SingleBlockLayout(p.data()), &problem);
   EXPECT_EQ(blocks, static_cast<int>(sweeps[0].points.size() + sweeps[1].points.size()));
   EXPECT_EQ(problem.NumResidualBlocks(), blocks);
   EXPECT_EQ(problem.NumParameterBlocks(), 2);
