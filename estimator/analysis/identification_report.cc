@@ -52,9 +52,22 @@ double ControlInFileUnit(const Sweep& sweep, double control) {
   return sweep.kind == SweepKind::kFrequency ? RadPerSecondToHz(control) : control;
 }
 
-}  // namespace
+// `key`: the items of `list` as a sequence (flow style with `flow`).
+template <typename List>
+void EmitList(const char* key, const List& list, YAML::Emitter* out, bool flow = false) {
+  *out << YAML::Key << key << YAML::Value;
+  if (flow) *out << YAML::Flow;
+  *out << YAML::BeginSeq;
+  for (const auto& item : list) *out << item;
+  *out << YAML::EndSeq;
+}
 
-namespace {
+// `key`: [first, second].
+template <typename T>
+void EmitPair(const char* key, const T& first, const T& second, YAML::Emitter* out) {
+  *out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << first << second
+       << YAML::EndSeq;
+}
 
 // ci95: the reported interval (its kind in uncertainty.interval_kind);
 // ci95_ends: how the profile found each end (crossed, bound, open);
@@ -62,13 +75,10 @@ namespace {
 // the profile's.
 void EmitInterval(double low, double high, const ProfileInterval* profile, double linear_low,
                   double linear_high, YAML::Emitter* out) {
-  *out << YAML::Key << "ci95" << YAML::Value << YAML::Flow << YAML::BeginSeq << low << high
-       << YAML::EndSeq;
+  EmitPair("ci95", low, high, out);
   if (profile == nullptr || !profile->computed) return;
-  *out << YAML::Key << "ci95_ends" << YAML::Value << YAML::Flow << YAML::BeginSeq
-       << ProfileEndName(profile->low_end) << ProfileEndName(profile->high_end) << YAML::EndSeq;
-  *out << YAML::Key << "linearised_ci95" << YAML::Value << YAML::Flow << YAML::BeginSeq
-       << linear_low << linear_high << YAML::EndSeq;
+  EmitPair("ci95_ends", ProfileEndName(profile->low_end), ProfileEndName(profile->high_end), out);
+  EmitPair("linearised_ci95", linear_low, linear_high, out);
 }
 
 const ProfileInterval* ProfileOf(const ParameterUncertainty& u, int i) {
@@ -136,9 +146,7 @@ void EmitUncertainty(const IdentificationReport& report, YAML::Emitter* out) {
     }
     *out << YAML::EndMap;
   }
-  *out << YAML::Key << "warnings" << YAML::Value << YAML::BeginSeq;
-  for (const std::string& warning : u.warnings) *out << warning;
-  *out << YAML::EndSeq;
+  EmitList("warnings", u.warnings, out);
   *out << YAML::EndMap;
 }
 
@@ -147,14 +155,10 @@ void EmitStarts(const IdentificationReport& report, YAML::Emitter* out) {
   *out << YAML::Key << "starts" << YAML::Value << report.multi_start.starts.size();
   *out << YAML::Key << "reached_best" << YAML::Value << report.multi_start.reached_best;
   *out << YAML::Key << "best_start" << YAML::Value << report.multi_start.best_start;
-  *out << YAML::Key << "final_costs" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (double cost : report.multi_start.final_costs) *out << cost;
-  *out << YAML::EndSeq;
+  EmitList("final_costs", report.multi_start.final_costs, out, /*flow=*/true);
   *out << YAML::EndMap;
   if (!report.initial_guess_steps.empty()) {
-    *out << YAML::Key << "automatic_initial_guess" << YAML::Value << YAML::BeginSeq;
-    for (const std::string& step : report.initial_guess_steps) *out << step;
-    *out << YAML::EndSeq;
+    EmitList("automatic_initial_guess", report.initial_guess_steps, out);
   }
 }
 
@@ -179,9 +183,7 @@ void EmitStage(const StageSummary& stage, YAML::Emitter* out) {
   *out << YAML::Key << "converged" << YAML::Value << stage.converged;
   if (stage.penalty_unit > 0.0) {
     *out << YAML::Key << "final_penalty_cost" << YAML::Value << stage.final_penalty_cost;
-    *out << YAML::Key << "missing_folds" << YAML::Value << YAML::BeginSeq;
-    for (const std::string& fold : stage.missing_folds) *out << fold;
-    *out << YAML::EndSeq;
+    EmitList("missing_folds", stage.missing_folds, out);
   }
   if (!stage.note.empty()) *out << YAML::Key << "note" << YAML::Value << stage.note;
   *out << YAML::Key << "solver" << YAML::Value << stage.brief_report;
@@ -195,10 +197,9 @@ void EmitJump(const Sweep& sweep, const PredictedJump& jump, YAML::Emitter* out)
   *out << YAML::Flow << YAML::BeginMap;
   *out << YAML::Key << "kind" << YAML::Value << JumpKindName(jump.kind);
   if (jump.measured) {
-    *out << YAML::Key << (frequency ? "measured_between_hz" : "measured_between_a_base")
-         << YAML::Value << YAML::Flow << YAML::BeginSeq
-         << ControlInFileUnit(sweep, jump.bracket.control_before)
-         << ControlInFileUnit(sweep, jump.bracket.control_after) << YAML::EndSeq;
+    EmitPair(frequency ? "measured_between_hz" : "measured_between_a_base",
+             ControlInFileUnit(sweep, jump.bracket.control_before),
+             ControlInFileUnit(sweep, jump.bracket.control_after), out);
   }
   *out << YAML::Key << (frequency ? "model_hz" : "model_a_base") << YAML::Value;
   if (jump.exists) {
@@ -322,9 +323,7 @@ void EmitLevelRefits(const LevelRefits& r, YAML::Emitter* out) {
       *out << YAML::EndMap;
     }
     *out << YAML::EndMap;
-    *out << YAML::Key << "warnings" << YAML::Value << YAML::BeginSeq;
-    for (const std::string& warning : r.warnings) *out << warning;
-    *out << YAML::EndSeq;
+    EmitList("warnings", r.warnings, out);
   }
   *out << YAML::EndMap;
 }

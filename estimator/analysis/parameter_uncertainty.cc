@@ -49,13 +49,10 @@ std::string PairAdvice(int a, int b) {
          "one of them";
 }
 
-// The plain-words account of what the sweeps cannot see. `null_space` (k x r)
-// holds orthonormal null directions of the column-normalised Jacobian J_n;
-// `column_cosines` (k x k) is J_n^T J_n, the cosines between its columns;
-// `unit_scale` is the physical change of each tangent coordinate per unit.
-// A parameter is implicated when its row of `null_space` has a norm of at
-// least kNullDirectionShare (the row norms do not depend on which basis of
-// the null space the SVD returned).
+// The plain-words account of what the sweeps cannot see (BlockCovariance's
+// null_space, unit_scale, free and column_cosines). A parameter is
+// implicated when its row of `null_space` has a norm of at least
+// kNullDirectionShare (independent of the basis the SVD returned).
 std::string DescribeNullSpace(const Eigen::MatrixXd& null_space, const Eigen::VectorXd& unit_scale,
                               const std::vector<int>& free, const Eigen::MatrixXd& column_cosines) {
   std::vector<int> involved;
@@ -191,23 +188,14 @@ std::vector<PenaltyCurvature> EnforcedJumps(const std::vector<const Sweep*>& fit
   return terms;
 }
 
+// `u` before its intervals are set, with `message`.
 ParameterUncertainty Unavailable(ParameterUncertainty u, const std::string& message) {
-  ParameterUncertainty out;
-  out.available = false;
-  out.message = message;
-  out.num_points = u.num_points;
-  out.num_free = u.num_free;
-  out.degrees_of_freedom = u.degrees_of_freedom;
-  out.noise_sigma = std::isfinite(u.noise_sigma) ? u.noise_sigma : 0.0;
-  out.reduced_chi_square = std::isfinite(u.reduced_chi_square) ? u.reduced_chi_square : 0.0;
-  out.collinearity = std::isnan(u.collinearity) ? 0.0 : u.collinearity;
-  out.omega_ref_rad_s = u.omega_ref_rad_s;
-  out.effective_nonlinearity = u.effective_nonlinearity;
-  out.dwells_past_branch_end = u.dwells_past_branch_end;
-  out.warnings = u.warnings;
-  out.interval_kind = u.interval_kind;
-  out.penalty_terms = u.penalty_terms;
-  return out;
+  u.available = false;
+  u.message = message;
+  if (!std::isfinite(u.noise_sigma)) u.noise_sigma = 0.0;
+  if (!std::isfinite(u.reduced_chi_square)) u.reduced_chi_square = 0.0;
+  if (std::isnan(u.collinearity)) u.collinearity = 0.0;
+  return u;
 }
 
 // The covariance's counts, noise and collinearity in `u`.
@@ -236,20 +224,6 @@ void CopyIntervals(const BlockCovariance& c, ParameterUncertainty* u) {
       u->correlation(a, b) = a == b              ? 1.0
                              : denominator > 0.0 ? u->covariance(a, b) / denominator
                                                  : 0.0;
-    }
-  }
-}
-
-// Correlations of the free parameters from `sampling` (the covariance
-// without the bias terms, whose rank-one shares would make every pair look
-// collinear).
-void SetCorrelation(const std::vector<int>& free, const Eigen::MatrixXd& sampling,
-                    ParameterUncertainty* u) {
-  if (sampling.rows() != kNumParameters || sampling.cols() != kNumParameters) return;
-  for (int a : free) {
-    for (int b : free) {
-      const double denominator = std::sqrt(sampling(a, a) * sampling(b, b));
-      u->correlation(a, b) = a == b ? 1.0 : denominator > 0.0 ? sampling(a, b) / denominator : 0.0;
     }
   }
 }
@@ -399,16 +373,10 @@ bool MakeProfileProblem(const std::vector<const Sweep*>& fitted,
   return problem->threshold > 0.0;
 }
 
-double Width(double low, double high) { return high - low; }
-
-// Replaces the linearised intervals in `u` by the profile's, keeps the
-// linearised ones beside them, and warns where the two differ by more than
+// Replaces the linearised intervals in `u` (kept in linearised_*) by the
+// profile's, and warns where the two differ by more than
 // kIntervalDisagreement or an end is open.
 void UseProfile(const ProfileLikelihood& profile, ParameterUncertainty* u) {
-  u->linearised_ci95_low = u->ci95_low;
-  u->linearised_ci95_high = u->ci95_high;
-  u->effective_nonlinearity_linearised_ci95_low = u->effective_nonlinearity_ci95_low;
-  u->effective_nonlinearity_linearised_ci95_high = u->effective_nonlinearity_ci95_high;
   u->profile = profile;
   u->interval_kind = "profile_likelihood";
   for (int q = 0; q <= kNumParameters; ++q) {
@@ -419,7 +387,7 @@ void UseProfile(const ProfileLikelihood& profile, ParameterUncertainty* u) {
     double& low = effective ? u->effective_nonlinearity_ci95_low : u->ci95_low[q];
     double& high = effective ? u->effective_nonlinearity_ci95_high : u->ci95_high[q];
     const char* name = effective ? "alpha_e" : ParameterName(q);
-    const double ratio = Width(low, high) / Width(interval.low, interval.high);
+    const double ratio = (high - low) / (interval.high - interval.low);
     if (interval.low_end == ProfileEnd::kOpen || interval.high_end == ProfileEnd::kOpen) {
       u->warnings.push_back(StringPrintf(
           "the data do not bound %s: its profile stays below the 95 %% threshold as far as the "
@@ -481,25 +449,18 @@ bool MoveToLower(const ProfileProblem& problem, const ParameterVector& start,
 
 }  // namespace
 
+// In IntervalMethod's order.
+constexpr const char* kIntervalMethodNames[] = {"data_only", "linearised", "profile"};
+
 const char* IntervalMethodName(IntervalMethod method) {
-  switch (method) {
-    case IntervalMethod::kDataOnly:
-      return "data_only";
-    case IntervalMethod::kLinearised:
-      return "linearised";
-    case IntervalMethod::kProfile:
-      return "profile";
-  }
-  return "profile";
+  return kIntervalMethodNames[static_cast<int>(method)];
 }
 
 bool ParseIntervalMethod(const std::string& name, IntervalMethod* method) {
-  for (IntervalMethod candidate :
-       {IntervalMethod::kDataOnly, IntervalMethod::kLinearised, IntervalMethod::kProfile}) {
-    if (name == IntervalMethodName(candidate)) {
-      *method = candidate;
-      return true;
-    }
+  for (int i = 0; i < 3; ++i) {
+    if (name != kIntervalMethodNames[i]) continue;
+    *method = static_cast<IntervalMethod>(i);
+    return true;
   }
   return false;
 }

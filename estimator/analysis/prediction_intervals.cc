@@ -48,12 +48,19 @@ std::vector<double> Quantities(const ParameterVector& p, const Sweep& sweep,
   return values;
 }
 
-// The central-difference step of parameter j at p: kRelativeStep of its
+// `scale` d Quantities / d p_j by central differences: step kRelativeStep of p_j's
 // magnitude, or 1e-6 for a parameter at 0 (delta, mu2: their effect is
 // linear near 0, so the step's size hardly matters).
-double Step(const ParameterVector& p, int j) {
-  const double magnitude = std::abs(p[j]);
-  return magnitude > 0.0 ? kRelativeStep * magnitude : 1e-6;
+std::vector<double> Derivatives(const ParameterVector& p, int j, const Sweep& sweep,
+                                const std::vector<int>& dwells, double scale = 1.0) {
+  const double h = std::abs(p[j]) > 0.0 ? kRelativeStep * std::abs(p[j]) : 1e-6;
+  ParameterVector plus = p, minus = p;
+  plus[j] += h;
+  minus[j] -= h;
+  std::vector<double> up = Quantities(plus, sweep, dwells);
+  const std::vector<double> down = Quantities(minus, sweep, dwells);
+  for (std::size_t q = 0; q < up.size(); ++q) up[q] = scale * (up[q] - down[q]) / (2.0 * h);
+  return up;
 }
 
 }  // namespace
@@ -105,26 +112,20 @@ std::vector<HeldOutPrediction> PredictHeldOut(const Sweep& sweep, const Paramete
   const std::vector<double> values = Quantities(parameters, sweep, dwells);
   std::vector<double> variance(values.size(), 0.0);
   if (covariance != nullptr) {
-    // g_q = d q / d p_j over the free parameters; s_p^2 = g^T C g.
-    std::vector<std::array<double, kNumParameters>> gradient(values.size());
-    for (auto& g : gradient) g.fill(0.0);
+    // g_q = d q / d p_j over the free parameters (column q); s_p^2 = g^T C g.
+    Eigen::Matrix<double, kNumParameters, Eigen::Dynamic> gradient =
+        Eigen::MatrixXd::Zero(kNumParameters, values.size());
     for (int j = 0; j < kNumParameters; ++j) {
       if (fixed[j] || (*covariance)(j, j) <= 0.0) continue;
-      const double h = Step(parameters, j);
-      ParameterVector plus = parameters, minus = parameters;
-      plus[j] += h;
-      minus[j] -= h;
-      const std::vector<double> up = Quantities(plus, sweep, dwells);
-      const std::vector<double> down = Quantities(minus, sweep, dwells);
+      const std::vector<double> derivatives = Derivatives(parameters, j, sweep, dwells);
       for (std::size_t q = 0; q < values.size(); ++q) {
-        const double derivative = (up[q] - down[q]) / (2.0 * h);
-        gradient[q][j] = std::isfinite(derivative) ? derivative : 0.0;
+        gradient(j, q) = std::isfinite(derivatives[q]) ? derivatives[q] : 0.0;
       }
     }
     for (std::size_t q = 0; q < values.size(); ++q) {
       for (int i = 0; i < kNumParameters; ++i) {
         for (int j = 0; j < kNumParameters; ++j) {
-          variance[q] += gradient[q][i] * (*covariance)(i, j) * gradient[q][j];
+          variance[q] += gradient(i, q) * (*covariance)(i, j) * gradient(j, q);
         }
       }
     }
@@ -171,12 +172,8 @@ ParameterMatrix PredictionCovariance(const ParameterMatrix& data_only,
   const int k = static_cast<int>(free.size());
   if (k == 0) return data_only;
   // Scaled coordinates: q_j = p_j / d_j, d_j = sqrt(C_d,jj).
-  Eigen::VectorXd d(k);
-  Eigen::MatrixXd scaled(k, k);
-  for (int a = 0; a < k; ++a) d[a] = std::sqrt(data_only(free[a], free[a]));
-  for (int a = 0; a < k; ++a) {
-    for (int b = 0; b < k; ++b) scaled(a, b) = data_only(free[a], free[b]) / (d[a] * d[b]);
-  }
+  const Eigen::VectorXd d = data_only.diagonal()(free).cwiseSqrt();
+  const Eigen::MatrixXd scaled = data_only(free, free).cwiseQuotient(d * d.transpose());
   Eigen::MatrixXd information = PseudoInverse(scaled);
   int observations = 0;
   for (const Sweep* sweep : fitted) {
@@ -188,15 +185,8 @@ ParameterMatrix PredictionCovariance(const ParameterMatrix& data_only,
       Eigen::VectorXd g(k);
       bool finite = h_k > 0.0;
       for (int a = 0; a < k && finite; ++a) {
-        // d f_k / d q_a = d_a d f_k / d p_j, by central differences in p_j.
-        const int j = free[a];
-        const double h = Step(parameters, j);
-        ParameterVector plus = parameters, minus = parameters;
-        plus[j] += h;
-        minus[j] -= h;
-        const std::vector<double> up = Quantities(plus, *sweep, {});
-        const std::vector<double> down = Quantities(minus, *sweep, {});
-        g[a] = d[a] * (up[q] - down[q]) / (2.0 * h);
+        // d f_k / d q_a = d_a d f_k / d p_j.
+        g[a] = Derivatives(parameters, free[a], *sweep, {}, d[a])[q];
         finite = std::isfinite(g[a]);
       }
       if (!finite) continue;
@@ -205,11 +195,8 @@ ParameterMatrix PredictionCovariance(const ParameterMatrix& data_only,
     }
   }
   if (observations == 0) return data_only;
-  const Eigen::MatrixXd combined = PseudoInverse(information);
   ParameterMatrix covariance = ParameterMatrix::Zero();
-  for (int a = 0; a < k; ++a) {
-    for (int b = 0; b < k; ++b) covariance(free[a], free[b]) = combined(a, b) * d[a] * d[b];
-  }
+  covariance(free, free) = d.asDiagonal() * PseudoInverse(information) * d.asDiagonal();
   return covariance;
 }
 
@@ -218,27 +205,13 @@ double HeldOutPrediction::ErrorPercent() const {
 }
 
 const char* HeldOutQuantityName(HeldOutQuantity quantity) {
-  switch (quantity) {
-    case HeldOutQuantity::kJumpDown:
-      return "jump-down";
-    case HeldOutQuantity::kJumpUp:
-      return "jump-up";
-    case HeldOutQuantity::kUpperBranchAmplitude:
-      return "upper-branch amplitude";
-  }
-  return "?";
+  static const char* const kNames[] = {"jump-down", "jump-up", "upper-branch amplitude"};
+  return kNames[static_cast<int>(quantity)];
 }
 
 const char* HeldOutQuantityKey(HeldOutQuantity quantity) {
-  switch (quantity) {
-    case HeldOutQuantity::kJumpDown:
-      return "jump_down";
-    case HeldOutQuantity::kJumpUp:
-      return "jump_up";
-    case HeldOutQuantity::kUpperBranchAmplitude:
-      return "upper_branch_amplitude";
-  }
-  return "?";
+  static const char* const kKeys[] = {"jump_down", "jump_up", "upper_branch_amplitude"};
+  return kKeys[static_cast<int>(quantity)];
 }
 
 double MedianOf(std::vector<double> values) {

@@ -360,15 +360,8 @@ Side MakeSide(const ProfileProblem& problem, int quantity, double sign,
 }  // namespace
 
 const char* ProfileEndName(ProfileEnd end) {
-  switch (end) {
-    case ProfileEnd::kCrossed:
-      return "crossed";
-    case ProfileEnd::kBound:
-      return "bound";
-    case ProfileEnd::kOpen:
-      return "open";
-  }
-  return "open";
+  static const char* const kNames[] = {"crossed", "bound", "open"};
+  return kNames[static_cast<int>(end)];
 }
 
 double RefitProfileProblem(const ProfileProblem& problem, ParameterVector* p) {
