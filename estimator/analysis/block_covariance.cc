@@ -22,10 +22,6 @@
 namespace dwellfit {
 namespace {
 
-// A normalised coordinate's entry of a null direction smaller than this (the
-// direction has unit length) does not implicate its entry.
-constexpr double kNullDirectionShare = 0.1;
-
 // One tangent unit per entry's magnitude (1 for 0).
 std::vector<double> TangentScale(const std::vector<double>& values) {
   std::vector<double> scale;
@@ -61,12 +57,9 @@ std::vector<double*> FreeBlocks(const FitDescription& fit) {
   const std::vector<bool> fixed = fit.FixedEntries();
   std::vector<double*> blocks;
   for (size_t b = 0; b < fit.blocks.size(); ++b) {
-    const int offset = fit.Offset(static_cast<int>(b));
-    for (int i = 0; i < fit.blocks[b].size; ++i) {
-      if (!fixed[offset + i]) {
-        blocks.push_back(fit.blocks[b].values);
-        break;
-      }
+    const auto begin = fixed.begin() + fit.Offset(static_cast<int>(b));
+    if (std::count(begin, begin + fit.blocks[b].size, false) > 0) {
+      blocks.push_back(fit.blocks[b].values);
     }
   }
   return blocks;
@@ -88,9 +81,9 @@ BlockCovariance Unavailable(BlockCovariance c, const std::string& message) {
   return c;
 }
 
-// A valid description, counts, free entries, zeroed results and the
-// point-sigma flags; false when there is nothing to estimate (`c->message`
-// says why).
+// A valid description, counts, free entries, zeroed results, the
+// point-sigma flag and its warning; false when there is nothing to estimate
+// (`c->message` says why).
 bool Prepare(const FitDescription& fit, const ResidualOptions& residual, BlockCovariance* c) {
   if (!fit.IsValid(&c->message) || !residual.IsValid(&c->message)) return false;
   c->values = fit.Values();
@@ -114,10 +107,16 @@ bool Prepare(const FitDescription& fit, const ResidualOptions& residual, BlockCo
   c->degrees_of_freedom = c->num_points - c->num_free;
   const bool use_sigma = residual.use_point_sigma;
   c->all_standardised = use_sigma && c->num_points > 0 && with_sigma == c->num_points;
-  c->some_standardised = use_sigma && with_sigma > 0;
-  if (c->num_free > 0) return true;
-  c->message = "every parameter is fixed: nothing was estimated";
-  return false;
+  if (c->num_free == 0) {
+    c->message = "every parameter is fixed: nothing was estimated";
+    return false;
+  }
+  if (use_sigma && with_sigma > 0 && !c->all_standardised) {
+    c->warnings.push_back(
+        "only some points have a sigma: residuals mix standardised and raw units, so the noise "
+        "estimate and the intervals are rough; give every point a sigma or none");
+  }
+  return true;
 }
 
 // s from the dwells' cost; false when it cannot be estimated.
@@ -165,10 +164,9 @@ bool NormaliseColumns(const FitDescription& fit, const std::vector<double>& tang
   return true;
 }
 
-// The collinearity of the normalised columns, from R_n (k x k), which has
-// the singular values and right singular vectors of J_n; false above
-// kMaxCollinearity, with the null directions and a message naming the
-// entries they involve.
+// The collinearity of J_n from R_n (same singular values and right singular
+// vectors); false above kMaxCollinearity, with the null directions and a
+// message naming their entries.
 bool CheckCollinearity(const FitDescription& fit, const Eigen::MatrixXd& r_normalised,
                        BlockCovariance* c) {
   const int k = c->num_free;
@@ -267,11 +265,6 @@ BlockCovariance EstimateBlockCovariance(const FitDescription& fit, const Residua
   BlockCovariance c;
   if (!options.IsValid(&c.message)) return Unavailable(c, c.message);
   if (!Prepare(fit, residual, &c)) return Unavailable(c, c.message);
-  if (c.some_standardised && !c.all_standardised) {
-    c.warnings.push_back(
-        "only some points have a sigma: residuals mix standardised and raw units, so the noise "
-        "estimate and the intervals are rough; give every point a sigma or none");
-  }
   const std::vector<double*> blocks = FreeBlocks(fit);
 
   // The dwells alone: their cost gives the noise.

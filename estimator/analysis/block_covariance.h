@@ -43,6 +43,9 @@ namespace dwellfit {
 // reciprocal condition number above ~1e-16 and its inverse is not rounding
 // noise.
 inline constexpr double kMaxCollinearity = 1e8;
+// An entry whose share of a (unit) null direction is below this is not
+// implicated in it.
+inline constexpr double kNullDirectionShare = 0.1;
 
 struct BlockCovarianceOptions {
   // Rows of J folded into R at a time (whole residual blocks, >= 1); memory
@@ -65,7 +68,6 @@ struct BlockCovariance {
   int caller_residuals = 0;         // rows of the caller's residual blocks
   bool evaluated = false;           // the residuals and J were evaluated at the estimate
   bool all_standardised = false;    // every dwell divided by its point sigma (s = 1)
-  bool some_standardised = false;   // some are
   double data_cost = 0.0;           // F_d
   double noise_sigma = 0.0;         // s
   double reduced_chi_square = 0.0;  // 2 F_d / (n - k)

@@ -230,8 +230,9 @@ void EmitSweep(const SweepPrediction& prediction, YAML::Emitter* out) {
   *out << YAML::EndMap;
 }
 
-// A number, or null when it is not finite (a missing prediction).
-void EmitNumber(double value, YAML::Emitter* out) {
+// `key`: a number, or null when it is not finite (a missing prediction).
+void EmitNumber(const char* key, double value, YAML::Emitter* out) {
+  *out << YAML::Key << key << YAML::Value;
   if (std::isfinite(value)) {
     *out << value;
   } else {
@@ -247,10 +248,8 @@ void EmitCoverage(const char* key, const IntervalCoverage& c, YAML::Emitter* out
   *out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginMap;
   *out << YAML::Key << "inside" << YAML::Value << c.inside;
   *out << YAML::Key << "total" << YAML::Value << c.total;
-  *out << YAML::Key << "median_half_width" << YAML::Value;
-  EmitNumber(c.median_half_width, out);
-  *out << YAML::Key << "median_half_width_percent" << YAML::Value;
-  EmitNumber(c.median_half_width_percent, out);
+  EmitNumber("median_half_width", c.median_half_width, out);
+  EmitNumber("median_half_width_percent", c.median_half_width_percent, out);
   *out << YAML::EndMap;
 }
 
@@ -275,13 +274,10 @@ void EmitValidationIntervals(const ValidationIntervals& v, YAML::Emitter* out) {
       *out << YAML::Key << "quantity" << YAML::Value << HeldOutQuantityKey(p.quantity);
       *out << YAML::Key << "unit" << YAML::Value << (IsAmplitude(p) ? "data" : "Hz");
       *out << YAML::Key << "measured" << YAML::Value << p.measured;
-      for (const auto& [key, value] : {std::pair<const char*, double>{"predicted", p.predicted},
-                                       {"half_width", p.half_width},
-                                       {"parameter_sd", p.parameter_sd},
-                                       {"model_sd", p.model_sd}}) {
-        *out << YAML::Key << key << YAML::Value;
-        EmitNumber(value, out);
-      }
+      EmitNumber("predicted", p.predicted, out);
+      EmitNumber("half_width", p.half_width, out);
+      EmitNumber("parameter_sd", p.parameter_sd, out);
+      EmitNumber("model_sd", p.model_sd, out);
       *out << YAML::Key << "inside" << YAML::Value << p.inside;
       *out << YAML::EndMap;
     }
@@ -343,74 +339,6 @@ void AppendBlockMapping(const char* key, const std::string& mapping, std::string
     begin = end + 1;
   }
 }
-
-}  // namespace
-
-std::string ReportToYaml(const IdentificationReport& report) {
-  const IdentificationResult& result = report.result;
-  YAML::Emitter out;
-  out.SetDoublePrecision(17);
-  out << YAML::BeginMap;
-  out << YAML::Key << "status" << YAML::Value << FitStatusName(result.status);
-  out << YAML::Key << "status_message" << YAML::Value << result.message;
-  out << YAML::Key << "dwellfit_version" << YAML::Value << DwellfitVersion();
-  out << YAML::Key << "config" << YAML::Value << report.config_path;
-  EmitParameters(report, &out);
-  EmitUncertainty(report, &out);
-  EmitStarts(report, &out);
-  out << YAML::Key << "final_cost" << YAML::Value << result.final_cost;
-  out << YAML::Key << "iterations" << YAML::Value << result.iterations;
-  out << YAML::Key << "converged" << YAML::Value << result.converged;
-  out << YAML::Key << "fitted_points" << YAML::Value << result.residual_blocks;
-  out << YAML::Key << "stages" << YAML::Value << YAML::BeginSeq;
-  for (const StageSummary& stage : result.stages) EmitStage(stage, &out);
-  out << YAML::EndSeq;
-  out << YAML::Key << "sweeps" << YAML::Value << YAML::BeginSeq;
-  for (const SweepPrediction& prediction : report.predictions) EmitSweep(prediction, &out);
-  out << YAML::EndSeq;
-  if (!report.validation_intervals.levels.empty()) {
-    EmitValidationIntervals(report.validation_intervals, &out);
-  }
-  if (!report.level_refits.message.empty()) EmitLevelRefits(report.level_refits, &out);
-  out << YAML::EndMap;
-  std::string yaml = std::string(out.c_str()) + "\n";
-  if (!report.config_in_effect.empty()) {
-    AppendBlockMapping("config_in_effect", report.config_in_effect, &yaml);
-  }
-  return yaml;
-}
-
-std::string ReportToPredictionsCsv(const IdentificationReport& report) {
-  size_t rows = 0;
-  for (const SweepPrediction& prediction : report.predictions) {
-    rows += prediction.sweep->points.size();
-  }
-  CsvText csv("sweep,direction,role,freq_hz,a_base,a,a_model,branch,model_status",
-              (rows + 1) * kPredictionRowBytes);
-  for (const SweepPrediction& prediction : report.predictions) {
-    const Sweep& sweep = *prediction.sweep;
-    const char* direction = SweepDirectionName(sweep.direction);
-    for (size_t i = 0; i < sweep.points.size(); ++i) {
-      const DwellPoint& point = sweep.points[i];
-      const StableRoot& model = prediction.model[i];
-      csv.Text(sweep.id);
-      csv.Text(direction);
-      csv.Text(Role(prediction));
-      for (double value : {RadPerSecondToHz(point.drive_frequency_rad_s), point.a_base,
-                           point.amplitude, model.a}) {
-        csv.Number(value);
-      }
-      csv.Text(BranchName(point.branch));
-      csv.Text(model.status == RootStatus::kOnBranch    ? "on_branch"
-               : model.status == RootStatus::kBranchEnd ? "branch_end"
-                                                        : "failed");
-      csv.EndRow();
-    }
-  }
-  return std::move(csv).Release();
-}
-
-namespace {
 
 void PrintStages(const IdentificationResult& result, std::ostream& out) {
   for (const StageSummary& stage : result.stages) {
@@ -560,6 +488,70 @@ void PrintLevelRefits(const IdentificationReport& report, std::ostream& out) {
 }
 
 }  // namespace
+
+std::string ReportToYaml(const IdentificationReport& report) {
+  const IdentificationResult& result = report.result;
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap;
+  out << YAML::Key << "status" << YAML::Value << FitStatusName(result.status);
+  out << YAML::Key << "status_message" << YAML::Value << result.message;
+  out << YAML::Key << "dwellfit_version" << YAML::Value << DwellfitVersion();
+  out << YAML::Key << "config" << YAML::Value << report.config_path;
+  EmitParameters(report, &out);
+  EmitUncertainty(report, &out);
+  EmitStarts(report, &out);
+  out << YAML::Key << "final_cost" << YAML::Value << result.final_cost;
+  out << YAML::Key << "iterations" << YAML::Value << result.iterations;
+  out << YAML::Key << "converged" << YAML::Value << result.converged;
+  out << YAML::Key << "fitted_points" << YAML::Value << result.residual_blocks;
+  out << YAML::Key << "stages" << YAML::Value << YAML::BeginSeq;
+  for (const StageSummary& stage : result.stages) EmitStage(stage, &out);
+  out << YAML::EndSeq;
+  out << YAML::Key << "sweeps" << YAML::Value << YAML::BeginSeq;
+  for (const SweepPrediction& prediction : report.predictions) EmitSweep(prediction, &out);
+  out << YAML::EndSeq;
+  if (!report.validation_intervals.levels.empty()) {
+    EmitValidationIntervals(report.validation_intervals, &out);
+  }
+  if (!report.level_refits.message.empty()) EmitLevelRefits(report.level_refits, &out);
+  out << YAML::EndMap;
+  std::string yaml = std::string(out.c_str()) + "\n";
+  if (!report.config_in_effect.empty()) {
+    AppendBlockMapping("config_in_effect", report.config_in_effect, &yaml);
+  }
+  return yaml;
+}
+
+std::string ReportToPredictionsCsv(const IdentificationReport& report) {
+  size_t rows = 0;
+  for (const SweepPrediction& prediction : report.predictions) {
+    rows += prediction.sweep->points.size();
+  }
+  CsvText csv("sweep,direction,role,freq_hz,a_base,a,a_model,branch,model_status",
+              (rows + 1) * kPredictionRowBytes);
+  for (const SweepPrediction& prediction : report.predictions) {
+    const Sweep& sweep = *prediction.sweep;
+    const char* direction = SweepDirectionName(sweep.direction);
+    for (size_t i = 0; i < sweep.points.size(); ++i) {
+      const DwellPoint& point = sweep.points[i];
+      const StableRoot& model = prediction.model[i];
+      csv.Text(sweep.id);
+      csv.Text(direction);
+      csv.Text(Role(prediction));
+      for (double value : {RadPerSecondToHz(point.drive_frequency_rad_s), point.a_base,
+                           point.amplitude, model.a}) {
+        csv.Number(value);
+      }
+      csv.Text(BranchName(point.branch));
+      csv.Text(model.status == RootStatus::kOnBranch    ? "on_branch"
+               : model.status == RootStatus::kBranchEnd ? "branch_end"
+                                                        : "failed");
+      csv.EndRow();
+    }
+  }
+  return std::move(csv).Release();
+}
 
 void PrintReport(const IdentificationReport& report, std::ostream& out) {
   PrintStages(report.result, out);

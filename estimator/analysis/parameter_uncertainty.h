@@ -75,7 +75,6 @@ struct ParameterUncertainty {
   // Standard errors, intervals, covariance and correlation are then 0.
   bool available = false;
   std::string message;
-  std::vector<std::string> message_notes;  // join the message
   // "profile_likelihood", "gauss_newton" or "linearised_with_penalty".
   std::string interval_kind = "gauss_newton";
   int penalty_terms = 0;  // enforced jumps whose curvature entered C

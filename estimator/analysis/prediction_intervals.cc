@@ -7,6 +7,7 @@
 
 #include "Eigen/Dense"
 #include "dwellfit/estimator/analysis/sweep_prediction.h"
+#include "dwellfit/estimator/fit/problem_builder.h"
 #include "dwellfit/residuals/model/stable_root.h"
 
 namespace dwellfit {
@@ -20,7 +21,7 @@ const char* const kPredictionIntervalRule =
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// Relative step of the central differences (see Step).
+// Relative step of the central differences (see Derivatives).
 constexpr double kRelativeStep = 1e-5;
 
 // The values `PredictHeldOut` predicts under `p`, in its order: each
@@ -151,14 +152,6 @@ Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& m) {
   return eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
 }
 
-bool Enforces(const IdentificationOptions& options, JumpKind kind) {
-  const BifurcationRangeOptions& range = options.solve.penalties.bifurcation_range;
-  const JumpTarget target =
-      kind == JumpKind::kJumpDown ? JumpTarget::kFrequencyJumpDown : JumpTarget::kFrequencyJumpUp;
-  return range.enabled &&
-         std::find(range.enforce.begin(), range.enforce.end(), target) != range.enforce.end();
-}
-
 }  // namespace
 
 ParameterMatrix PredictionCovariance(const ParameterMatrix& data_only,
@@ -180,7 +173,7 @@ ParameterMatrix PredictionCovariance(const ParameterMatrix& data_only,
     if (sweep->kind != SweepKind::kFrequency) continue;
     for (std::size_t q = 0; q < sweep->jumps.size(); ++q) {
       const JumpBracket& jump = sweep->jumps[q];
-      if (!Enforces(options, jump.kind)) continue;
+      if (!IsEnforced(options.solve.penalties.bifurcation_range, *sweep, jump)) continue;
       const double h_k = RadPerSecondToHz(jump.half_width());
       Eigen::VectorXd g(k);
       bool finite = h_k > 0.0;
