@@ -69,21 +69,19 @@ void EmitPair(const char* key, const T& first, const T& second, YAML::Emitter* o
        << YAML::EndSeq;
 }
 
-// ci95: the reported interval (its kind in uncertainty.interval_kind);
-// ci95_ends: how the profile found each end (crossed, bound, open);
-// linearised_ci95: estimate -/+ q standard_error, when the reported one is
-// the profile's.
-void EmitInterval(double low, double high, const ProfileInterval* profile, double linear_low,
-                  double linear_high, YAML::Emitter* out) {
-  EmitPair("ci95", low, high, out);
-  if (profile == nullptr || !profile->computed) return;
-  EmitPair("ci95_ends", ProfileEndName(profile->low_end), ProfileEndName(profile->high_end), out);
-  EmitPair("linearised_ci95", linear_low, linear_high, out);
-}
-
-const ProfileInterval* ProfileOf(const ParameterUncertainty& u, int i) {
-  if (u.interval_kind != "profile_likelihood") return nullptr;
-  return i < kNumParameters ? &u.profile.parameters[i] : &u.profile.effective_nonlinearity;
+// Of parameter i (kNumParameters: alpha_e): ci95, the reported interval
+// (its kind in uncertainty.interval_kind); with the profile's, ci95_ends
+// (crossed, bound, open) and linearised_ci95 (estimate -/+ q standard_error).
+void EmitInterval(const ParameterUncertainty& u, int i, YAML::Emitter* out) {
+  const bool p = i < kNumParameters;
+  EmitPair("ci95", p ? u.ci95_low[i] : u.effective_nonlinearity_ci95_low,
+           p ? u.ci95_high[i] : u.effective_nonlinearity_ci95_high, out);
+  const ProfileInterval& profile = p ? u.profile.parameters[i] : u.profile.effective_nonlinearity;
+  if (u.interval_kind != "profile_likelihood" || !profile.computed) return;
+  EmitPair("ci95_ends", ProfileEndName(profile.low_end), ProfileEndName(profile.high_end), out);
+  EmitPair("linearised_ci95",
+           p ? u.linearised_ci95_low[i] : u.effective_nonlinearity_linearised_ci95_low,
+           p ? u.linearised_ci95_high[i] : u.effective_nonlinearity_linearised_ci95_high, out);
 }
 
 // parameters: value, start, fixed and interval of each; the natural frequency
@@ -99,8 +97,7 @@ void EmitParameters(const IdentificationReport& report, YAML::Emitter* out) {
     *out << YAML::Key << "fixed" << YAML::Value << report.options.fixed[i];
     if (u.available && !report.options.fixed[i]) {
       *out << YAML::Key << "standard_error" << YAML::Value << u.standard_error[i];
-      EmitInterval(u.ci95_low[i], u.ci95_high[i], ProfileOf(u, i), u.linearised_ci95_low[i],
-                   u.linearised_ci95_high[i], out);
+      EmitInterval(u, i, out);
     }
     if (i == kNaturalFrequency) *out << YAML::Key << "unit" << YAML::Value << "rad/s";
     *out << YAML::EndMap;
@@ -114,9 +111,7 @@ void EmitParameters(const IdentificationReport& report, YAML::Emitter* out) {
   *out << YAML::Key << "omega_ref_rad_s" << YAML::Value << report.omega_ref_rad_s;
   if (u.available) {
     *out << YAML::Key << "standard_error" << YAML::Value << u.effective_nonlinearity_standard_error;
-    EmitInterval(u.effective_nonlinearity_ci95_low, u.effective_nonlinearity_ci95_high,
-                 ProfileOf(u, kNumParameters), u.effective_nonlinearity_linearised_ci95_low,
-                 u.effective_nonlinearity_linearised_ci95_high, out);
+    EmitInterval(u, kNumParameters, out);
   }
   *out << YAML::EndMap;
 }

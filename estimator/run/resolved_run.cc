@@ -74,10 +74,15 @@ void CheckEnoughDwells(const IdentifyConfig& config, const std::vector<const Swe
                        "sweeps, or fix parameters (fixed: with their initial_guess)");
 }
 
-// A fixed parameter is held at its initial value, so that value must be
-// the user's: held at an estimate from the data, it would bias every other
-// parameter without a word.
-void CheckFixedAreGiven(const IdentifyConfig& config) {
+// The settings the run uses before the fit (the fit's own options are
+// checked where they enter it), so that a config built in code is checked.
+// A fixed parameter's value must be the user's: held at an estimate from the
+// data, it would bias every other parameter without a word.
+void CheckSettings(const IdentifyConfig& config) {
+  std::string message;
+  if (!config.jump_detection.IsValid(&message)) {
+    throw InputError(config.config_path, 0, "jump_detection", message);
+  }
   for (int i = 0; i < kNumParameters; ++i) {
     if (!config.identification.fixed[i] || config.initial_guess[i]) continue;
     const std::string key = i == kNaturalFrequency ? "omega_hz" : ParameterName(i);
@@ -87,16 +92,6 @@ void CheckFixedAreGiven(const IdentifyConfig& config) {
                          "initial_guess." +
                          key + ", or remove it from 'fixed'");
   }
-}
-
-// The settings the run uses before the fit (the fit's own options are
-// checked where they enter it): a config built in code is checked here.
-void CheckSettings(const IdentifyConfig& config) {
-  std::string message;
-  if (!config.jump_detection.IsValid(&message)) {
-    throw InputError(config.config_path, 0, "jump_detection", message);
-  }
-  CheckFixedAreGiven(config);
 }
 
 // Fills the guesses the config leaves to the data into run->options.initial,
