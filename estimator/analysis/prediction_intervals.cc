@@ -89,22 +89,17 @@ std::vector<HeldOutPrediction> PredictHeldOut(const Sweep& sweep, const Paramete
   const std::vector<int> dwells = UpperBranchDwells(sweep);
   if (sweep.kind == SweepKind::kFrequency) {
     for (const JumpBracket& jump : sweep.jumps) {
-      HeldOutPrediction p;
-      p.sweep = sweep.Name();
-      p.quantity =
-          jump.kind == JumpKind::kJumpDown ? HeldOutQuantity::kJumpDown : HeldOutQuantity::kJumpUp;
-      p.measured = RadPerSecondToHz(jump.centre());
-      predictions.push_back(p);
+      const bool down = jump.kind == JumpKind::kJumpDown;
+      predictions.push_back({sweep.Name(),
+                             down ? HeldOutQuantity::kJumpDown : HeldOutQuantity::kJumpUp,
+                             RadPerSecondToHz(jump.centre())});
     }
   }
   if (!dwells.empty()) {
-    HeldOutPrediction p;
-    p.sweep = sweep.Name();
-    p.quantity = HeldOutQuantity::kUpperBranchAmplitude;
     double sum = 0.0;
     for (int i : dwells) sum += sweep.points[i].amplitude;
-    p.measured = sum / static_cast<double>(dwells.size());
-    predictions.push_back(p);
+    predictions.push_back({sweep.Name(), HeldOutQuantity::kUpperBranchAmplitude,
+                           sum / static_cast<double>(dwells.size())});
   }
   if (!usable) {
     for (HeldOutPrediction& p : predictions) p.predicted = p.half_width = kNaN;
