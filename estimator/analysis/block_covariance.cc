@@ -22,13 +22,16 @@
 namespace dwellfit {
 namespace {
 
-// A normalised coordinate's entry of a null direction smaller than this (the
-// direction has unit length) does not implicate its entry.
-constexpr double kNullDirectionShare = 0.1;
+// One tangent unit per entry's magnitude (1 for 0).
+std::vector<double> TangentScale(const std::vector<double>& values) {
+  std::vector<double> scale;
+  for (double value : values) scale.push_back(value != 0.0 ? std::abs(value) : 1.0);
+  return scale;
+}
 
-// The vertical-error problem at the blocks' current values, one tangent unit
-// per entry's magnitude (1 for 0), every dwell weighted by `dwell_weight`;
-// the caller's residual blocks when `with_caller`, whose own blocks are held.
+// The vertical-error problem at the blocks' current values in TangentScale
+// units, every dwell weighted by `dwell_weight`; the caller's residual
+// blocks when `with_caller`, whose own blocks are held.
 std::unique_ptr<StageProblem> AssembleDataProblem(const FitDescription& fit,
                                                   const ResidualOptions& residual,
                                                   double dwell_weight, bool with_caller) {
@@ -37,7 +40,7 @@ std::unique_ptr<StageProblem> AssembleDataProblem(const FitDescription& fit,
   setup.residuals.residual_options = residual;
   setup.residuals.dwell_weight = dwell_weight;
   setup.threaded_evaluation = false;  // evaluated twice: no threads needed
-  for (double value : fit.Values()) setup.scale.push_back(value != 0.0 ? std::abs(value) : 1.0);
+  setup.scale = TangentScale(fit.Values());
   auto problem = std::make_unique<StageProblem>(fit, setup);
   if (with_caller) problem->AddCallerResiduals();
   problem->Configure();
@@ -54,12 +57,9 @@ std::vector<double*> FreeBlocks(const FitDescription& fit) {
   const std::vector<bool> fixed = fit.FixedEntries();
   std::vector<double*> blocks;
   for (size_t b = 0; b < fit.blocks.size(); ++b) {
-    const int offset = fit.Offset(static_cast<int>(b));
-    for (int i = 0; i < fit.blocks[b].size; ++i) {
-      if (!fixed[offset + i]) {
-        blocks.push_back(fit.blocks[b].values);
-        break;
-      }
+    const auto begin = fixed.begin() + fit.Offset(static_cast<int>(b));
+    if (std::count(begin, begin + fit.blocks[b].size, false) > 0) {
+      blocks.push_back(fit.blocks[b].values);
     }
   }
   return blocks;
@@ -81,9 +81,9 @@ BlockCovariance Unavailable(BlockCovariance c, const std::string& message) {
   return c;
 }
 
-// A valid description, counts, free entries, zeroed results and the
-// point-sigma flags; false when there is nothing to estimate (`c->message`
-// says why).
+// A valid description, counts, free entries, zeroed results, the
+// point-sigma flag and its warning; false when there is nothing to estimate
+// (`c->message` says why).
 bool Prepare(const FitDescription& fit, const ResidualOptions& residual, BlockCovariance* c) {
   if (!fit.IsValid(&c->message) || !residual.IsValid(&c->message)) return false;
   c->values = fit.Values();
@@ -107,10 +107,16 @@ bool Prepare(const FitDescription& fit, const ResidualOptions& residual, BlockCo
   c->degrees_of_freedom = c->num_points - c->num_free;
   const bool use_sigma = residual.use_point_sigma;
   c->all_standardised = use_sigma && c->num_points > 0 && with_sigma == c->num_points;
-  c->some_standardised = use_sigma && with_sigma > 0;
-  if (c->num_free > 0) return true;
-  c->message = "every parameter is fixed: nothing was estimated";
-  return false;
+  if (c->num_free == 0) {
+    c->message = "every parameter is fixed: nothing was estimated";
+    return false;
+  }
+  if (use_sigma && with_sigma > 0 && !c->all_standardised) {
+    c->warnings.push_back(
+        "only some points have a sigma: residuals mix standardised and raw units, so the noise "
+        "estimate and the intervals are rough; give every point a sigma or none");
+  }
+  return true;
 }
 
 // s from the dwells' cost; false when it cannot be estimated.
@@ -158,10 +164,9 @@ bool NormaliseColumns(const FitDescription& fit, const std::vector<double>& tang
   return true;
 }
 
-// The collinearity of the normalised columns, from R_n (k x k), which has
-// the singular values and right singular vectors of J_n; false above
-// kMaxCollinearity, with the null directions and a message naming the
-// entries they involve.
+// The collinearity of J_n from R_n (same singular values and right singular
+// vectors); false above kMaxCollinearity, with the null directions and a
+// message naming their entries.
 bool CheckCollinearity(const FitDescription& fit, const Eigen::MatrixXd& r_normalised,
                        BlockCovariance* c) {
   const int k = c->num_free;
@@ -186,17 +191,13 @@ bool CheckCollinearity(const FitDescription& fit, const Eigen::MatrixXd& r_norma
   return false;
 }
 
-// (J^T J)^-1 by ceres::Covariance, in physical units, into c->covariance
-// (times `factor`). Its problem holds a copy x of every described entry
-// (ambient order), stepping in the normalised units (ScaledSubsetManifold:
-// x = x0 + unit_scale_j t_j on free entry j, fixed entries held), and one
-// linear residual block r = M (x - x0) (ceres::NormalPrior), M (k x ambient)
-// with column R_n.col(j) / unit_scale_j for free entry j and zeros for fixed
-// ones. Its Jacobian in t is M's free columns times unit_scale: R_n, whose
-// R_n^T R_n is J_n^T J_n of the dwells' problem stepping in the same units.
-// So Ceres inverts the same matrix as on the whole problem, C_t =
-// (J_n^T J_n)^-1, and lifts it to the ambient entries as D C_t D^T, D the
-// manifold's PlusJacobian (unit_scale_j at (free[j], j)).
+// `factor` (J^T J)^-1 by ceres::Covariance, in physical units, into
+// c->covariance. Its problem holds a copy x of every entry stepping in the
+// normalised units (ScaledSubsetManifold: x = x0 + unit_scale_j t_j) and one
+// linear block r = M (x - x0) (ceres::NormalPrior), M's column of free entry
+// j R_n.col(j) / unit_scale_j: its Jacobian in t is R_n, so Ceres inverts
+// R_n^T R_n = J_n^T J_n and lifts it to the entries with the manifold's
+// PlusJacobian.
 bool ComputeCovariance(const FitDescription& fit, double factor,
                        const Eigen::MatrixXd& r_normalised, BlockCovariance* c) {
   const int n = fit.NumEntries();
@@ -264,14 +265,7 @@ BlockCovariance EstimateBlockCovariance(const FitDescription& fit, const Residua
   BlockCovariance c;
   if (!options.IsValid(&c.message)) return Unavailable(c, c.message);
   if (!Prepare(fit, residual, &c)) return Unavailable(c, c.message);
-  if (c.some_standardised && !c.all_standardised) {
-    c.warnings.push_back(
-        "only some points have a sigma: residuals mix standardised and raw units, so the noise "
-        "estimate and the intervals are rough; give every point a sigma or none");
-  }
   const std::vector<double*> blocks = FreeBlocks(fit);
-  std::vector<double> tangent_scale;
-  for (double value : c.values) tangent_scale.push_back(value != 0.0 ? std::abs(value) : 1.0);
 
   // The dwells alone: their cost gives the noise.
   std::unique_ptr<StageProblem> problem = AssembleDataProblem(fit, residual, 1.0, false);
@@ -307,7 +301,7 @@ BlockCovariance EstimateBlockCovariance(const FitDescription& fit, const Residua
     factor = 1.0;
   }
   problem.reset();
-  if (!NormaliseColumns(fit, tangent_scale, &r, &c) || !CheckCollinearity(fit, r, &c)) {
+  if (!NormaliseColumns(fit, TangentScale(c.values), &r, &c) || !CheckCollinearity(fit, r, &c)) {
     return Unavailable(c, c.message);
   }
   if (!ComputeCovariance(fit, factor, r, &c)) {

@@ -52,28 +52,36 @@ double ControlInFileUnit(const Sweep& sweep, double control) {
   return sweep.kind == SweepKind::kFrequency ? RadPerSecondToHz(control) : control;
 }
 
-}  // namespace
-
-namespace {
-
-// ci95: the reported interval (its kind in uncertainty.interval_kind);
-// ci95_ends: how the profile found each end (crossed, bound, open);
-// linearised_ci95: estimate -/+ q standard_error, when the reported one is
-// the profile's.
-void EmitInterval(double low, double high, const ProfileInterval* profile, double linear_low,
-                  double linear_high, YAML::Emitter* out) {
-  *out << YAML::Key << "ci95" << YAML::Value << YAML::Flow << YAML::BeginSeq << low << high
-       << YAML::EndSeq;
-  if (profile == nullptr || !profile->computed) return;
-  *out << YAML::Key << "ci95_ends" << YAML::Value << YAML::Flow << YAML::BeginSeq
-       << ProfileEndName(profile->low_end) << ProfileEndName(profile->high_end) << YAML::EndSeq;
-  *out << YAML::Key << "linearised_ci95" << YAML::Value << YAML::Flow << YAML::BeginSeq
-       << linear_low << linear_high << YAML::EndSeq;
+// `key`: the items of `list` as a sequence (flow style with `flow`).
+template <typename List>
+void EmitList(const char* key, const List& list, YAML::Emitter* out, bool flow = false) {
+  *out << YAML::Key << key << YAML::Value;
+  if (flow) *out << YAML::Flow;
+  *out << YAML::BeginSeq;
+  for (const auto& item : list) *out << item;
+  *out << YAML::EndSeq;
 }
 
-const ProfileInterval* ProfileOf(const ParameterUncertainty& u, int i) {
-  if (u.interval_kind != "profile_likelihood") return nullptr;
-  return i < kNumParameters ? &u.profile.parameters[i] : &u.profile.effective_nonlinearity;
+// `key`: [first, second].
+template <typename T>
+void EmitPair(const char* key, const T& first, const T& second, YAML::Emitter* out) {
+  *out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << first << second
+       << YAML::EndSeq;
+}
+
+// Of parameter i (kNumParameters: alpha_e): ci95, the reported interval
+// (its kind in uncertainty.interval_kind); with the profile's, ci95_ends
+// (crossed, bound, open) and linearised_ci95 (estimate -/+ q standard_error).
+void EmitInterval(const ParameterUncertainty& u, int i, YAML::Emitter* out) {
+  const bool p = i < kNumParameters;
+  EmitPair("ci95", p ? u.ci95_low[i] : u.effective_nonlinearity_ci95_low,
+           p ? u.ci95_high[i] : u.effective_nonlinearity_ci95_high, out);
+  const ProfileInterval& profile = p ? u.profile.parameters[i] : u.profile.effective_nonlinearity;
+  if (u.interval_kind != "profile_likelihood" || !profile.computed) return;
+  EmitPair("ci95_ends", ProfileEndName(profile.low_end), ProfileEndName(profile.high_end), out);
+  EmitPair("linearised_ci95",
+           p ? u.linearised_ci95_low[i] : u.effective_nonlinearity_linearised_ci95_low,
+           p ? u.linearised_ci95_high[i] : u.effective_nonlinearity_linearised_ci95_high, out);
 }
 
 // parameters: value, start, fixed and interval of each; the natural frequency
@@ -89,8 +97,7 @@ void EmitParameters(const IdentificationReport& report, YAML::Emitter* out) {
     *out << YAML::Key << "fixed" << YAML::Value << report.options.fixed[i];
     if (u.available && !report.options.fixed[i]) {
       *out << YAML::Key << "standard_error" << YAML::Value << u.standard_error[i];
-      EmitInterval(u.ci95_low[i], u.ci95_high[i], ProfileOf(u, i), u.linearised_ci95_low[i],
-                   u.linearised_ci95_high[i], out);
+      EmitInterval(u, i, out);
     }
     if (i == kNaturalFrequency) *out << YAML::Key << "unit" << YAML::Value << "rad/s";
     *out << YAML::EndMap;
@@ -104,9 +111,7 @@ void EmitParameters(const IdentificationReport& report, YAML::Emitter* out) {
   *out << YAML::Key << "omega_ref_rad_s" << YAML::Value << report.omega_ref_rad_s;
   if (u.available) {
     *out << YAML::Key << "standard_error" << YAML::Value << u.effective_nonlinearity_standard_error;
-    EmitInterval(u.effective_nonlinearity_ci95_low, u.effective_nonlinearity_ci95_high,
-                 ProfileOf(u, kNumParameters), u.effective_nonlinearity_linearised_ci95_low,
-                 u.effective_nonlinearity_linearised_ci95_high, out);
+    EmitInterval(u, kNumParameters, out);
   }
   *out << YAML::EndMap;
 }
@@ -136,9 +141,7 @@ void EmitUncertainty(const IdentificationReport& report, YAML::Emitter* out) {
     }
     *out << YAML::EndMap;
   }
-  *out << YAML::Key << "warnings" << YAML::Value << YAML::BeginSeq;
-  for (const std::string& warning : u.warnings) *out << warning;
-  *out << YAML::EndSeq;
+  EmitList("warnings", u.warnings, out);
   *out << YAML::EndMap;
 }
 
@@ -147,14 +150,10 @@ void EmitStarts(const IdentificationReport& report, YAML::Emitter* out) {
   *out << YAML::Key << "starts" << YAML::Value << report.multi_start.starts.size();
   *out << YAML::Key << "reached_best" << YAML::Value << report.multi_start.reached_best;
   *out << YAML::Key << "best_start" << YAML::Value << report.multi_start.best_start;
-  *out << YAML::Key << "final_costs" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (double cost : report.multi_start.final_costs) *out << cost;
-  *out << YAML::EndSeq;
+  EmitList("final_costs", report.multi_start.final_costs, out, /*flow=*/true);
   *out << YAML::EndMap;
   if (!report.initial_guess_steps.empty()) {
-    *out << YAML::Key << "automatic_initial_guess" << YAML::Value << YAML::BeginSeq;
-    for (const std::string& step : report.initial_guess_steps) *out << step;
-    *out << YAML::EndSeq;
+    EmitList("automatic_initial_guess", report.initial_guess_steps, out);
   }
 }
 
@@ -179,9 +178,7 @@ void EmitStage(const StageSummary& stage, YAML::Emitter* out) {
   *out << YAML::Key << "converged" << YAML::Value << stage.converged;
   if (stage.penalty_unit > 0.0) {
     *out << YAML::Key << "final_penalty_cost" << YAML::Value << stage.final_penalty_cost;
-    *out << YAML::Key << "missing_folds" << YAML::Value << YAML::BeginSeq;
-    for (const std::string& fold : stage.missing_folds) *out << fold;
-    *out << YAML::EndSeq;
+    EmitList("missing_folds", stage.missing_folds, out);
   }
   if (!stage.note.empty()) *out << YAML::Key << "note" << YAML::Value << stage.note;
   *out << YAML::Key << "solver" << YAML::Value << stage.brief_report;
@@ -195,10 +192,9 @@ void EmitJump(const Sweep& sweep, const PredictedJump& jump, YAML::Emitter* out)
   *out << YAML::Flow << YAML::BeginMap;
   *out << YAML::Key << "kind" << YAML::Value << JumpKindName(jump.kind);
   if (jump.measured) {
-    *out << YAML::Key << (frequency ? "measured_between_hz" : "measured_between_a_base")
-         << YAML::Value << YAML::Flow << YAML::BeginSeq
-         << ControlInFileUnit(sweep, jump.bracket.control_before)
-         << ControlInFileUnit(sweep, jump.bracket.control_after) << YAML::EndSeq;
+    EmitPair(frequency ? "measured_between_hz" : "measured_between_a_base",
+             ControlInFileUnit(sweep, jump.bracket.control_before),
+             ControlInFileUnit(sweep, jump.bracket.control_after), out);
   }
   *out << YAML::Key << (frequency ? "model_hz" : "model_a_base") << YAML::Value;
   if (jump.exists) {
@@ -229,8 +225,9 @@ void EmitSweep(const SweepPrediction& prediction, YAML::Emitter* out) {
   *out << YAML::EndMap;
 }
 
-// A number, or null when it is not finite (a missing prediction).
-void EmitNumber(double value, YAML::Emitter* out) {
+// `key`: a number, or null when it is not finite (a missing prediction).
+void EmitNumber(const char* key, double value, YAML::Emitter* out) {
+  *out << YAML::Key << key << YAML::Value;
   if (std::isfinite(value)) {
     *out << value;
   } else {
@@ -246,10 +243,8 @@ void EmitCoverage(const char* key, const IntervalCoverage& c, YAML::Emitter* out
   *out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginMap;
   *out << YAML::Key << "inside" << YAML::Value << c.inside;
   *out << YAML::Key << "total" << YAML::Value << c.total;
-  *out << YAML::Key << "median_half_width" << YAML::Value;
-  EmitNumber(c.median_half_width, out);
-  *out << YAML::Key << "median_half_width_percent" << YAML::Value;
-  EmitNumber(c.median_half_width_percent, out);
+  EmitNumber("median_half_width", c.median_half_width, out);
+  EmitNumber("median_half_width_percent", c.median_half_width_percent, out);
   *out << YAML::EndMap;
 }
 
@@ -274,13 +269,10 @@ void EmitValidationIntervals(const ValidationIntervals& v, YAML::Emitter* out) {
       *out << YAML::Key << "quantity" << YAML::Value << HeldOutQuantityKey(p.quantity);
       *out << YAML::Key << "unit" << YAML::Value << (IsAmplitude(p) ? "data" : "Hz");
       *out << YAML::Key << "measured" << YAML::Value << p.measured;
-      for (const auto& [key, value] : {std::pair<const char*, double>{"predicted", p.predicted},
-                                       {"half_width", p.half_width},
-                                       {"parameter_sd", p.parameter_sd},
-                                       {"model_sd", p.model_sd}}) {
-        *out << YAML::Key << key << YAML::Value;
-        EmitNumber(value, out);
-      }
+      EmitNumber("predicted", p.predicted, out);
+      EmitNumber("half_width", p.half_width, out);
+      EmitNumber("parameter_sd", p.parameter_sd, out);
+      EmitNumber("model_sd", p.model_sd, out);
       *out << YAML::Key << "inside" << YAML::Value << p.inside;
       *out << YAML::EndMap;
     }
@@ -322,9 +314,7 @@ void EmitLevelRefits(const LevelRefits& r, YAML::Emitter* out) {
       *out << YAML::EndMap;
     }
     *out << YAML::EndMap;
-    *out << YAML::Key << "warnings" << YAML::Value << YAML::BeginSeq;
-    for (const std::string& warning : r.warnings) *out << warning;
-    *out << YAML::EndSeq;
+    EmitList("warnings", r.warnings, out);
   }
   *out << YAML::EndMap;
 }
@@ -344,74 +334,6 @@ void AppendBlockMapping(const char* key, const std::string& mapping, std::string
     begin = end + 1;
   }
 }
-
-}  // namespace
-
-std::string ReportToYaml(const IdentificationReport& report) {
-  const IdentificationResult& result = report.result;
-  YAML::Emitter out;
-  out.SetDoublePrecision(17);
-  out << YAML::BeginMap;
-  out << YAML::Key << "status" << YAML::Value << FitStatusName(result.status);
-  out << YAML::Key << "status_message" << YAML::Value << result.message;
-  out << YAML::Key << "dwellfit_version" << YAML::Value << DwellfitVersion();
-  out << YAML::Key << "config" << YAML::Value << report.config_path;
-  EmitParameters(report, &out);
-  EmitUncertainty(report, &out);
-  EmitStarts(report, &out);
-  out << YAML::Key << "final_cost" << YAML::Value << result.final_cost;
-  out << YAML::Key << "iterations" << YAML::Value << result.iterations;
-  out << YAML::Key << "converged" << YAML::Value << result.converged;
-  out << YAML::Key << "fitted_points" << YAML::Value << result.residual_blocks;
-  out << YAML::Key << "stages" << YAML::Value << YAML::BeginSeq;
-  for (const StageSummary& stage : result.stages) EmitStage(stage, &out);
-  out << YAML::EndSeq;
-  out << YAML::Key << "sweeps" << YAML::Value << YAML::BeginSeq;
-  for (const SweepPrediction& prediction : report.predictions) EmitSweep(prediction, &out);
-  out << YAML::EndSeq;
-  if (!report.validation_intervals.levels.empty()) {
-    EmitValidationIntervals(report.validation_intervals, &out);
-  }
-  if (!report.level_refits.message.empty()) EmitLevelRefits(report.level_refits, &out);
-  out << YAML::EndMap;
-  std::string yaml = std::string(out.c_str()) + "\n";
-  if (!report.config_in_effect.empty()) {
-    AppendBlockMapping("config_in_effect", report.config_in_effect, &yaml);
-  }
-  return yaml;
-}
-
-std::string ReportToPredictionsCsv(const IdentificationReport& report) {
-  size_t rows = 0;
-  for (const SweepPrediction& prediction : report.predictions) {
-    rows += prediction.sweep->points.size();
-  }
-  CsvText csv("sweep,direction,role,freq_hz,a_base,a,a_model,branch,model_status",
-              (rows + 1) * kPredictionRowBytes);
-  for (const SweepPrediction& prediction : report.predictions) {
-    const Sweep& sweep = *prediction.sweep;
-    const char* direction = SweepDirectionName(sweep.direction);
-    for (size_t i = 0; i < sweep.points.size(); ++i) {
-      const DwellPoint& point = sweep.points[i];
-      const StableRoot& model = prediction.model[i];
-      csv.Text(sweep.id);
-      csv.Text(direction);
-      csv.Text(Role(prediction));
-      for (double value : {RadPerSecondToHz(point.drive_frequency_rad_s), point.a_base,
-                           point.amplitude, model.a}) {
-        csv.Number(value);
-      }
-      csv.Text(BranchName(point.branch));
-      csv.Text(model.status == RootStatus::kOnBranch    ? "on_branch"
-               : model.status == RootStatus::kBranchEnd ? "branch_end"
-                                                        : "failed");
-      csv.EndRow();
-    }
-  }
-  return std::move(csv).Release();
-}
-
-namespace {
 
 void PrintStages(const IdentificationResult& result, std::ostream& out) {
   for (const StageSummary& stage : result.stages) {
@@ -561,6 +483,70 @@ void PrintLevelRefits(const IdentificationReport& report, std::ostream& out) {
 }
 
 }  // namespace
+
+std::string ReportToYaml(const IdentificationReport& report) {
+  const IdentificationResult& result = report.result;
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap;
+  out << YAML::Key << "status" << YAML::Value << FitStatusName(result.status);
+  out << YAML::Key << "status_message" << YAML::Value << result.message;
+  out << YAML::Key << "dwellfit_version" << YAML::Value << DwellfitVersion();
+  out << YAML::Key << "config" << YAML::Value << report.config_path;
+  EmitParameters(report, &out);
+  EmitUncertainty(report, &out);
+  EmitStarts(report, &out);
+  out << YAML::Key << "final_cost" << YAML::Value << result.final_cost;
+  out << YAML::Key << "iterations" << YAML::Value << result.iterations;
+  out << YAML::Key << "converged" << YAML::Value << result.converged;
+  out << YAML::Key << "fitted_points" << YAML::Value << result.residual_blocks;
+  out << YAML::Key << "stages" << YAML::Value << YAML::BeginSeq;
+  for (const StageSummary& stage : result.stages) EmitStage(stage, &out);
+  out << YAML::EndSeq;
+  out << YAML::Key << "sweeps" << YAML::Value << YAML::BeginSeq;
+  for (const SweepPrediction& prediction : report.predictions) EmitSweep(prediction, &out);
+  out << YAML::EndSeq;
+  if (!report.validation_intervals.levels.empty()) {
+    EmitValidationIntervals(report.validation_intervals, &out);
+  }
+  if (!report.level_refits.message.empty()) EmitLevelRefits(report.level_refits, &out);
+  out << YAML::EndMap;
+  std::string yaml = std::string(out.c_str()) + "\n";
+  if (!report.config_in_effect.empty()) {
+    AppendBlockMapping("config_in_effect", report.config_in_effect, &yaml);
+  }
+  return yaml;
+}
+
+std::string ReportToPredictionsCsv(const IdentificationReport& report) {
+  size_t rows = 0;
+  for (const SweepPrediction& prediction : report.predictions) {
+    rows += prediction.sweep->points.size();
+  }
+  CsvText csv("sweep,direction,role,freq_hz,a_base,a,a_model,branch,model_status",
+              (rows + 1) * kPredictionRowBytes);
+  for (const SweepPrediction& prediction : report.predictions) {
+    const Sweep& sweep = *prediction.sweep;
+    const char* direction = SweepDirectionName(sweep.direction);
+    for (size_t i = 0; i < sweep.points.size(); ++i) {
+      const DwellPoint& point = sweep.points[i];
+      const StableRoot& model = prediction.model[i];
+      csv.Text(sweep.id);
+      csv.Text(direction);
+      csv.Text(Role(prediction));
+      for (double value : {RadPerSecondToHz(point.drive_frequency_rad_s), point.a_base,
+                           point.amplitude, model.a}) {
+        csv.Number(value);
+      }
+      csv.Text(BranchName(point.branch));
+      csv.Text(model.status == RootStatus::kOnBranch    ? "on_branch"
+               : model.status == RootStatus::kBranchEnd ? "branch_end"
+                                                        : "failed");
+      csv.EndRow();
+    }
+  }
+  return std::move(csv).Release();
+}
 
 void PrintReport(const IdentificationReport& report, std::ostream& out) {
   PrintStages(report.result, out);

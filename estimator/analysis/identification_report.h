@@ -1,6 +1,6 @@
-// What an identification run reports: the estimates, how the solver ended,
-// and the model beside every measured dwell of the fitted and validation
-// sweeps, as result.yaml, predictions.csv and a printed summary.
+// What an identification run reports (result.yaml, predictions.csv and a
+// printed summary): the estimates, how the solver ended, and the model beside
+// every measured dwell.
 #ifndef DWELLFIT_ESTIMATOR_ANALYSIS_IDENTIFICATION_REPORT_H_
 #define DWELLFIT_ESTIMATOR_ANALYSIS_IDENTIFICATION_REPORT_H_
 
@@ -20,9 +20,8 @@ namespace dwellfit {
 
 struct IdentificationReport {
   std::string config_path;
-  // The configuration in effect (overrides applied) as a YAML block mapping,
-  // recorded in result.yaml when set (identify leaves out output_dir and the
-  // thread counts, which cannot change the result).
+  // The configuration in effect as a YAML block mapping, recorded in
+  // result.yaml when set.
   std::string config_in_effect;
   IdentificationOptions options;  // the start and the fixed parameters
   IdentificationResult result;
@@ -33,9 +32,7 @@ struct IdentificationReport {
   // The starts and how many reached the best (one start: trivially 1 of 1).
   MultiStartResult multi_start;
   ParameterUncertainty uncertainty;
-  // Model error (docs/uncertainty.md, "Model error"), set by AddModelError:
-  // the validation sweeps' 95 % prediction intervals, and the
-  // leave-one-level-out refits of the fitted levels.
+  // Model error (docs/uncertainty.md), set by AddModelError.
   ValidationIntervals validation_intervals;
   LevelRefits level_refits;
 };
@@ -49,18 +46,14 @@ IdentificationReport MakeIdentificationReport(const std::string& config_path,
                                               const std::vector<const Sweep*>& fitted,
                                               const std::vector<const Sweep*>& validation);
 
-// Fills report->validation_intervals (PredictValidationIntervals at the
-// report's estimate) and report->level_refits (RefitLeavingOneLevelOut with
-// report->options, whose `initial` is the reported fit's start, at
-// report->omega_ref_rad_s, on `threads`).
+// Fills report->validation_intervals and report->level_refits at the
+// report's estimate (report->options.initial: the reported fit's start).
 void AddModelError(const std::vector<const Sweep*>& fitted,
                    const std::vector<const Sweep*>& validation, int threads,
                    IdentificationReport* report);
 
-// result.yaml: the run's status and its reason, the dwellfit version, the
-// parameters (omega in rad/s), effective nonlinearity and its Omega_ref,
-// final_cost, iterations, stages, per-sweep errors, measured jump brackets,
-// the validation prediction intervals and leave-one-level-out refits (when
+// result.yaml: status and reason, version, parameters (omega in rad/s) and
+// their uncertainty, stages, per-sweep errors and jumps, model error (when
 // computed) and the configuration in effect.
 std::string ReportToYaml(const IdentificationReport& report);
 

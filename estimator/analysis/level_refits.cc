@@ -5,7 +5,6 @@
 
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/fit/identification.h"
-#include "tbb/blocked_range.h"
 #include "tbb/parallel_for.h"
 #include "tbb/task_arena.h"
 
@@ -89,17 +88,15 @@ std::vector<RefitSpread> SpreadOverRefits(const std::vector<LevelRefit>& refits,
     if (refit.usable) usable.push_back(&refit);
   }
   if (usable.size() < 2) return spread;
-  for (int j = 0; j < kNumParameters; ++j) {
-    if (fixed[j]) continue;
+  for (int j = 0; j <= kNumParameters; ++j) {  // kNumParameters: alpha_e
+    const bool parameter = j < kNumParameters;
+    if (parameter ? fixed[j] : fixed[kAlpha] && fixed[kDelta]) continue;
     std::vector<double> values;
-    for (const LevelRefit* refit : usable) values.push_back(refit->parameters[j]);
-    spread.push_back(SpreadOf(j, estimate[j], values));
-  }
-  if (!fixed[kAlpha] || !fixed[kDelta]) {
-    std::vector<double> values;
-    for (const LevelRefit* refit : usable) values.push_back(refit->effective_nonlinearity);
-    spread.push_back(
-        SpreadOf(kNumParameters, EffectiveNonlinearity(estimate, omega_ref_rad_s), values));
+    for (const LevelRefit* refit : usable) {
+      values.push_back(parameter ? refit->parameters[j] : refit->effective_nonlinearity);
+    }
+    spread.push_back(SpreadOf(
+        j, parameter ? estimate[j] : EffectiveNonlinearity(estimate, omega_ref_rad_s), values));
   }
   return spread;
 }
@@ -122,10 +119,8 @@ LevelRefits RefitLeavingOneLevelOut(const std::vector<const Sweep*>& fitted,
   result.refits.resize(count);
   tbb::task_arena arena(std::max(1, std::min(threads, count)));
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, count, 1), [&](const tbb::blocked_range<int>& r) {
-      for (int i = r.begin(); i < r.end(); ++i) {
-        result.refits[i] = Refit(fitted, refit_options, result.levels[i], omega_ref_rad_s);
-      }
+    tbb::parallel_for(0, count, [&](int i) {
+      result.refits[i] = Refit(fitted, refit_options, result.levels[i], omega_ref_rad_s);
     });
   });
   for (const LevelRefit& refit : result.refits) result.usable += refit.usable;

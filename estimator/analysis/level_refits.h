@@ -1,23 +1,19 @@
 // Leave-one-level-out refits: how much each parameter moves when one level
 // (a sweep id: its up and down sweeps together) is left out of the fit.
 //
-// Measured residuals are not independent noise: the dwells of one level
-// share its model error, so the statistical interval (its noise taken as
-// independent) can be much narrower than the estimate's dependence on which
-// levels were measured. With L >= kMinLevelsForRefits fitted levels, the fit
-// is run again L times, each time without one level: the same options (the
-// stages, residual, penalties, solver, fixed parameters) from the same start
-// as the reported fit (Identify), each refit's residuals on one thread, the
-// refits side by side on `threads`; the result does not depend on the
-// thread count. Warnings: a refit that is not usable, and an all-level
-// estimate outside the refits' range (beyond 1e-9 of its magnitude). Per
-// free parameter and for alpha_e (at the run's Omega_ref),
-// over the refits whose solution is usable (IsSolutionUsable, finite):
-//   - min and max of the refits' values, beside the all-level estimate;
-//   - the jackknife standard error
-//       se_J = sqrt((m - 1) / m sum_i (theta_i - theta_bar)^2),
-//     m the usable refits, theta_bar their mean: the spread scaled up to a
-//     fit on all the levels (each refit saw (m - 1) / m of them).
+// The dwells of one level share its model error, so the statistical
+// interval can be much narrower than the estimate's dependence on which
+// levels were measured. With L >= kMinLevelsForRefits fitted levels the fit
+// is run L more times, each without one level, with the reported fit's
+// options and start, side by side on `threads` (the result does not depend
+// on the count). Per free parameter and alpha_e, over the usable refits:
+// min and max beside the all-level estimate, and the jackknife standard error
+//
+//   se_J = sqrt((m - 1) / m sum_i (theta_i - theta_bar)^2),
+//
+// m the usable refits, theta_bar their mean (each refit saw (m - 1) / m of
+// the levels). Warnings: an unusable refit, and an all-level estimate
+// outside the refits' range (beyond 1e-9 of its magnitude).
 #ifndef DWELLFIT_ESTIMATOR_ANALYSIS_LEVEL_REFITS_H_
 #define DWELLFIT_ESTIMATOR_ANALYSIS_LEVEL_REFITS_H_
 
@@ -45,8 +41,8 @@ struct LevelRefit {
   double effective_nonlinearity = 0.0;
 };
 
-// One quantity's spread over the usable refits. Index kNumParameters is
-// alpha_e; omega in rad/s.
+// One quantity's spread over the usable refits (index kNumParameters:
+// alpha_e; omega in rad/s).
 struct RefitSpread {
   int index = 0;
   std::string name;       // ParameterName, or "alpha_e"
@@ -62,8 +58,6 @@ struct LevelRefits {
   std::vector<LevelRefit> refits;   // one per level, in its order
   int usable = 0;                   // refits counted in the spread
   std::vector<RefitSpread> spread;  // free parameters in ParameterIndex order, then alpha_e
-  // A refit that failed; an all-level estimate outside every refit's value
-  // (the levels disagree, or the all-level fit found another minimum).
   std::vector<std::string> warnings;
 };
 
@@ -72,16 +66,14 @@ std::vector<std::string> FittedLevels(const std::vector<const Sweep*>& fitted);
 
 // Runs the refits (see above) of the fit of `fitted` with `options`
 // (options.initial: the reported fit's start) whose estimate is `estimate`.
-// With fewer than kMinLevelsForRefits levels, computed = false and the
-// message says so. Never throws for a failed refit: its status says it.
+// Never throws for a failed refit: its status says it.
 LevelRefits RefitLeavingOneLevelOut(const std::vector<const Sweep*>& fitted,
                                     const IdentificationOptions& options,
                                     const ParameterVector& estimate, double omega_ref_rad_s,
                                     int threads);
 
 // The spread of each free parameter and alpha_e over the usable refits
-// (none with fewer than two). Part of RefitLeavingOneLevelOut; exposed for
-// tests.
+// (none with fewer than two); exposed for tests.
 std::vector<RefitSpread> SpreadOverRefits(const std::vector<LevelRefit>& refits,
                                           const std::array<bool, kNumParameters>& fixed,
                                           const ParameterVector& estimate, double omega_ref_rad_s);

@@ -20,10 +20,6 @@
 namespace dwellfit {
 namespace {
 
-// A tangent coordinate's entry of a null direction smaller than this (the
-// direction has unit length) does not implicate its parameter.
-constexpr double kNullDirectionShare = 0.1;
-
 std::string JoinNames(const std::vector<int>& parameters) {
   std::string joined;
   for (size_t i = 0; i < parameters.size(); ++i) {
@@ -49,13 +45,10 @@ std::string PairAdvice(int a, int b) {
          "one of them";
 }
 
-// The plain-words account of what the sweeps cannot see. `null_space` (k x r)
-// holds orthonormal null directions of the column-normalised Jacobian J_n;
-// `column_cosines` (k x k) is J_n^T J_n, the cosines between its columns;
-// `unit_scale` is the physical change of each tangent coordinate per unit.
-// A parameter is implicated when its row of `null_space` has a norm of at
-// least kNullDirectionShare (the row norms do not depend on which basis of
-// the null space the SVD returned).
+// The plain-words account of what the sweeps cannot see (BlockCovariance's
+// null_space, unit_scale, free and column_cosines). A parameter is
+// implicated when its row of `null_space` has a norm of at least
+// kNullDirectionShare (independent of the basis the SVD returned).
 std::string DescribeNullSpace(const Eigen::MatrixXd& null_space, const Eigen::VectorXd& unit_scale,
                               const std::vector<int>& free, const Eigen::MatrixXd& column_cosines) {
   std::vector<int> involved;
@@ -99,29 +92,38 @@ std::string DescribeNullSpace(const Eigen::MatrixXd& null_space, const Eigen::Ve
 }
 
 // The fitted dwells whose measured branch does not reach their a_base at
-// `parameters` (RootStatus::kBranchEnd): the vertical error then measures
-// them from the fold where that branch ends, and the cost has a kink as the
-// fold passes a dwell. Returns their number and names up to three of them.
-int DwellsPastTheirBranchEnd(const std::vector<const Sweep*>& fitted,
-                             const ParameterVector& parameters, std::string* examples) {
+// `estimate` (RootStatus::kBranchEnd): the vertical error then measures them
+// from the fold where that branch ends, and the cost has a kink as the fold
+// passes a dwell. Counts them and warns, naming up to three.
+void WarnAboutDwellsPastTheirBranchEnd(const std::vector<const Sweep*>& fitted,
+                                       const ParameterVector& estimate, ParameterUncertainty* u) {
   int count = 0;
+  std::string examples;
   for (const Sweep* sweep : fitted) {
     for (const DwellPoint& point : sweep->points) {
-      const auto k = ResponseCoefficients<double>::FromParameters(parameters.data(),
+      const auto k = ResponseCoefficients<double>::FromParameters(estimate.data(),
                                                                   point.drive_frequency_rad_s);
       if (SolveStableRoot(k, point.a_base, point.branch, point.amplitude).status !=
           RootStatus::kBranchEnd) {
         continue;
       }
       if (++count > 3) continue;
-      if (!examples->empty()) *examples += ", ";
-      *examples += sweep->kind == SweepKind::kFrequency
-                       ? StringPrintf("%s at %.4g Hz", sweep->Name().c_str(),
-                                      RadPerSecondToHz(point.drive_frequency_rad_s))
-                       : StringPrintf("%s at a_base %.4g", sweep->Name().c_str(), point.a_base);
+      if (!examples.empty()) examples += ", ";
+      examples += sweep->kind == SweepKind::kFrequency
+                      ? StringPrintf("%s at %.4g Hz", sweep->Name().c_str(),
+                                     RadPerSecondToHz(point.drive_frequency_rad_s))
+                      : StringPrintf("%s at a_base %.4g", sweep->Name().c_str(), point.a_base);
     }
   }
-  return count;
+  u->dwells_past_branch_end = count;
+  if (count == 0) return;
+  u->warnings.push_back(StringPrintf(
+      "%d fitted dwell(s) lie past the end of their branch at the estimate (%s%s): the model's "
+      "fold falls short of where they were measured and the fit is not smooth there; where the "
+      "sweep's measured jump ends that branch the intervals are widened by the move back to it "
+      "(label pulls), elsewhere they may be too narrow; check the branch labels or enable the "
+      "branch-stability penalty",
+      count, examples.c_str(), count > 3 ? ", ..." : ""));
 }
 
 // One enforced jump of the bifurcation-range penalty at the estimate: its
@@ -191,26 +193,8 @@ std::vector<PenaltyCurvature> EnforcedJumps(const std::vector<const Sweep*>& fit
   return terms;
 }
 
-ParameterUncertainty Unavailable(ParameterUncertainty u, const std::string& message) {
-  ParameterUncertainty out;
-  out.available = false;
-  out.message = message;
-  out.num_points = u.num_points;
-  out.num_free = u.num_free;
-  out.degrees_of_freedom = u.degrees_of_freedom;
-  out.noise_sigma = std::isfinite(u.noise_sigma) ? u.noise_sigma : 0.0;
-  out.reduced_chi_square = std::isfinite(u.reduced_chi_square) ? u.reduced_chi_square : 0.0;
-  out.collinearity = std::isnan(u.collinearity) ? 0.0 : u.collinearity;
-  out.omega_ref_rad_s = u.omega_ref_rad_s;
-  out.effective_nonlinearity = u.effective_nonlinearity;
-  out.dwells_past_branch_end = u.dwells_past_branch_end;
-  out.warnings = u.warnings;
-  out.interval_kind = u.interval_kind;
-  out.penalty_terms = u.penalty_terms;
-  return out;
-}
-
-// The covariance's counts, noise and collinearity in `u`.
+// The covariance's counts, noise and collinearity in `u`; its warnings
+// before those of `u`.
 void CopyCounts(const BlockCovariance& c, ParameterUncertainty* u) {
   u->num_points = c.num_points;
   u->num_free = c.num_free;
@@ -218,38 +202,22 @@ void CopyCounts(const BlockCovariance& c, ParameterUncertainty* u) {
   u->noise_sigma = c.noise_sigma;
   u->reduced_chi_square = c.reduced_chi_square;
   u->collinearity = c.collinearity;
-  u->warnings = c.warnings;
+  u->warnings.insert(u->warnings.begin(), c.warnings.begin(), c.warnings.end());
 }
 
 // Standard errors, intervals and correlations from the 6 x 6 covariance.
 void CopyIntervals(const BlockCovariance& c, ParameterUncertainty* u) {
   u->interval_quantile = c.interval_quantile;
   u->covariance = c.covariance;
-  for (int i = 0; i < kNumParameters; ++i) {
-    u->standard_error[i] = c.standard_error[i];
-    u->ci95_low[i] = c.ci95_low[i];
-    u->ci95_high[i] = c.ci95_high[i];
-  }
+  std::copy_n(c.standard_error.begin(), kNumParameters, u->standard_error.begin());
+  std::copy_n(c.ci95_low.begin(), kNumParameters, u->ci95_low.begin());
+  std::copy_n(c.ci95_high.begin(), kNumParameters, u->ci95_high.begin());
   for (int a : c.free) {
     for (int b : c.free) {
       const double denominator = u->standard_error[a] * u->standard_error[b];
       u->correlation(a, b) = a == b              ? 1.0
                              : denominator > 0.0 ? u->covariance(a, b) / denominator
                                                  : 0.0;
-    }
-  }
-}
-
-// Correlations of the free parameters from `sampling` (the covariance
-// without the bias terms, whose rank-one shares would make every pair look
-// collinear).
-void SetCorrelation(const std::vector<int>& free, const Eigen::MatrixXd& sampling,
-                    ParameterUncertainty* u) {
-  if (sampling.rows() != kNumParameters || sampling.cols() != kNumParameters) return;
-  for (int a : free) {
-    for (int b : free) {
-      const double denominator = std::sqrt(sampling(a, a) * sampling(b, b));
-      u->correlation(a, b) = a == b ? 1.0 : denominator > 0.0 ? sampling(a, b) / denominator : 0.0;
     }
   }
 }
@@ -295,21 +263,6 @@ void AddPairAndBoundWarnings(const std::vector<int>& free, const ParameterVector
                             "ignores the bound");
     }
   }
-}
-
-// The warning about fitted dwells past their branch's end, if any.
-void WarnAboutDwellsPastTheirBranchEnd(const std::vector<const Sweep*>& fitted,
-                                       const ParameterVector& estimate, ParameterUncertainty* u) {
-  std::string examples;
-  u->dwells_past_branch_end = DwellsPastTheirBranchEnd(fitted, estimate, &examples);
-  if (u->dwells_past_branch_end == 0) return;
-  u->warnings.push_back(StringPrintf(
-      "%d fitted dwell(s) lie past the end of their branch at the estimate (%s%s): the model's "
-      "fold falls short of where they were measured and the fit is not smooth there; where the "
-      "sweep's measured jump ends that branch the intervals are widened by the move back to it "
-      "(label pulls), elsewhere they may be too narrow; check the branch labels or enable the "
-      "branch-stability penalty",
-      u->dwells_past_branch_end, examples.c_str(), u->dwells_past_branch_end > 3 ? ", ..." : ""));
 }
 
 // A = J_d^T J_d / s^2 + sum_k (kappa_k / s^2) g_k g_k^T inverted: the
@@ -399,16 +352,10 @@ bool MakeProfileProblem(const std::vector<const Sweep*>& fitted,
   return problem->threshold > 0.0;
 }
 
-double Width(double low, double high) { return high - low; }
-
-// Replaces the linearised intervals in `u` by the profile's, keeps the
-// linearised ones beside them, and warns where the two differ by more than
+// Replaces the linearised intervals in `u` (kept in linearised_*) by the
+// profile's, and warns where the two differ by more than
 // kIntervalDisagreement or an end is open.
 void UseProfile(const ProfileLikelihood& profile, ParameterUncertainty* u) {
-  u->linearised_ci95_low = u->ci95_low;
-  u->linearised_ci95_high = u->ci95_high;
-  u->effective_nonlinearity_linearised_ci95_low = u->effective_nonlinearity_ci95_low;
-  u->effective_nonlinearity_linearised_ci95_high = u->effective_nonlinearity_ci95_high;
   u->profile = profile;
   u->interval_kind = "profile_likelihood";
   for (int q = 0; q <= kNumParameters; ++q) {
@@ -419,7 +366,7 @@ void UseProfile(const ProfileLikelihood& profile, ParameterUncertainty* u) {
     double& low = effective ? u->effective_nonlinearity_ci95_low : u->ci95_low[q];
     double& high = effective ? u->effective_nonlinearity_ci95_high : u->ci95_high[q];
     const char* name = effective ? "alpha_e" : ParameterName(q);
-    const double ratio = Width(low, high) / Width(interval.low, interval.high);
+    const double ratio = (high - low) / (interval.high - interval.low);
     if (interval.low_end == ProfileEnd::kOpen || interval.high_end == ProfileEnd::kOpen) {
       u->warnings.push_back(StringPrintf(
           "the data do not bound %s: its profile stays below the 95 %% threshold as far as the "
@@ -447,13 +394,14 @@ bool AtRoundOff(const ParameterUncertainty& u, const ParameterVector& estimate) 
   return true;
 }
 
-// The kind `method` asks for, in `u` (which holds the linearised one).
+// The profile intervals in `u` (which holds the linearised ones), or a note
+// in its message why not.
 void ProfileIntervals(const std::vector<const Sweep*>& fitted, const IdentificationOptions& options,
                       const ParameterVector& estimate, const FitSummary* summary,
                       const BlockCovariance& c, int threads, ParameterUncertainty* u) {
   if (AtRoundOff(*u, estimate)) {
-    u->message_notes.push_back(
-        "the residuals are at round-off (exact data): the linearised intervals are reported");
+    u->message +=
+        "; the residuals are at round-off (exact data): the linearised intervals are reported";
     return;
   }
   ProfileProblem problem;
@@ -481,25 +429,18 @@ bool MoveToLower(const ProfileProblem& problem, const ParameterVector& start,
 
 }  // namespace
 
+// In IntervalMethod's order.
+constexpr const char* kIntervalMethodNames[] = {"data_only", "linearised", "profile"};
+
 const char* IntervalMethodName(IntervalMethod method) {
-  switch (method) {
-    case IntervalMethod::kDataOnly:
-      return "data_only";
-    case IntervalMethod::kLinearised:
-      return "linearised";
-    case IntervalMethod::kProfile:
-      return "profile";
-  }
-  return "profile";
+  return kIntervalMethodNames[static_cast<int>(method)];
 }
 
 bool ParseIntervalMethod(const std::string& name, IntervalMethod* method) {
-  for (IntervalMethod candidate :
-       {IntervalMethod::kDataOnly, IntervalMethod::kLinearised, IntervalMethod::kProfile}) {
-    if (name == IntervalMethodName(candidate)) {
-      *method = candidate;
-      return true;
-    }
+  for (int i = 0; i < 3; ++i) {
+    if (name != kIntervalMethodNames[i]) continue;
+    *method = static_cast<IntervalMethod>(i);
+    return true;
   }
   return false;
 }
@@ -520,19 +461,16 @@ ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted
       method == IntervalMethod::kDataOnly || !data_only.available
           ? data_only
           : PenaltyCovariance(fitted, options, estimate, summary, data_only, &u);
-  const std::vector<std::string> own_warnings = u.warnings;
   CopyCounts(c, &u);
-  u.warnings.insert(u.warnings.end(), own_warnings.begin(), own_warnings.end());
   if (c.evaluated) WarnAboutDwellsPastTheirBranchEnd(fitted, estimate, &u);
   if (!c.available) {
     // Entries the data cannot tell apart are named in the model's terms.
-    const std::string message =
-        c.null_space.cols() == 0
-            ? c.message
-            : DescribeNullSpace(c.null_space, c.unit_scale, c.free, c.column_cosines) +
-                  StringPrintf(" (collinearity %.3g, limit %.3g)", c.collinearity,
-                               kMaxCollinearity);
-    return Unavailable(u, message);
+    u.message = c.null_space.cols() == 0
+                    ? c.message
+                    : DescribeNullSpace(c.null_space, c.unit_scale, c.free, c.column_cosines) +
+                          StringPrintf(" (collinearity %.3g, limit %.3g)", c.collinearity,
+                                       kMaxCollinearity);
+    return u;
   }
   CopyIntervals(c, &u);
   SetEffectiveNonlinearity(&u);
@@ -541,12 +479,11 @@ ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted
   u.linearised_ci95_high = u.ci95_high;
   u.effective_nonlinearity_linearised_ci95_low = u.effective_nonlinearity_ci95_low;
   u.effective_nonlinearity_linearised_ci95_high = u.effective_nonlinearity_ci95_high;
+  u.available = true;
+  u.message = c.message;
   if (method == IntervalMethod::kProfile) {
     ProfileIntervals(fitted, options, estimate, summary, c, threads, &u);
   }
-  u.available = true;
-  u.message = c.message;
-  for (const std::string& note : u.message_notes) u.message += "; " + note;
   if (u.interval_kind == "profile_likelihood") {
     u.message +=
         StringPrintf("; profile-likelihood intervals from %d constrained fits", u.profile.fits);
@@ -561,18 +498,17 @@ ParameterUncertainty EstimateUncertaintyAtMinimum(const std::vector<const Sweep*
                                                   double omega_ref_rad_s,
                                                   IdentificationResult* result, int threads) {
   ProfileProblem problem;
-  ParameterUncertainty scratch;
-  scratch.omega_ref_rad_s =
+  ParameterUncertainty u;
+  u.omega_ref_rad_s =
       omega_ref_rad_s > 0.0 ? omega_ref_rad_s : result->parameters[kNaturalFrequency];
-  if (!result->IsSolutionUsable() ||
-      !MakeProfileProblem(fitted, options, result, 1.0, 1, &scratch, &problem)) {
-    return EstimateUncertainty(fitted, options, result->parameters, omega_ref_rad_s, result,
-                               IntervalMethod::kProfile, threads);
+  const bool profiled = result->IsSolutionUsable() &&
+                        MakeProfileProblem(fitted, options, result, 1.0, 1, &u, &problem);
+  if (profiled) {
+    u = EstimateUncertainty(fitted, options, result->parameters, omega_ref_rad_s, result,
+                            IntervalMethod::kLinearised);
   }
   // Exact data: nothing to profile (EstimateUncertainty says so).
-  ParameterUncertainty u = EstimateUncertainty(fitted, options, result->parameters, omega_ref_rad_s,
-                                               result, IntervalMethod::kLinearised);
-  if (!u.available || AtRoundOff(u, result->parameters)) {
+  if (!profiled || !u.available || AtRoundOff(u, result->parameters)) {
     return EstimateUncertainty(fitted, options, result->parameters, omega_ref_rad_s, result,
                                IntervalMethod::kProfile, threads);
   }

@@ -7,6 +7,7 @@
 
 #include "Eigen/Dense"
 #include "dwellfit/estimator/analysis/sweep_prediction.h"
+#include "dwellfit/estimator/fit/problem_builder.h"
 #include "dwellfit/residuals/model/stable_root.h"
 
 namespace dwellfit {
@@ -20,7 +21,7 @@ const char* const kPredictionIntervalRule =
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// Relative step of the central differences (see Step).
+// Relative step of the central differences (see Derivatives).
 constexpr double kRelativeStep = 1e-5;
 
 // The values `PredictHeldOut` predicts under `p`, in its order: each
@@ -48,12 +49,19 @@ std::vector<double> Quantities(const ParameterVector& p, const Sweep& sweep,
   return values;
 }
 
-// The central-difference step of parameter j at p: kRelativeStep of its
+// `scale` d Quantities / d p_j by central differences: step kRelativeStep of p_j's
 // magnitude, or 1e-6 for a parameter at 0 (delta, mu2: their effect is
 // linear near 0, so the step's size hardly matters).
-double Step(const ParameterVector& p, int j) {
-  const double magnitude = std::abs(p[j]);
-  return magnitude > 0.0 ? kRelativeStep * magnitude : 1e-6;
+std::vector<double> Derivatives(const ParameterVector& p, int j, const Sweep& sweep,
+                                const std::vector<int>& dwells, double scale = 1.0) {
+  const double h = std::abs(p[j]) > 0.0 ? kRelativeStep * std::abs(p[j]) : 1e-6;
+  ParameterVector plus = p, minus = p;
+  plus[j] += h;
+  minus[j] -= h;
+  std::vector<double> up = Quantities(plus, sweep, dwells);
+  const std::vector<double> down = Quantities(minus, sweep, dwells);
+  for (std::size_t q = 0; q < up.size(); ++q) up[q] = scale * (up[q] - down[q]) / (2.0 * h);
+  return up;
 }
 
 }  // namespace
@@ -81,22 +89,17 @@ std::vector<HeldOutPrediction> PredictHeldOut(const Sweep& sweep, const Paramete
   const std::vector<int> dwells = UpperBranchDwells(sweep);
   if (sweep.kind == SweepKind::kFrequency) {
     for (const JumpBracket& jump : sweep.jumps) {
-      HeldOutPrediction p;
-      p.sweep = sweep.Name();
-      p.quantity =
-          jump.kind == JumpKind::kJumpDown ? HeldOutQuantity::kJumpDown : HeldOutQuantity::kJumpUp;
-      p.measured = RadPerSecondToHz(jump.centre());
-      predictions.push_back(p);
+      const bool down = jump.kind == JumpKind::kJumpDown;
+      predictions.push_back({sweep.Name(),
+                             down ? HeldOutQuantity::kJumpDown : HeldOutQuantity::kJumpUp,
+                             RadPerSecondToHz(jump.centre())});
     }
   }
   if (!dwells.empty()) {
-    HeldOutPrediction p;
-    p.sweep = sweep.Name();
-    p.quantity = HeldOutQuantity::kUpperBranchAmplitude;
     double sum = 0.0;
     for (int i : dwells) sum += sweep.points[i].amplitude;
-    p.measured = sum / static_cast<double>(dwells.size());
-    predictions.push_back(p);
+    predictions.push_back({sweep.Name(), HeldOutQuantity::kUpperBranchAmplitude,
+                           sum / static_cast<double>(dwells.size())});
   }
   if (!usable) {
     for (HeldOutPrediction& p : predictions) p.predicted = p.half_width = kNaN;
@@ -105,26 +108,20 @@ std::vector<HeldOutPrediction> PredictHeldOut(const Sweep& sweep, const Paramete
   const std::vector<double> values = Quantities(parameters, sweep, dwells);
   std::vector<double> variance(values.size(), 0.0);
   if (covariance != nullptr) {
-    // g_q = d q / d p_j over the free parameters; s_p^2 = g^T C g.
-    std::vector<std::array<double, kNumParameters>> gradient(values.size());
-    for (auto& g : gradient) g.fill(0.0);
+    // g_q = d q / d p_j over the free parameters (column q); s_p^2 = g^T C g.
+    Eigen::Matrix<double, kNumParameters, Eigen::Dynamic> gradient =
+        Eigen::MatrixXd::Zero(kNumParameters, values.size());
     for (int j = 0; j < kNumParameters; ++j) {
       if (fixed[j] || (*covariance)(j, j) <= 0.0) continue;
-      const double h = Step(parameters, j);
-      ParameterVector plus = parameters, minus = parameters;
-      plus[j] += h;
-      minus[j] -= h;
-      const std::vector<double> up = Quantities(plus, sweep, dwells);
-      const std::vector<double> down = Quantities(minus, sweep, dwells);
+      const std::vector<double> derivatives = Derivatives(parameters, j, sweep, dwells);
       for (std::size_t q = 0; q < values.size(); ++q) {
-        const double derivative = (up[q] - down[q]) / (2.0 * h);
-        gradient[q][j] = std::isfinite(derivative) ? derivative : 0.0;
+        gradient(j, q) = std::isfinite(derivatives[q]) ? derivatives[q] : 0.0;
       }
     }
     for (std::size_t q = 0; q < values.size(); ++q) {
       for (int i = 0; i < kNumParameters; ++i) {
         for (int j = 0; j < kNumParameters; ++j) {
-          variance[q] += gradient[q][i] * (*covariance)(i, j) * gradient[q][j];
+          variance[q] += gradient(i, q) * (*covariance)(i, j) * gradient(j, q);
         }
       }
     }
@@ -150,14 +147,6 @@ Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& m) {
   return eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
 }
 
-bool Enforces(const IdentificationOptions& options, JumpKind kind) {
-  const BifurcationRangeOptions& range = options.solve.penalties.bifurcation_range;
-  const JumpTarget target =
-      kind == JumpKind::kJumpDown ? JumpTarget::kFrequencyJumpDown : JumpTarget::kFrequencyJumpUp;
-  return range.enabled &&
-         std::find(range.enforce.begin(), range.enforce.end(), target) != range.enforce.end();
-}
-
 }  // namespace
 
 ParameterMatrix PredictionCovariance(const ParameterMatrix& data_only,
@@ -171,32 +160,21 @@ ParameterMatrix PredictionCovariance(const ParameterMatrix& data_only,
   const int k = static_cast<int>(free.size());
   if (k == 0) return data_only;
   // Scaled coordinates: q_j = p_j / d_j, d_j = sqrt(C_d,jj).
-  Eigen::VectorXd d(k);
-  Eigen::MatrixXd scaled(k, k);
-  for (int a = 0; a < k; ++a) d[a] = std::sqrt(data_only(free[a], free[a]));
-  for (int a = 0; a < k; ++a) {
-    for (int b = 0; b < k; ++b) scaled(a, b) = data_only(free[a], free[b]) / (d[a] * d[b]);
-  }
+  const Eigen::VectorXd d = data_only.diagonal()(free).cwiseSqrt();
+  const Eigen::MatrixXd scaled = data_only(free, free).cwiseQuotient(d * d.transpose());
   Eigen::MatrixXd information = PseudoInverse(scaled);
   int observations = 0;
   for (const Sweep* sweep : fitted) {
     if (sweep->kind != SweepKind::kFrequency) continue;
     for (std::size_t q = 0; q < sweep->jumps.size(); ++q) {
       const JumpBracket& jump = sweep->jumps[q];
-      if (!Enforces(options, jump.kind)) continue;
+      if (!IsEnforced(options.solve.penalties.bifurcation_range, *sweep, jump)) continue;
       const double h_k = RadPerSecondToHz(jump.half_width());
       Eigen::VectorXd g(k);
       bool finite = h_k > 0.0;
       for (int a = 0; a < k && finite; ++a) {
-        // d f_k / d q_a = d_a d f_k / d p_j, by central differences in p_j.
-        const int j = free[a];
-        const double h = Step(parameters, j);
-        ParameterVector plus = parameters, minus = parameters;
-        plus[j] += h;
-        minus[j] -= h;
-        const std::vector<double> up = Quantities(plus, *sweep, {});
-        const std::vector<double> down = Quantities(minus, *sweep, {});
-        g[a] = d[a] * (up[q] - down[q]) / (2.0 * h);
+        // d f_k / d q_a = d_a d f_k / d p_j.
+        g[a] = Derivatives(parameters, free[a], *sweep, {}, d[a])[q];
         finite = std::isfinite(g[a]);
       }
       if (!finite) continue;
@@ -205,11 +183,8 @@ ParameterMatrix PredictionCovariance(const ParameterMatrix& data_only,
     }
   }
   if (observations == 0) return data_only;
-  const Eigen::MatrixXd combined = PseudoInverse(information);
   ParameterMatrix covariance = ParameterMatrix::Zero();
-  for (int a = 0; a < k; ++a) {
-    for (int b = 0; b < k; ++b) covariance(free[a], free[b]) = combined(a, b) * d[a] * d[b];
-  }
+  covariance(free, free) = d.asDiagonal() * PseudoInverse(information) * d.asDiagonal();
   return covariance;
 }
 
@@ -218,27 +193,13 @@ double HeldOutPrediction::ErrorPercent() const {
 }
 
 const char* HeldOutQuantityName(HeldOutQuantity quantity) {
-  switch (quantity) {
-    case HeldOutQuantity::kJumpDown:
-      return "jump-down";
-    case HeldOutQuantity::kJumpUp:
-      return "jump-up";
-    case HeldOutQuantity::kUpperBranchAmplitude:
-      return "upper-branch amplitude";
-  }
-  return "?";
+  static const char* const kNames[] = {"jump-down", "jump-up", "upper-branch amplitude"};
+  return kNames[static_cast<int>(quantity)];
 }
 
 const char* HeldOutQuantityKey(HeldOutQuantity quantity) {
-  switch (quantity) {
-    case HeldOutQuantity::kJumpDown:
-      return "jump_down";
-    case HeldOutQuantity::kJumpUp:
-      return "jump_up";
-    case HeldOutQuantity::kUpperBranchAmplitude:
-      return "upper_branch_amplitude";
-  }
-  return "?";
+  static const char* const kKeys[] = {"jump_down", "jump_up", "upper_branch_amplitude"};
+  return kKeys[static_cast<int>(quantity)];
 }
 
 double MedianOf(std::vector<double> values) {

@@ -1,19 +1,13 @@
-// 95 % prediction intervals of sweeps a fit did not see: of each measured
-// jump's frequency (frequency sweeps) and of the upper-branch amplitude, the
-// one rule used by `identify` (its validation sweeps) and `select_model`
-// (its held-out levels). docs/model-selection.md and docs/uncertainty.md
-// ("Model error") state it with the beam's numbers.
+// 95 % prediction intervals of sweeps a fit did not see, the one rule of
+// `identify` (validation sweeps) and `select_model` (held-out levels);
+// docs/model-selection.md and docs/uncertainty.md give the beam's numbers.
 //
-// The predicted quantities of a sweep (PredictHeldOut):
-//   - each measured jump: the model's fold nearest the bracket (PredictJumps)
-//     in Hz, against the bracket's centre; NaN when the model lacks the fold;
-//   - the upper-branch amplitude of an up-sweep with a measured jump-down:
-//     the mean measured amplitude A of its dwells before the jump whose
-//     amplitude exceeds half the sweep's peak (UpperBranchDwells), against
-//     the mean of the model's amplitudes on that branch at the same dwells.
+// Predicted quantities (PredictHeldOut): each measured jump's fold nearest
+// the bracket (Hz, against the bracket's centre; NaN without the fold), and
+// an up-sweep's upper-branch amplitude (UpperBranchDwells: mean model
+// against mean measured amplitude).
 //
-// The interval of a predicted quantity q at one level (a sweep id: its up
-// and down sweeps together):
+// The interval of q at one level (a sweep id: its up and down sweeps):
 //
 //   q_model +/- z sqrt(s_p^2 + s_m^2),   z = 1.95996 (normal, 0.975),
 //
@@ -22,11 +16,8 @@
 //     at 0), C the fit's prediction covariance (PredictionCovariance): its
 //     dwells-alone covariance with each enforced jump as one observation;
 //   - s_m = |q_model| x the RMS of the relative errors (q_model - q) / q of
-//     the same quantity at every *other* level predicted from the same fit:
-//     the model error those levels show, none of it from the level itself.
-//     With no other level, s_m = 0.
-// A prediction is inside when |q_model - q| <= half-width; a missing
-// prediction (no fold) has no interval and counts outside.
+//     the same quantity at every *other* level (0 without one).
+// Inside: |q_model - q| <= half-width; a missing prediction counts outside.
 #ifndef DWELLFIT_ESTIMATOR_ANALYSIS_PREDICTION_INTERVALS_H_
 #define DWELLFIT_ESTIMATOR_ANALYSIS_PREDICTION_INTERVALS_H_
 
@@ -84,27 +75,21 @@ struct PredictionCoverage {
 // Median of `values`; NaN when empty.
 double MedianOf(std::vector<double> values);
 
-// The dwells of the upper branch of an up frequency sweep with a measured
-// jump-down: those before the jump whose amplitude exceeds half the sweep's
-// peak (indices into sweep.points). Empty for any other sweep.
+// The dwells (indices) of an up frequency sweep before its measured
+// jump-down whose amplitude exceeds half the sweep's peak; else none.
 std::vector<int> UpperBranchDwells(const Sweep& sweep);
 
-// The predictions of `sweep`'s measured jumps (frequency sweeps only) and of
-// its upper-branch amplitude, under `parameters` (none usable: every
-// prediction NaN). With `covariance` (physical units, zero rows for fixed
-// parameters), each prediction's parameter_sd by the delta method over the
-// parameters `fixed` leaves free; without it, 0. model_sd, half_width and
-// inside are left for AddPredictionIntervals.
+// The predictions of `sweep` under `parameters` (not `usable`: NaN), with
+// parameter_sd from `covariance` over the parameters `fixed` leaves free (0
+// without it); the rest is left for AddPredictionIntervals.
 std::vector<HeldOutPrediction> PredictHeldOut(const Sweep& sweep, const ParameterVector& parameters,
                                               bool usable, const ParameterMatrix* covariance,
                                               const std::array<bool, kNumParameters>& fixed);
 
-// The covariance a fit's predictions are uncertain by: the fit's
-// dwells-alone covariance C_d (EstimateUncertainty, kDataOnly) with every
-// enforced jump of the fitted frequency sweeps (the bifurcation-range
-// penalty's, when on) taken as one observation of its fold frequency f_k
-// with the bracket's half-width h_k as standard deviation -- what the
-// penalty holds it to:
+// The covariance of a fit's predictions: its dwells-alone covariance C_d
+// (IntervalMethod::kDataOnly) with every jump the bifurcation-range penalty
+// enforces as one observation of its fold frequency f_k, standard deviation
+// the bracket's half-width h_k:
 //   C = (C_d^+ + sum_k g_k g_k^T / h_k^2)^+,   g_k = d f_k / d p,
 // on the free parameters, computed in the scale of C_d's diagonal (^+: the
 // pseudo-inverse, eigenvalues below 1e-12 of the largest dropped). Without
@@ -114,17 +99,15 @@ ParameterMatrix PredictionCovariance(const ParameterMatrix& data_only,
                                      const IdentificationOptions& options,
                                      const ParameterVector& parameters);
 
-// PredictionCovariance of the fit of `fitted` at `parameters`, C_d
-// estimated here; none when the dwells-alone covariance is not available
-// (`why`, when given, says why).
+// PredictionCovariance with C_d estimated here; none (`why` says why) when
+// it is not available.
 std::optional<ParameterMatrix> FitPredictionCovariance(const std::vector<const Sweep*>& fitted,
                                                        const IdentificationOptions& options,
                                                        const ParameterVector& parameters,
                                                        std::string* why = nullptr);
 
 // Fills model_sd, half_width and inside of every prediction of every level
-// (levels[i]: the predictions of level i, all from one fit or each from its
-// own, see above) and returns the coverage of each quantity.
+// and returns the coverage of each quantity.
 PredictionCoverage AddPredictionIntervals(
     const std::vector<std::vector<HeldOutPrediction>*>& levels);
 
@@ -141,11 +124,9 @@ struct ValidationIntervals {
   std::string note;
 };
 
-// Predicts every validation sweep at the fit's `parameters` (usable: the
-// fit gave a solution), with intervals; the levels are the validation
-// sweeps' ids (those with something to predict: a measured jump of a
-// frequency sweep, an upper branch), and each level's s_m comes from the
-// other validation levels.
+// Predicts every validation sweep at the fit's `parameters`, with
+// intervals; levels are the validation sweep ids with something to predict,
+// each level's s_m from the others.
 ValidationIntervals PredictValidationIntervals(const std::vector<const Sweep*>& fitted,
                                                const std::vector<const Sweep*>& validation,
                                                const IdentificationOptions& options,

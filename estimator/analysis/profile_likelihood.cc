@@ -28,17 +28,15 @@ constexpr int kNone = -1;
 // this share of the estimate; a profile still below the threshold there
 // reaches the bound 0.
 constexpr double kPositiveFloorShare = 1e-3;
-// The first trial's share of the linearised interval's half-width: where
-// the linearisation is right the second trial (the secant, 4x) lands on the
-// end; where it is many times too wide (a penalty's flat-bottomed wall, a
-// valley) the first trial stays near enough for its fit to stay in the
-// estimate's basin.
+// The first trial's share of the linearised half-width: where the
+// linearisation is right the second trial (secant, 4x) lands on the end;
+// where it is far too wide (a penalty's wall, a valley) the first fit stays
+// in the estimate's basin.
 constexpr double kFirstStepShare = 0.25;
 // A profile's constrained fits end when an iteration lowers the cost by less
-// than this share of Delta (relative to the cost: 1e-6 on the measured
-// beam, where Delta is 1e-3 of the cost; the solver's own tolerance, 1e-8,
-// where that is larger): the ends are then found to well within
-// kProfileTolerance at a third fewer iterations.
+// than this share of Delta (or the solver's own tolerance, if looser): 1e-6
+// relative on the measured beam, the ends well within kProfileTolerance at a
+// third fewer iterations.
 constexpr double kProfileCostShare = 1e-3;
 
 // The block's free entries step in units of their scale (as
@@ -97,10 +95,9 @@ double AlphaETie(const ProfileProblem& problem) {
   return (2.0 / 3.0) * problem.omega_ref_rad_s * problem.omega_ref_rad_s;
 }
 
-// Minimises the cost from `p` with `held` entries kept (and alpha tied to
-// delta when `tie`), to the looser of the solver's function tolerance and
-// `function_tolerance`. Returns the final cost, infinity when it cannot be
-// evaluated.
+// Minimises the cost from `p` with `held` entries kept (alpha tied to delta
+// when `tie`) to the looser of the solver's and `function_tolerance`.
+// Returns the final cost, infinity when it cannot be evaluated.
 double MinimiseHeld(const ProfileProblem& problem, const std::array<bool, kNumParameters>& held,
                     bool tie, double function_tolerance, ParameterVector* p) {
   const FitDescription fit = SingleBlockFit(problem.fitted, held, p);
@@ -174,8 +171,8 @@ bool IsProfiled(const ProfileProblem& problem, int quantity) {
   return !problem.fixed[quantity];
 }
 
-// The lowest value a trial may take on the lower side (-infinity: none),
-// and whether reaching it means the bound 0.
+// The lowest value a trial may take on the lower side (-infinity: none);
+// reaching it means the bound 0.
 double LowerFloor(int quantity, double estimate) {
   if (quantity == kMu1 || quantity == kMu2) return 0.0;
   if (quantity == kEtaE || quantity == kNaturalFrequency) {
@@ -196,6 +193,18 @@ struct SideResult {
   int fits = 0;
   std::optional<Trial> lower;  // the lowest constrained fit below F^
   double lower_cost = kInfinity;
+
+  // Keeps `trial` when its `cost` is the lowest below F^ so far.
+  void NoteLower(const Trial& trial, double cost, double minimum_cost) {
+    if (!(cost < minimum_cost * (1.0 - kLowerCostTolerance) && cost < lower_cost)) return;
+    lower = trial;
+    lower_cost = cost;
+  }
+  SideResult& End(double at, ProfileEnd how) {
+    end = at;
+    kind = how;
+    return *this;
+  }
 };
 
 // One side's search (see the header): the quantity, its direction, the
@@ -208,10 +217,9 @@ struct Side {
   double first_step = 0.0;
 };
 
-// The next trial: secant from the estimate (no trial outside yet; growth
-// 1.5x to 4x the last step), else false position in z between the last
-// trial inside and the first outside (kept 10 % inside the bracket),
-// bisection where the outside trial could not be evaluated.
+// The next trial: secant from the estimate while none is outside (growth
+// 1.5x to 4x), else false position in z between the last inside and the
+// first outside (10 % inside the bracket), bisection where z is infinite.
 double NextTrial(const Trial& centre, const Trial& inside, const std::optional<Trial>& outside,
                  const Side& side, double target) {
   if (!outside) {
@@ -234,8 +242,7 @@ double Interpolate(const Trial& inside, const Trial& outside, double target) {
 }
 
 // The warm start of a trial at `t`: the last fit inside moved along the
-// path (the secant through the last two fits inside, else the linearised
-// one), inside the model's range.
+// path (see the header), inside the model's range.
 ParameterVector WarmStart(const Trial& inside, const std::optional<Trial>& before, const Side& side,
                           double t) {
   ParameterVector p = inside.p;
@@ -258,7 +265,7 @@ SideResult SearchSide(const ProfileProblem& problem, const Side& side, double mi
                            ? LowerFloor(side.quantity, centre.t)
                            : -kInfinity;
   SideResult result;
-  if (centre.t <= floor) return {0.0, ProfileEnd::kBound, 0, std::nullopt, kInfinity};
+  if (centre.t <= floor) return result.End(0.0, ProfileEnd::kBound);
   Trial inside = centre;
   std::optional<Trial> before, outside;
   while (result.fits < kMaxProfileFitsPerSide) {
@@ -282,37 +289,22 @@ SideResult SearchSide(const ProfileProblem& problem, const Side& side, double mi
         trial.p = again;
       }
     }
-    if (cost < minimum_cost * (1.0 - kLowerCostTolerance) && cost < result.lower_cost) {
-      result.lower = trial;
-      result.lower_cost = cost;
-    }
+    result.NoteLower(trial, cost, minimum_cost);
     trial.z = std::isfinite(cost) ? std::sqrt(std::max(cost - minimum_cost, 0.0)) : kInfinity;
     if (std::abs(trial.z / target - 1.0) <= kProfileTolerance) {
-      result.end = trial.t;
-      result.kind = ProfileEnd::kCrossed;
-      return result;
+      return result.End(trial.t, ProfileEnd::kCrossed);
     }
     if (trial.z < target) {
       before = inside;
       inside = trial;
-      if (at_floor) {
-        result.end = 0.0;
-        result.kind = ProfileEnd::kBound;
-        return result;
-      }
+      if (at_floor) return result.End(0.0, ProfileEnd::kBound);
     } else {
       outside = trial;
     }
     if (outside && std::abs(outside->t - inside.t) <= 1e-9 * std::abs(centre.t)) break;
   }
-  if (outside) {
-    result.end = Interpolate(inside, *outside, target);
-    result.kind = ProfileEnd::kCrossed;
-  } else {
-    result.end = side.sign * kInfinity;
-    result.kind = ProfileEnd::kOpen;
-  }
-  return result;
+  if (outside) return result.End(Interpolate(inside, *outside, target), ProfileEnd::kCrossed);
+  return result.End(side.sign * kInfinity, ProfileEnd::kOpen);
 }
 
 // The constrained fit with the quantity held at the estimate's own value,
@@ -321,12 +313,9 @@ SideResult FitAtEstimate(const ProfileProblem& problem, int quantity,
                          const ParameterVector& estimate, double minimum_cost) {
   SideResult result;
   Trial trial{ValueOf(problem, quantity, estimate), 0.0, estimate};
-  const double cost = ConstrainedMinimum(problem, quantity, trial.t, minimum_cost, &trial.p);
+  result.NoteLower(trial, ConstrainedMinimum(problem, quantity, trial.t, minimum_cost, &trial.p),
+                   minimum_cost);
   result.fits = 1;
-  if (cost < minimum_cost * (1.0 - kLowerCostTolerance)) {
-    result.lower = trial;
-    result.lower_cost = cost;
-  }
   return result;
 }
 
@@ -360,15 +349,8 @@ Side MakeSide(const ProfileProblem& problem, int quantity, double sign,
 }  // namespace
 
 const char* ProfileEndName(ProfileEnd end) {
-  switch (end) {
-    case ProfileEnd::kCrossed:
-      return "crossed";
-    case ProfileEnd::kBound:
-      return "bound";
-    case ProfileEnd::kOpen:
-      return "open";
-  }
-  return "open";
+  static const char* const kNames[] = {"crossed", "bound", "open"};
+  return kNames[static_cast<int>(end)];
 }
 
 double RefitProfileProblem(const ProfileProblem& problem, ParameterVector* p) {
@@ -383,16 +365,14 @@ ProfileLikelihood ProfileCost(const ProfileProblem& problem, const ParameterVect
   profile.minimum_cost =
       MinimiseHeld(problem, std::array<bool, kNumParameters>{true, true, true, true, true, true},
                    false, 0.0, &at_estimate);
-  // Every side of every profiled quantity, in a fixed order: 2 q + (side > 0).
   std::vector<int> quantities;
   for (int q = 0; q <= kEffective; ++q) {
     if (IsProfiled(problem, q)) quantities.push_back(q);
   }
-  // Per quantity three searches, in a fixed order (3 q + k): the lower side,
-  // the upper side, and the constrained fit at the estimate's own value
-  // (the fit of the others with it held where it is: a lower cost there
-  // shows a fit that stopped short along a valley, or a parameter on its
-  // bound whose neighbours were not at their minimum).
+  // Per quantity three searches (3 q + k): the lower side, the upper side,
+  // and the fit at the estimate's own value (a lower cost there shows a fit
+  // that stopped short along a valley, or a parameter on its bound whose
+  // neighbours were not at their minimum).
   std::vector<SideResult> sides(3 * quantities.size());
   const auto search = [&](size_t i) {
     const int q = quantities[i / 3];

@@ -1,46 +1,33 @@
 // Profile-likelihood intervals of the fitted cost.
 //
-// With F(p) the cost the fit minimised (the dwells' vertical error,
-// (1/2) sum r_i^2, plus the penalties of its last stage at the weights that
-// stage used, FitSummary's StageSummary::penalties) and F^ = F(p^) its
-// minimum, the profile of a quantity theta (one free parameter, or the
-// effective nonlinearity alpha_e = alpha - (2/3) delta Omega_ref^2) is
+// With F(p) the cost the fit minimised (the dwells' vertical error plus the
+// penalties of its last stage at the weights it used) and F^ = F(p^), the
+// profile of a quantity theta (a free parameter, or alpha_e = alpha - (2/3)
+// delta Omega_ref^2) is
 //
 //   F_theta(t) = min { F(p) : theta(p) = t, bounds kept },
 //
-// and its 95 % interval is the set where the profile rises at most
+// and its 95 % interval is where the profile rises at most Delta = q^2 s^2 / 2
+// above F^ (q and s as for the linearised interval, parameter_uncertainty.h).
+// For a model linear in its parameters this is the Gauss-Newton interval; on
+// a nonlinear model, near a bound or at the penalties' flat-bottomed walls
+// (eq. 3.17) it follows the cost: asymmetric and never past a bound.
 //
-//   Delta = q^2 s^2 / 2
+// Each end is found along one side by constrained fits at trial values t,
+// warm-started from the nearest fit inside moved along the profile's path
+// (first the linearised path p^ + (t - theta^) C g / (g^T C g), g = grad
+// theta; then the secant through the last two fits inside). The first trial
+// is a share of the linearised half-width, the next ones come from the
+// signed root z(t) = sqrt(F_theta(t) - F^), linear in t for a quadratic cost
+// (secant, then false position). An end is "crossed" when z is within
+// kProfileTolerance of sqrt(Delta), "bound" at the quantity's bound with the
+// profile still below, and "open" when the search ends without crossing
+// (reported as +/- infinity).
 //
-// above F^, q the interval quantile (Student's t with n - k degrees of
-// freedom when the noise s is estimated, 2 F_data / (n - k) = s^2; the
-// normal's 1.96 with point sigmas, s = 1). For a model linear in its
-// parameters this is exactly the Gauss-Newton interval p^ -/+ q se; on a
-// nonlinear model, near a bound or with the penalties' flat-bottomed walls
-// (eq. 3.17), it follows the cost itself: asymmetric, never past a bound
-// (eta_e, mu1, mu2 >= 0, w > 0), and as wide as the data (and the enforced
-// jumps) allow, where the linearisation can be far too wide or too narrow.
-//
-// Each end is found by a search along one side: constrained fits at trial
-// values t, each warm-started from the nearest fit inside the interval moved
-// along the profile's path (the linearised path p^ + (t - theta^) C g /
-// (g^T C g) from the estimate, C the linearised covariance and g the
-// gradient of theta; then the secant through the last two fits inside), the
-// first trial at the linearised interval's end, the
-// next trial from the signed root z(t) = sqrt(F_theta(t) - F^), which is
-// linear in t for a quadratic cost (secant from the estimate, then
-// false position between the last trial inside and the first outside). An
-// end is "crossed" when z is within kProfileTolerance of sqrt(Delta), "bound"
-// when the quantity's bound is reached with the profile still below the
-// threshold, and "open" when the search ends without crossing (the data do
-// not bound the quantity there: the end is reported as +/- infinity).
-//
-// Beside the two searches, each quantity gets one constrained fit at the
-// estimate's own value (held where it is, the others refitted). A
-// constrained fit that ends below F^ (by more than kLowerCostTolerance,
-// relative) shows that the estimate is no minimum: the lowest such point is
-// returned, and the caller fits again from it (EstimateUncertaintyAtMinimum,
-// parameter_uncertainty.h).
+// Each quantity also gets one constrained fit at the estimate's own value. A
+// constrained fit ending below F^ (kLowerCostTolerance) shows the estimate is
+// no minimum: the lowest such point is returned for the caller to fit again
+// from (EstimateUncertaintyAtMinimum).
 #ifndef DWELLFIT_ESTIMATOR_ANALYSIS_PROFILE_LIKELIHOOD_H_
 #define DWELLFIT_ESTIMATOR_ANALYSIS_PROFILE_LIKELIHOOD_H_
 
@@ -107,18 +94,13 @@ struct ProfileLikelihood {
   int fits = 0;             // every constrained fit
 };
 
-// Minimises the profile problem's cost over its free parameters from `p`
-// (updated), with nothing held but the fixed ones: a fit of the last stage
-// again, with its weights. Returns the final cost (infinity when the cost
-// cannot be evaluated).
+// Fits the last stage again from `p` (updated), only the fixed parameters
+// held; returns the final cost (infinity when it cannot be evaluated).
 double RefitProfileProblem(const ProfileProblem& problem, ParameterVector* p);
 
 // The profile intervals of every free parameter and of alpha_e around
-// `estimate` (a minimum of the problem's cost), from the linearised
-// covariance `covariance` (6 x 6, physical units, zero for fixed
-// parameters) and its interval quantile: the first trial is the
-// linearised interval's end (a tenth of the value's magnitude where that
-// is not finite or positive), warm-started on the linearised path.
+// `estimate`, from the linearised `covariance` (6 x 6, physical units) and
+// its interval quantile (first step and path, see above).
 ProfileLikelihood ProfileCost(const ProfileProblem& problem, const ParameterVector& estimate,
                               const Eigen::MatrixXd& covariance, double quantile);
 

@@ -6,22 +6,17 @@
 #include "dwellfit/residuals/model/fold_point.h"
 
 namespace dwellfit {
-
 namespace {
 
 PredictedJump PredictJump(const ParameterVector& p, const Sweep& sweep, JumpKind kind,
                           double guess_control) {
   PredictedJump predicted;
   predicted.kind = kind;
-  const JumpKind fold_kind = kind == JumpKind::kJumpUp ? JumpKind::kJumpUp : JumpKind::kJumpDown;
   const DwellPoint& first = sweep.points.front();
-  FoldPoint fold;
-  if (sweep.kind == SweepKind::kFrequency) {
-    fold =
-        SolveFrequencyFold(p.data(), first.a_base, fold_kind, guess_control, 1e-3 * guess_control);
-  } else {
-    fold = SolveAmplitudeFold(p.data(), first.drive_frequency_rad_s, fold_kind);
-  }
+  const FoldPoint fold =
+      sweep.kind == SweepKind::kFrequency
+          ? SolveFrequencyFold(p.data(), first.a_base, kind, guess_control, 1e-3 * guess_control)
+          : SolveAmplitudeFold(p.data(), first.drive_frequency_rad_s, kind);
   predicted.exists = fold.exists;
   predicted.control = fold.control;
   return predicted;

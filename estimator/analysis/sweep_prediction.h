@@ -28,9 +28,8 @@ struct PredictedJump {
   bool inside = false;   // measured and exists: the fold lies inside the bracket
 };
 
-// For every measured jump, the model's fold nearest the bracket; for a sweep
-// without a measured jump, the model's jump-up and jump-down (a frequency
-// sweep's searched from its amplitude peak).
+// For every measured jump, the model's fold nearest the bracket; without
+// one, the model's jump-up and jump-down (searched from the amplitude peak).
 std::vector<PredictedJump> PredictJumps(const ParameterVector& parameters, const Sweep& sweep);
 
 struct SweepPrediction {

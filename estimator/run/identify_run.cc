@@ -61,29 +61,19 @@ void MarkUnidentifiable(IdentificationReport* report) {
       result.message;
 }
 
-// Below this many dwells in the fitted and validation sweeps the parts after
-// the fit run one after the other on the calling thread: starting the thread
-// pool (0.6 ms the first time in a process) and waking a worker cost more
-// than they save (the thesis case, 456 dwells: 2 ms of work in all, no faster
-// on two threads). The beam's 24,576 gain.
+// Below this many dwells the parts after the fit run on the calling thread:
+// starting the thread pool (0.6 ms) costs more than it saves (the thesis
+// case, 456 dwells, is no faster on two threads; the beam's 24,576 gain).
 constexpr std::size_t kMinDwellsForThreadsAfterFit = 2048;
-// From this many dwells on the run keeps its memory down. The fit's freed
-// memory goes back to the kernel before the parts after it allocate theirs
-// (ReturnFreedMemory): kept, it stays resident beside their largest blocks,
-// which are mapped afresh. The parts run one after the other again: the
-// covariance (its Jacobian and R factor) and the predictions (one per dwell,
-// and their CSV text) each hold some 180 bytes per dwell at their peak, and
-// side by side their peaks add. On a million dwells the run's peak was
-// 631 MB side by side, 447 MB one after the other, 336 MB with the memory
-// returned as well (and the fit's dwells in FunctorBatch blocks).
+// From this many dwells on the run keeps its memory down: the fit's freed
+// memory goes back to the kernel (ReturnFreedMemory) and the parts after it
+// run one after the other (each holds ~180 bytes per dwell at its peak). On
+// a million dwells the peak fell from 631 MB to 336 MB.
 constexpr std::size_t kLargeRunDwells = 100000;
 
-// What the run computes from the estimate once the fit has ended and its
-// uncertainty is known: the predictions of every sweep into
-// report->predictions and `predictions_csv`, and the response curves into
-// `curves`, side by side on the run's threads (solver.num_threads) when
-// there are enough dwells and not too many (kLargeRunDwells), each part in
-// its own variable so that none depends on which thread runs it or when.
+// The predictions of every sweep (report->predictions, `predictions_csv`)
+// and the response curves (`curves`), side by side on the run's threads
+// between the two limits above; each part writes only its own outputs.
 void ComputeAfterFit(const ResolvedRun& run, const IdentificationResult& result,
                      IdentificationReport* report, std::string* predictions_csv,
                      RunCurves* curves) {
@@ -141,16 +131,15 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
   for (const Sweep* sweep : run.fitted) out << "fit      " << DescribeJumps(*sweep) << "\n";
   for (const Sweep* sweep : run.validation) out << "validate " << DescribeJumps(*sweep) << "\n";
   out << "\n";
-  if (run.guessed_from_data) {
-    out << "automatic initial guess:\n";
-    for (const std::string& step : run.initial_guess_steps) out << "  " << step << "\n";
+  const auto print_steps = [&out](bool print, const char* title, const auto& steps) {
+    if (!print) return;
+    out << title << ":\n";
+    for (const std::string& step : steps) out << "  " << step << "\n";
     out << "\n";
-  }
-  if (!run.automatic_start_steps.empty()) {
-    out << "automatic start of the multi-start:\n";
-    for (const std::string& step : run.automatic_start_steps) out << "  " << step << "\n";
-    out << "\n";
-  }
+  };
+  print_steps(run.guessed_from_data, "automatic initial guess", run.initial_guess_steps);
+  print_steps(!run.automatic_start_steps.empty(), "automatic start of the multi-start",
+              run.automatic_start_steps);
 
   MultiStartResult multi_start = FitRun(run);
   CheckUsable(config, multi_start);

@@ -20,20 +20,17 @@ struct IdentifyOutcome {
   IdentificationReport report;
 };
 
-// Runs the identification and writes its files; prints the config in effect
-// and the summary to `out`. The report's result carries the run's status
-// (FitStatus): converged, no_convergence, failure (an enforced fold missing
-// at the end, a cost dominated by the penalties), or unidentifiable (the
-// data cannot tell the free parameters apart: no covariance), each with its
-// reason, and result.yaml records it. Throws InputError on bad input or when
-// no fit could be made at all (the model cannot be evaluated from the start,
-// or the estimate is not finite); nothing is written then.
-// How a run writes, beyond what the config says.
 struct IdentifyRunOptions {
   // Render the figures with gnuplot (curves.csv and figures.gp are written
-  // either way; rendering takes longer than the fit on small data).
+  // either way).
   bool render_figures = true;
 };
+
+// Runs the identification and writes its files; prints the config in effect
+// and the summary to `out`. The report's result carries the run's status
+// (FitStatus) with its reason; unidentifiable when the data cannot tell the
+// free parameters apart. Throws InputError on bad input or when no fit could
+// be made at all; nothing is written then.
 std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::ostream& out,
                                              const IdentifyRunOptions& options = {});
 

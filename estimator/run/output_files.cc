@@ -54,11 +54,9 @@ void RemoveStaleStaging(const fs::path& directory) {
   }
 }
 
-// A file being written: open while alive. Write() hands its content to the
-// kernel and starts writing it to the disk without waiting; Flush() waits
-// until it is there. Files written one after the other and flushed together
-// reach the disk in one journal commit of the file system rather than one
-// each.
+// A file being written: Write() starts writing to the disk without waiting,
+// Flush() waits until it is there, so that files flushed together reach the
+// disk in one journal commit rather than one each.
 class DurableFile {
  public:
   explicit DurableFile(fs::path path) : path_(std::move(path)) {
@@ -156,18 +154,15 @@ void MoveIntoPlace(const fs::path& staging, const fs::path& directory,
   fs::remove(directory / kManifestFileName, error);
   if (error)
     ThrowOutputError(directory / kManifestFileName, "cannot replace (" + error.message() + ")");
-  for (const auto& [name, content] : files) {
+  const auto move = [&](const std::string& name, const std::string& what) {
     fs::rename(staging / name, directory / name, error);
     if (error) {
       ThrowOutputError(directory / name,
-                       "cannot move the result into place (" + error.message() + ")");
+                       "cannot move the " + what + " into place (" + error.message() + ")");
     }
-  }
-  fs::rename(staging / kManifestFileName, directory / kManifestFileName, error);
-  if (error) {
-    ThrowOutputError(directory / kManifestFileName,
-                     "cannot move the manifest into place (" + error.message() + ")");
-  }
+  };
+  for (const auto& [name, content] : files) move(name, "result");
+  move(kManifestFileName, "manifest");
 }
 
 }  // namespace

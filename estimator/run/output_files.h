@@ -8,11 +8,9 @@
 //      each rename is atomic).
 //   4. `manifest.yaml`, listing every file of the run with its size in bytes,
 //      is renamed into place last; then the staging folder is removed.
-// So the files a manifest lists are always one run's complete files: a run
-// killed before step 4 leaves no manifest, and one killed before step 2
-// leaves the previous run's files and manifest untouched. Staging folders
-// (and `*.partial-<pid>` files of earlier versions) left by a killed process
-// are removed by the next run into the same directory.
+// So a manifest always lists one run's complete files. What a killed
+// process leaves (staging folders, `*.partial-<pid>` files) is removed by the
+// next run into the same directory.
 #ifndef DWELLFIT_ESTIMATOR_RUN_OUTPUT_FILES_H_
 #define DWELLFIT_ESTIMATOR_RUN_OUTPUT_FILES_H_
 
@@ -25,11 +23,10 @@ namespace dwellfit {
 // The file that lists a complete run's files; written last.
 inline constexpr char kManifestFileName[] = "manifest.yaml";
 
-// Checks, without creating or writing anything, that `directory` is or can
-// become a writable directory: it is a directory (or does not exist yet) and
-// its nearest existing ancestor is a writable directory. Throws InputError
-// naming the path and `field` (the config key or flag that set it) otherwise.
-// Call it before a long computation whose result goes there.
+// Checks, without writing anything, that `directory` is or can become a
+// writable directory; throws InputError naming the path and `field` (the
+// config key or flag that set it) otherwise. Call it before a long
+// computation whose result goes there.
 void CheckOutputDirectory(const std::string& directory, const std::string& field);
 
 // Creates `directory` if needed and publishes each (file name, content) pair

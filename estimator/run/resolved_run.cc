@@ -37,9 +37,8 @@ std::vector<const Sweep*> SelectSweeps(const std::vector<Sweep>& sweeps,
                                        const std::vector<SweepSelection>& selections,
                                        const std::string& config_path, const std::string& field) {
   for (const SweepSelection& selection : selections) {
-    bool found = false;
-    for (const Sweep& sweep : sweeps) found = found || selection.Selects(sweep);
-    if (!found) {
+    const auto selects = [&](const Sweep& sweep) { return selection.Selects(sweep); };
+    if (std::none_of(sweeps.begin(), sweeps.end(), selects)) {
       std::string available;
       for (const Sweep& sweep : sweeps) available += (available.empty() ? "" : ", ") + sweep.Name();
       throw InputError(
@@ -49,19 +48,14 @@ std::vector<const Sweep*> SelectSweeps(const std::vector<Sweep>& sweeps,
   }
   std::vector<const Sweep*> selected;
   for (const Sweep& sweep : sweeps) {
-    for (const SweepSelection& selection : selections) {
-      if (selection.Selects(sweep)) {
-        selected.push_back(&sweep);
-        break;
-      }
-    }
+    const auto selects = [&](const SweepSelection& selection) { return selection.Selects(sweep); };
+    if (std::any_of(selections.begin(), selections.end(), selects)) selected.push_back(&sweep);
   }
   return selected;
 }
 
 // Throws when the fitted sweeps hold no more dwells than there are free
-// parameters: such a fit interpolates (or is underdetermined) and has no
-// degree of freedom left to estimate the noise, so no usable result.
+// parameters: no degree of freedom would be left to estimate the noise.
 void CheckEnoughDwells(const IdentifyConfig& config, const std::vector<const Sweep*>& fitted) {
   std::size_t dwells = 0;
   for (const Sweep* sweep : fitted) dwells += sweep->points.size();
@@ -80,10 +74,15 @@ void CheckEnoughDwells(const IdentifyConfig& config, const std::vector<const Swe
                        "sweeps, or fix parameters (fixed: with their initial_guess)");
 }
 
-// A fixed parameter is held at its initial value, so that value must be
-// the user's: held at an estimate from the data, it would bias every other
-// parameter without a word.
-void CheckFixedAreGiven(const IdentifyConfig& config) {
+// The settings the run uses before the fit (the fit's own options are
+// checked where they enter it), so that a config built in code is checked.
+// A fixed parameter's value must be the user's: held at an estimate from the
+// data, it would bias every other parameter without a word.
+void CheckSettings(const IdentifyConfig& config) {
+  std::string message;
+  if (!config.jump_detection.IsValid(&message)) {
+    throw InputError(config.config_path, 0, "jump_detection", message);
+  }
   for (int i = 0; i < kNumParameters; ++i) {
     if (!config.identification.fixed[i] || config.initial_guess[i]) continue;
     const std::string key = i == kNaturalFrequency ? "omega_hz" : ParameterName(i);
@@ -93,19 +92,6 @@ void CheckFixedAreGiven(const IdentifyConfig& config) {
                          "initial_guess." +
                          key + ", or remove it from 'fixed'");
   }
-}
-
-// The settings the run uses before the fit. The config reader checks each
-// block at its line; the fit's options (identification, multi_start) are
-// checked where they enter the fit (IdentifyMultiStart, Identify,
-// SolveStaged). The jump detection enters the library here (DetectJumps
-// takes valid options), so a config built in code is checked here.
-void CheckSettings(const IdentifyConfig& config) {
-  std::string message;
-  if (!config.jump_detection.IsValid(&message)) {
-    throw InputError(config.config_path, 0, "jump_detection", message);
-  }
-  CheckFixedAreGiven(config);
 }
 
 // Fills the guesses the config leaves to the data into run->options.initial,
@@ -129,10 +115,7 @@ void FillGuessesFromData(const IdentifyConfig& config, ResolvedRun* run) {
   run->initial_guess_steps = std::move(guess.steps);
 }
 
-// The multi-start's automatic start: every free parameter from the data
-// (the fixed ones at their given values), so that it differs from start 0
-// whenever guesses are given. Without a resonance to estimate from, the
-// multi-start does without it.
+// The multi-start's automatic start (ResolvedRun::automatic_start).
 void FindAutomaticStart(const IdentifyConfig& config, ResolvedRun* run) {
   if (config.multi_start.starts <= 1) return;
   KnownParameters fixed;

@@ -50,27 +50,21 @@ struct ResolvedRun {
   // (one line per step, initial_guess.h; empty when every guess is given).
   bool guessed_from_data = false;
   std::vector<std::string> initial_guess_steps;
-  // With more than one start (multi_start.starts > 1), the automatic start:
-  // every free parameter found from the data, the fixed ones at their given
-  // values. It is the multi-start's second start (MultiStartPoints); unset
-  // when the sweeps show no resonance to estimate from (its step says so).
+  // With multi_start.starts > 1, the multi-start's second start: every free
+  // parameter found from the data, the fixed ones given; unset when the
+  // sweeps show no resonance to estimate from (its step says so).
   std::optional<ParameterVector> automatic_start;
   std::vector<std::string> automatic_start_steps;
 };
 
 // Reads the config's data files (sweep ids unique across files) and resolves
-// the run on them. Throws InputError naming the file and the field: a data
-// file that cannot be read, a `jumps:` entry or a selection that names no
-// sweep, a fixed parameter whose guess is left to the data, no starting
-// point to be found from the data, or an unusable start.
+// the run on them. Throws InputError naming the file and the field.
 ResolvedRun ResolveRun(const IdentifyConfig& config);
 
-// The same on sweeps already in memory (e.g. simulated from a dwell plan):
-// labelled, overridden, selected and started exactly as ResolveRun does.
+// The same on sweeps already in memory (e.g. simulated from a dwell plan).
 ResolvedRun ResolveRun(const IdentifyConfig& config, std::vector<Sweep> sweeps);
 
-// Fits the run's fitted sweeps from its start (IdentifyMultiStart with
-// `run.multi_start`; with one start, a single Identify from run.options).
+// Fits the run's fitted sweeps from its start (IdentifyMultiStart).
 MultiStartResult FitRun(const ResolvedRun& run);
 
 }  // namespace dwellfit

@@ -40,8 +40,8 @@ FigureSweep MakeFigureSweep(const IdentificationReport& report, const ResponseCu
   return figure;
 }
 
-}  // namespace
-
+// The estimates as the figures' corner shows them: "eta_e = 100 ± 0.02",
+// omega in Hz, "(fixed)" for fixed parameters.
 std::vector<std::string> EstimateLines(const IdentificationReport& report) {
   std::vector<std::string> lines;
   const ParameterUncertainty& u = report.uncertainty;
@@ -59,6 +59,8 @@ std::vector<std::string> EstimateLines(const IdentificationReport& report) {
   }
   return lines;
 }
+
+}  // namespace
 
 RunCurves TraceRunCurves(const ParameterVector& parameters,
                          const std::vector<const Sweep*>& sweeps) {

@@ -26,17 +26,12 @@ struct RunCurves {
 RunCurves TraceRunCurves(const ParameterVector& parameters,
                          const std::vector<const Sweep*>& sweeps);
 
-// Appends curves.csv and figures.gp to `files` (which must hold
-// predictions.csv, read by the script), and with `render` the images gnuplot
-// draws from them; `curves` are TraceRunCurves of the report's estimate and
-// sweeps; their CSV text moves into `files`. No curves, or a missing or
-// failing gnuplot, is a warning on `out` (and in the log), never an error.
+// Appends curves.csv and figures.gp (`curves`: TraceRunCurves of the
+// report's estimate) to `files`, which must hold predictions.csv, and with
+// `render` gnuplot's images. No curves, or no working gnuplot, is a warning
+// on `out`, never an error.
 void AppendCurvesAndFigures(const IdentificationReport& report, RunCurves curves,
                             std::vector<NamedFile>* files, std::ostream& out, bool render = true);
-
-// The estimates as the figures' corner shows them: "eta_e = 100 ± 0.02",
-// omega in Hz, "(fixed)" for fixed parameters.
-std::vector<std::string> EstimateLines(const IdentificationReport& report);
 
 }  // namespace dwellfit
 
