@@ -10,12 +10,10 @@
 #include <thread>
 #include <utility>
 
-#include "dwellfit/estimator/analysis/parameter_uncertainty.h"
 #include "dwellfit/estimator/analysis/sweep_prediction.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/run/resolved_run.h"
-#include "dwellfit/estimator/studies/model_selection_predictions.h"
 
 namespace dwellfit {
 namespace {
@@ -46,6 +44,46 @@ IdentifyConfig VariantConfig(const IdentifyConfig& config, const ModelVariant& v
 bool SelectedByAny(const Sweep& sweep, const std::vector<SweepSelection>& selections) {
   return std::any_of(selections.begin(), selections.end(),
                      [&](const SweepSelection& s) { return s.Selects(sweep); });
+}
+
+// The errors of `predictions` (a missing prediction counts 100 %, in Hz the
+// measured frequency) with the sweep's relative RMS amplitude error when
+// `relative_rms` is finite.
+PredictionErrors ErrorsOf(const std::vector<HeldOutPrediction>& predictions, double relative_rms) {
+  PredictionErrors errors;
+  for (const HeldOutPrediction& p : predictions) {
+    const bool known = std::isfinite(p.predicted);
+    const double percent = known ? std::abs(p.ErrorPercent()) : 100.0;
+    const double hz = known ? std::abs(p.predicted - p.measured) : p.measured;
+    switch (p.quantity) {
+      case HeldOutQuantity::kJumpDown:
+        errors.jump_down_percent.push_back(percent);
+        errors.jump_down_hz.push_back(hz);
+        break;
+      case HeldOutQuantity::kJumpUp:
+        errors.jump_up_percent.push_back(percent);
+        errors.jump_up_hz.push_back(hz);
+        break;
+      case HeldOutQuantity::kUpperBranchAmplitude:
+        errors.upper_branch_percent.push_back(percent);
+        break;
+    }
+  }
+  if (std::isfinite(relative_rms)) errors.relative_rms.push_back(relative_rms);
+  return errors;
+}
+
+// Every combination of the block's choices, delta slowest, omega fastest.
+std::vector<ModelVariant> ModelVariants(const ModelSelectionConfig& selection) {
+  std::vector<ModelVariant> variants;
+  for (const ParameterChoice& delta : selection.delta) {
+    for (const ParameterChoice& mu2 : selection.mu2) {
+      for (const ParameterChoice& omega : selection.omega) {
+        variants.push_back(ModelVariant{delta, mu2, omega});
+      }
+    }
+  }
+  return variants;
 }
 
 // One held-out sweep predicted: its predictions (with their parameter
@@ -575,28 +613,25 @@ int ModelVariant::FreeParameters(const IdentifyConfig& config) const {
   return static_cast<int>(std::count(fixed.begin(), fixed.end(), false));
 }
 
-std::vector<ModelVariant> ModelVariants(const ModelSelectionConfig& selection) {
-  std::vector<ModelVariant> variants;
-  for (const ParameterChoice& delta : selection.delta) {
-    for (const ParameterChoice& mu2 : selection.mu2) {
-      for (const ParameterChoice& omega : selection.omega) {
-        variants.push_back(ModelVariant{delta, mu2, omega});
-      }
-    }
-  }
-  return variants;
+void AddPredictionIntervals(VariantResult* result) {
+  std::vector<std::vector<HeldOutPrediction>*> levels;
+  for (CrossValidationFold& fold : result->folds) levels.push_back(&fold.predictions);
+  const PredictionCoverage coverage = AddPredictionIntervals(levels);
+  result->jump_down_coverage = coverage.jump_down;
+  result->jump_up_coverage = coverage.jump_up;
+  result->upper_branch_coverage = coverage.upper_branch;
 }
 
 void PredictionErrors::Add(const PredictionErrors& other) {
-  jump_down_percent.insert(jump_down_percent.end(), other.jump_down_percent.begin(),
-                           other.jump_down_percent.end());
-  jump_up_percent.insert(jump_up_percent.end(), other.jump_up_percent.begin(),
-                         other.jump_up_percent.end());
-  relative_rms.insert(relative_rms.end(), other.relative_rms.begin(), other.relative_rms.end());
-  jump_down_hz.insert(jump_down_hz.end(), other.jump_down_hz.begin(), other.jump_down_hz.end());
-  jump_up_hz.insert(jump_up_hz.end(), other.jump_up_hz.begin(), other.jump_up_hz.end());
-  upper_branch_percent.insert(upper_branch_percent.end(), other.upper_branch_percent.begin(),
-                              other.upper_branch_percent.end());
+  const auto append = [](std::vector<double>* to, const std::vector<double>& from) {
+    to->insert(to->end(), from.begin(), from.end());
+  };
+  append(&jump_down_percent, other.jump_down_percent);
+  append(&jump_down_hz, other.jump_down_hz);
+  append(&jump_up_percent, other.jump_up_percent);
+  append(&jump_up_hz, other.jump_up_hz);
+  append(&upper_branch_percent, other.upper_branch_percent);
+  append(&relative_rms, other.relative_rms);
 }
 
 ModelSelectionReport RunModelSelection(const IdentifyConfig& config, int threads) {

@@ -243,10 +243,6 @@ std::string ModelSelectionMarkdown(const ModelSelectionReport& report) {
   return out.str();
 }
 
-}  // namespace dwellfit
-
-namespace dwellfit {
-
 std::string RecommendedConfigYaml(const IdentifyConfig& config,
                                   const ModelSelectionReport& report) {
   if (report.recommended < 0) return "";
@@ -255,9 +251,8 @@ std::string RecommendedConfigYaml(const IdentifyConfig& config,
   out << "# The variant select_model recommends for " << config.config_path << ":\n#   "
       << chosen.variant.Name() << "\n#   " << report.verdict << "\n"
       << "# Rule: " << report.rule << ".\n"
-      << "# Run it as is: identify --config <this file>. Paths are absolute.\n";
-  std::string yaml = ConfigToYaml(WithVariant(config, chosen.variant));
-  out << yaml;
+      << "# Run it as is: identify --config <this file>. Paths are absolute.\n"
+      << ConfigToYaml(WithVariant(config, chosen.variant));
   return out.str();
 }
 
