@@ -252,28 +252,6 @@ std::vector<RawPoint> AmplitudeTrace(const ParameterVector& p, const CurveSpec& 
   return trace;
 }
 
-}  // namespace
-
-bool CurveSpec::IsValid(std::string* why) const {
-  auto fail = [why](const std::string& text) {
-    *why = text;
-    return false;
-  };
-  if (kind == SweepKind::kFrequency && !(a_base > 0.0 && std::isfinite(a_base)))
-    return fail(StringPrintf("a frequency curve needs a base level a_base > 0 (got %g)", a_base));
-  if (kind == SweepKind::kAmplitude && !(omega_rad_s > 0.0 && std::isfinite(omega_rad_s)))
-    return fail("an amplitude curve needs a drive frequency > 0");
-  const double min_low = kind == SweepKind::kFrequency ? 0.0 : -1.0;
-  if (!(control_low > min_low && control_high > control_low && std::isfinite(control_high)))
-    return fail(StringPrintf("the swept range [%g, %g] must be finite, positive and increasing",
-                             control_low, control_high));
-  if (points_per_side < 10 || points_per_side > 1000000)
-    return fail(StringPrintf("points_per_side %d is outside [10, 1000000]", points_per_side));
-  return true;
-}
-
-namespace {
-
 // The swept control on `side` at amplitude a: Omega [rad/s] or a_base.
 double SideControl(const ParameterVector& p, const CurveSpec& spec, double a, int side) {
   if (spec.kind == SweepKind::kFrequency) return SideFrequency(p, spec.a_base, a, side % 2, true);
@@ -326,6 +304,24 @@ void AddBackbone(const ParameterVector& p, const std::vector<RawPoint>& trace,
 }
 
 }  // namespace
+
+bool CurveSpec::IsValid(std::string* why) const {
+  auto fail = [why](const std::string& text) {
+    *why = text;
+    return false;
+  };
+  if (kind == SweepKind::kFrequency && !(a_base > 0.0 && std::isfinite(a_base)))
+    return fail(StringPrintf("a frequency curve needs a base level a_base > 0 (got %g)", a_base));
+  if (kind == SweepKind::kAmplitude && !(omega_rad_s > 0.0 && std::isfinite(omega_rad_s)))
+    return fail("an amplitude curve needs a drive frequency > 0");
+  const double min_low = kind == SweepKind::kFrequency ? 0.0 : -1.0;
+  if (!(control_low > min_low && control_high > control_low && std::isfinite(control_high)))
+    return fail(StringPrintf("the swept range [%g, %g] must be finite, positive and increasing",
+                             control_low, control_high));
+  if (points_per_side < 10 || points_per_side > 1000000)
+    return fail(StringPrintf("points_per_side %d is outside [10, 1000000]", points_per_side));
+  return true;
+}
 
 ResponseCurve TraceResponseCurve(const ParameterVector& p, const CurveSpec& spec) {
   std::string why;

@@ -234,25 +234,26 @@ void CheckPlan(const DwellPlan& plan, const RigOptions& options) {
 }  // namespace
 
 bool RigOptions::IsValid(std::string* error) const {
+  auto fail = [error](const std::string& what) {
+    *error = what;
+    return false;
+  };
   if (!channels.IsValid(error) || !gauge.IsValid(error)) return false;
   if (!(sample_rate_hz > 0.0 && std::isfinite(sample_rate_hz)) || record_periods < 1) {
-    *error = "sample_rate_hz must be positive and record_periods at least 1";
-    return false;
+    return fail("sample_rate_hz must be positive and record_periods at least 1");
   }
   if (!(settle_tolerance > 0.0) || settle_window_periods < 1 ||
       max_settle_periods < 2 * settle_window_periods) {
-    *error =
+    return fail(
         "settle_tolerance must be positive, window_periods >= 1 and max_periods at least "
-        "twice window_periods";
-    return false;
+        "twice window_periods");
   }
   if (!(noise_relative_sigma >= 0.0 && noise_relative_sigma < 1.0)) {
-    *error = StringPrintf("noise relative_sigma must lie in [0, 1), got %g", noise_relative_sigma);
-    return false;
+    return fail(
+        StringPrintf("noise relative_sigma must lie in [0, 1), got %g", noise_relative_sigma));
   }
   if (!(integration_tolerance > 0.0 && integration_tolerance < 1e-3)) {
-    *error = "integration_tolerance must lie in (0, 1e-3)";
-    return false;
+    return fail("integration_tolerance must lie in (0, 1e-3)");
   }
   return true;
 }
@@ -263,9 +264,7 @@ RigRun SimulateRig(const DwellPlan& plan, const RigOptions& options, const RigPr
   std::mt19937_64 random(options.noise_seed);
   int total = 0;
   for (const SweepPlan& sweep : plan.sweeps) {
-    for (SweepDirection direction : sweep.directions) {
-      total += static_cast<int>(ControlGrid(sweep, direction).size());
-    }
+    total += (sweep.NumSteps() + 1) * static_cast<int>(sweep.directions.size());
   }
   RigRun run;
   for (const SweepPlan& sweep : plan.sweeps) {

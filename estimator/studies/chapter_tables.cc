@@ -1,11 +1,10 @@
 #include "dwellfit/estimator/studies/chapter_tables.h"
 
-#include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 #include <vector>
 
+#include "dwellfit/estimator/analysis/prediction_intervals.h"
 #include "dwellfit/estimator/analysis/sweep_prediction.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/fit/identification.h"
@@ -74,12 +73,18 @@ std::string PercentError(double estimate, double reference) {
 }
 
 void SolverLines(const PairedFit& fit, std::ostream& out) {
-  out << "- with penalty: final cost " << StringPrintf("%.6g", fit.with_penalty.final_cost) << ", "
-      << fit.with_penalty.iterations << " iterations, "
-      << (fit.with_penalty.converged ? "converged" : "not converged") << "\n";
-  out << "- without penalty: final cost " << StringPrintf("%.6g", fit.without_penalty.final_cost)
-      << ", " << fit.without_penalty.iterations << " iterations, "
-      << (fit.without_penalty.converged ? "converged" : "not converged") << "\n\n";
+  for (const IdentificationResult* r : {&fit.with_penalty, &fit.without_penalty}) {
+    out << (r == &fit.with_penalty ? "- with" : "- without") << " penalty: final cost "
+        << StringPrintf("%.6g", r->final_cost) << ", " << r->iterations << " iterations, "
+        << (r->converged ? "converged" : "not converged") << "\n";
+  }
+  out << "\n";
+}
+
+// The config's path from its "datasets/" on.
+std::string DatasetName(const IdentifyConfig& config) {
+  const std::string::size_type at = config.config_path.rfind("datasets/");
+  return config.config_path.substr(at == std::string::npos ? 0 : at);
 }
 
 // Every measured jump: its bracket and both models' folds (Hz for frequency
@@ -119,16 +124,11 @@ void JumpTable(const PairedFit& fit, std::ostream& out) {
       }
     }
   }
-  auto median = [](std::vector<double> values) {
-    if (values.empty()) return std::string("-");
-    std::sort(values.begin(), values.end());
-    const size_t n = values.size();
-    return StringPrintf("%.2f", n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]));
-  };
   if (!held_out_with.empty()) {
     out << "\nMedian error of the predicted jump-down frequency over the " << held_out_with.size()
-        << " held-out frequency sweeps (a missing fold counts 100 %): " << median(held_out_with)
-        << " % with the penalty, " << median(held_out_without) << " % without.\n";
+        << " held-out frequency sweeps (a missing fold counts 100 %): "
+        << StringPrintf("%.2f", MedianOf(held_out_with)) << " % with the penalty, "
+        << StringPrintf("%.2f", MedianOf(held_out_without)) << " % without.\n";
   }
   out << "\n";
 }
@@ -148,11 +148,7 @@ std::string ChapterTablesMarkdown(const IdentifyConfig& numerical, const Paramet
          "holds each enforced jump inside its bracket.\n\n";
 
   const PairedFit thesis = FitBothWays(numerical);
-  out << "## Table 3.3: numerical data (`"
-      << numerical.config_path.substr(numerical.config_path.rfind("datasets/") == std::string::npos
-                                          ? 0
-                                          : numerical.config_path.rfind("datasets/"))
-      << "`)\n\n"
+  out << "## Table 3.3: numerical data (`" << DatasetName(numerical) << "`)\n\n"
       << "| parameter | known value | with penalty | error % | without penalty | error % |\n"
       << "|---|---|---|---|---|---|\n";
   for (const Row& row : Rows(thesis, thesis.data.options, truth)) {
@@ -167,11 +163,7 @@ std::string ChapterTablesMarkdown(const IdentifyConfig& numerical, const Paramet
   JumpTable(thesis, out);
 
   const PairedFit beam = FitBothWays(measured);
-  out << "## Table 3.4: measured data (`"
-      << measured.config_path.substr(measured.config_path.rfind("datasets/") == std::string::npos
-                                         ? 0
-                                         : measured.config_path.rfind("datasets/"))
-      << "`)\n\n"
+  out << "## Table 3.4: measured data (`" << DatasetName(measured) << "`)\n\n"
       << "Percent comparison: |with - without| / |with|.\n\n"
       << "| parameter | with penalty | without penalty | percent comparison |\n"
       << "|---|---|---|---|\n";

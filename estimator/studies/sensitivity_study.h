@@ -97,7 +97,7 @@ std::string StudyToYaml(const SensitivityStudy& study);
 // success rate, and per parameter mean, standard deviation, mean standard
 // error and, with a truth, the bias.
 std::string SummaryToYaml(const SensitivityStudy& study);
-// sensitivity.gp: histograms of every estimate per case and, with one axis,
+// figures.gp: histograms of every estimate per case and, with one axis,
 // the profile: the mean cost and every estimate against the axis value.
 std::string StudyFigureScript(const SensitivityStudy& study);
 
