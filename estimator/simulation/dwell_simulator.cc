@@ -37,8 +37,6 @@ double MiddleRoot(const ResponseCoefficients<double>& k, const TurningPoints& tp
                          0.5 * (tp.a_lower_end + tp.a_upper_end));
 }
 
-Branch OtherBranch(Branch side) { return side == Branch::kLower ? Branch::kUpper : Branch::kLower; }
-
 struct JumpAt {
   int sweep = 0;        // index into the output sweeps
   int index_after = 0;  // first dwell on the new branch
@@ -201,7 +199,7 @@ SettledDwell SettleDwell(const ParameterVector& truth, double omega_drive_rad_s,
     }
   } else if ((side == Branch::kLower && !lower_exists) ||
              (side == Branch::kUpper && !upper_exists)) {
-    side = OtherBranch(side);
+    side = side == Branch::kLower ? Branch::kUpper : Branch::kLower;
     dwell.jumped = !from_rest;
   }
   dwell.side = side;

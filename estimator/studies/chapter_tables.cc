@@ -52,18 +52,17 @@ std::vector<Row> Rows(const PairedFit& fit, const IdentificationOptions& options
   for (int i = 0; i < kNumParameters; ++i) {
     if (i == kNaturalFrequency && options.fixed[kNaturalFrequency]) continue;
     const bool omega = i == kNaturalFrequency;
-    rows.push_back(
-        {omega ? "w [Hz]" : ParameterName(i),
-         omega ? RadPerSecondToHz(fit.with_penalty.parameters[i]) : fit.with_penalty.parameters[i],
-         omega ? RadPerSecondToHz(fit.without_penalty.parameters[i])
-               : fit.without_penalty.parameters[i],
-         omega ? RadPerSecondToHz(truth[i]) : truth[i]});
+    auto shown = [&](const ParameterVector& p) { return omega ? RadPerSecondToHz(p[i]) : p[i]; };
+    rows.push_back({omega ? "w [Hz]" : ParameterName(i), shown(fit.with_penalty.parameters),
+                    shown(fit.without_penalty.parameters), shown(truth)});
   }
+  auto effective = [&](const ParameterVector& p) {
+    return EffectiveNonlinearity(p, fit.omega_ref_rad_s);
+  };
   rows.push_back({"effective nonlinearity at " +
                       StringPrintf("%.4g", RadPerSecondToHz(fit.omega_ref_rad_s)) + " Hz",
-                  EffectiveNonlinearity(fit.with_penalty.parameters, fit.omega_ref_rad_s),
-                  EffectiveNonlinearity(fit.without_penalty.parameters, fit.omega_ref_rad_s),
-                  EffectiveNonlinearity(truth, fit.omega_ref_rad_s)});
+                  effective(fit.with_penalty.parameters), effective(fit.without_penalty.parameters),
+                  effective(truth)});
   return rows;
 }
 

@@ -182,7 +182,6 @@ FamilyOutcome RunFamilyMember(const IdentifyConfig& base, const FamilyMember& me
     const IdentificationResult result = FitRun(run).best;
     outcome.status = result.status;
     outcome.message = result.message;
-    outcome.iterations = result.iterations;
     for (int i = 0; i < kNumParameters; ++i) {
       if (member.fixed[i]) continue;
       const double truth = member.plan.truth[i];

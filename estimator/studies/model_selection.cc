@@ -1,19 +1,19 @@
 #include "dwellfit/estimator/studies/model_selection.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <exception>
 #include <limits>
 #include <map>
 #include <set>
-#include <thread>
 #include <utility>
 
 #include "dwellfit/estimator/analysis/sweep_prediction.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/run/resolved_run.h"
+#include "tbb/parallel_for.h"
+#include "tbb/task_arena.h"
 
 namespace dwellfit {
 namespace {
@@ -46,12 +46,36 @@ bool SelectedByAny(const Sweep& sweep, const std::vector<SweepSelection>& select
                      [&](const SweepSelection& s) { return s.Selects(sweep); });
 }
 
-// The errors of `predictions` (a missing prediction counts 100 %, in Hz the
-// measured frequency) with the sweep's relative RMS amplitude error when
-// `relative_rms` is finite.
-PredictionErrors ErrorsOf(const std::vector<HeldOutPrediction>& predictions, double relative_rms) {
+// Every combination of the block's choices, delta slowest, omega fastest.
+std::vector<ModelVariant> ModelVariants(const ModelSelectionConfig& selection) {
+  std::vector<ModelVariant> variants;
+  for (const ParameterChoice& delta : selection.delta) {
+    for (const ParameterChoice& mu2 : selection.mu2) {
+      for (const ParameterChoice& omega : selection.omega) {
+        variants.push_back(ModelVariant{delta, mu2, omega});
+      }
+    }
+  }
+  return variants;
+}
+
+// One held-out sweep predicted: its predictions (with their parameter
+// uncertainty when `covariance` is given) and their errors (a missing
+// prediction counts 100 %, in Hz the measured frequency); with no usable
+// fit, every measured jump and upper branch counts 100 % and the relative
+// RMS is left out.
+struct SweepResult {
   PredictionErrors errors;
-  for (const HeldOutPrediction& p : predictions) {
+  std::vector<HeldOutPrediction> predictions;
+};
+
+SweepResult PredictHeldOutSweep(const Sweep& sweep, const ParameterVector& parameters, bool usable,
+                                const ParameterMatrix* covariance,
+                                const std::array<bool, kNumParameters>& fixed) {
+  SweepResult result;
+  result.predictions = PredictHeldOut(sweep, parameters, usable, covariance, fixed);
+  PredictionErrors& errors = result.errors;
+  for (const HeldOutPrediction& p : result.predictions) {
     const bool known = std::isfinite(p.predicted);
     const double percent = known ? std::abs(p.ErrorPercent()) : 100.0;
     const double hz = known ? std::abs(p.predicted - p.measured) : p.measured;
@@ -69,40 +93,9 @@ PredictionErrors ErrorsOf(const std::vector<HeldOutPrediction>& predictions, dou
         break;
     }
   }
-  if (std::isfinite(relative_rms)) errors.relative_rms.push_back(relative_rms);
-  return errors;
-}
-
-// Every combination of the block's choices, delta slowest, omega fastest.
-std::vector<ModelVariant> ModelVariants(const ModelSelectionConfig& selection) {
-  std::vector<ModelVariant> variants;
-  for (const ParameterChoice& delta : selection.delta) {
-    for (const ParameterChoice& mu2 : selection.mu2) {
-      for (const ParameterChoice& omega : selection.omega) {
-        variants.push_back(ModelVariant{delta, mu2, omega});
-      }
-    }
-  }
-  return variants;
-}
-
-// One held-out sweep predicted: its predictions (with their parameter
-// uncertainty when `covariance` is given) and errors; with no usable fit,
-// every measured jump and upper branch counts 100 % and the relative RMS
-// is left out.
-struct SweepResult {
-  PredictionErrors errors;
-  std::vector<HeldOutPrediction> predictions;
-};
-
-SweepResult PredictHeldOutSweep(const Sweep& sweep, const ParameterVector& parameters, bool usable,
-                                const ParameterMatrix* covariance,
-                                const std::array<bool, kNumParameters>& fixed) {
-  SweepResult result;
-  result.predictions = PredictHeldOut(sweep, parameters, usable, covariance, fixed);
   const double relative_rms =
       usable ? PredictSweep(parameters, sweep, /*fitted=*/false).relative_rms_error : kNaN;
-  result.errors = ErrorsOf(result.predictions, relative_rms);
+  if (std::isfinite(relative_rms)) errors.relative_rms.push_back(relative_rms);
   return result;
 }
 
@@ -259,7 +252,6 @@ bool Predicts(const Plan& plan, int set, const Sweep& sweep) {
 TaskResult RunTask(const IdentifyConfig& config, const ModelVariant& variant,
                    const std::vector<Sweep>& sweeps, const Plan& plan, int set) {
   TaskResult task;
-  task.fit.fitted_sweeps.clear();
   for (const SweepSelection& s : plan.training[set]) task.fit.fitted_sweeps.push_back(s.Name());
   const IdentifyConfig variant_config = VariantConfig(config, variant, plan.training[set]);
   const std::array<bool, kNumParameters>& fixed = variant_config.identification.fixed;
@@ -308,16 +300,12 @@ std::vector<TaskResult> RunTasks(const IdentifyConfig& config,
   const int sets = static_cast<int>(plan.training.size());
   const int count = static_cast<int>(variants.size()) * sets;
   std::vector<TaskResult> results(count);
-  std::atomic<int> next{0};
-  auto work = [&]() {
-    for (int i = next++; i < count; i = next++) {
-      results[i] = RunTask(config, variants[i / sets], sweeps, plan, i % sets);
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::min(threads, count); ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& thread : pool) thread.join();
+  tbb::task_arena(std::max(1, std::min(threads, count))).execute([&] {
+    tbb::parallel_for(
+        0, count,
+        [&](int i) { results[i] = RunTask(config, variants[i / sets], sweeps, plan, i % sets); },
+        tbb::simple_partitioner());
+  });
   for (const TaskResult& result : results) {
     if (result.error) std::rethrow_exception(result.error);
   }
@@ -335,8 +323,12 @@ void Criteria(VariantResult* result) {
   result->bic = minus_two_log_likelihood + result->free_parameters * std::log(n);
 }
 
+// The spread of `value` (of a fit's parameters) over the fits.
+template <typename Value>
 ParameterSpread SpreadOf(const std::string& name, ParameterIndex index,
-                         const std::vector<double>& values) {
+                         const std::vector<const VariantFit*>& fits, const Value& value) {
+  std::vector<double> values;
+  for (const VariantFit* fit : fits) values.push_back(value(fit->parameters));
   ParameterSpread spread;
   spread.name = name;
   spread.index = index;
@@ -360,19 +352,13 @@ std::vector<ParameterSpread> Spreads(const IdentifyConfig& config,
   for (int j = 0; j < kNumParameters; ++j) {
     if (fixed[j]) continue;
     const bool frequency = j == kNaturalFrequency;
-    std::vector<double> values;
-    for (const VariantFit* fit : usable) {
-      values.push_back(frequency ? RadPerSecondToHz(fit->parameters[j]) : fit->parameters[j]);
-    }
-    spreads.push_back(
-        SpreadOf(frequency ? "w [Hz]" : ParameterName(j), static_cast<ParameterIndex>(j), values));
+    spreads.push_back(SpreadOf(
+        frequency ? "w [Hz]" : ParameterName(j), static_cast<ParameterIndex>(j), usable,
+        [&](const ParameterVector& p) { return frequency ? RadPerSecondToHz(p[j]) : p[j]; }));
     if (j != kAlpha) continue;
-    std::vector<double> effective;
-    for (const VariantFit* fit : usable) {
-      const ParameterVector& p = fit->parameters;
-      effective.push_back(p[kAlpha] - 2.0 / 3.0 * p[kDelta] * omega_ref * omega_ref);
-    }
-    spreads.push_back(SpreadOf("alpha_e", kAlpha, effective));
+    spreads.push_back(SpreadOf("alpha_e", kAlpha, usable, [&](const ParameterVector& p) {
+      return EffectiveNonlinearity(p, omega_ref);
+    }));
   }
   return spreads;
 }

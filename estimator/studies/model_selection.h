@@ -90,7 +90,7 @@ struct CrossValidationFold {
 struct ParameterSpread {
   std::string name;  // "eta_e", ..., "w [Hz]" (values in Hz), "alpha_e"
   ParameterIndex index = kEtaE;
-  double min = 0.0, median = 0.0, max = 0.0;  // physical units (w in rad/s)
+  double min = 0.0, median = 0.0, max = 0.0;  // physical units (w in Hz)
   double relative_range = 0.0;                // (max - min) / |median|; inf when median is 0
 };
 

@@ -1,9 +1,11 @@
 // ModelSelectionCsv and ModelSelectionMarkdown: the study's tables.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
 #include <string>
 
+#include "boost/algorithm/string/join.hpp"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/studies/model_selection.h"
 
@@ -17,9 +19,8 @@ std::string Cell(double value, const char* format = "%.4g") {
 }
 
 double MaxOf(const std::vector<double>& values) {
-  double max = std::numeric_limits<double>::quiet_NaN();
-  for (double v : values) max = std::isnan(max) || v > max ? v : max;
-  return max;
+  return values.empty() ? std::numeric_limits<double>::quiet_NaN()
+                        : *std::max_element(values.begin(), values.end());
 }
 
 std::string FitCounts(const VariantResult& v) {
@@ -60,9 +61,7 @@ void MainTable(const ModelSelectionReport& report, std::ostream& out) {
 }
 
 std::string Joined(const std::vector<std::string>& names) {
-  std::string text;
-  for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
-  return text;
+  return boost::algorithm::join(names, ", ");
 }
 
 // A held-out value with its unit: Hz for jumps, the data's unit for amplitudes.
