@@ -37,12 +37,6 @@ double MiddleRoot(const ResponseCoefficients<double>& k, const TurningPoints& tp
                          0.5 * (tp.a_lower_end + tp.a_upper_end));
 }
 
-struct JumpAt {
-  int sweep = 0;        // index into the output sweeps
-  int index_after = 0;  // first dwell on the new branch
-  Branch from = Branch::kLower;
-};
-
 }  // namespace
 
 double RoundToSignificantDigits(double value, int digits) {
@@ -217,7 +211,6 @@ std::vector<Sweep> SimulateDwells(const DwellPlan& plan) {
   std::string error;
   if (!plan.IsValid(&error)) throw InputError("dwell plan: " + error);
   std::vector<Sweep> sweeps;
-  std::vector<JumpAt> jumps;
   for (const SweepPlan& sweep_plan : plan.sweeps) {
     Branch side = sweep_plan.start_branch;
     double a = 0.0;  // at rest before the first dwell
@@ -235,8 +228,10 @@ std::vector<Sweep> SimulateDwells(const DwellPlan& plan) {
         const SettledDwell dwell =
             SettleDwell(plan.truth, point.drive_frequency_rad_s, point.a_base, side, a);
         if (dwell.jumped && !sweep.points.empty()) {
-          jumps.push_back(
-              {static_cast<int>(sweeps.size()), static_cast<int>(sweep.points.size()), side});
+          JumpBracket jump;  // its controls and amplitudes once the noise is on
+          jump.kind = side == Branch::kLower ? JumpKind::kJumpUp : JumpKind::kJumpDown;
+          jump.index_before = static_cast<int>(sweep.points.size()) - 1;
+          sweep.jumps.push_back(jump);
         }
         side = dwell.side;
         a = dwell.amplitude;
@@ -260,18 +255,15 @@ std::vector<Sweep> SimulateDwells(const DwellPlan& plan) {
       }
     }
   }
-  for (const JumpAt& jump : jumps) {
-    Sweep& sweep = sweeps[jump.sweep];
-    const DwellPoint& before = sweep.points[jump.index_after - 1];
-    const DwellPoint& after = sweep.points[jump.index_after];
-    JumpBracket bracket;
-    bracket.kind = jump.from == Branch::kLower ? JumpKind::kJumpUp : JumpKind::kJumpDown;
-    bracket.index_before = jump.index_after - 1;
-    bracket.control_before = sweep.Control(before);
-    bracket.control_after = sweep.Control(after);
-    bracket.amplitude_before = before.amplitude;
-    bracket.amplitude_after = after.amplitude;
-    sweep.jumps.push_back(bracket);
+  for (Sweep& sweep : sweeps) {
+    for (JumpBracket& jump : sweep.jumps) {
+      const DwellPoint& before = sweep.points[jump.index_before];
+      const DwellPoint& after = sweep.points[jump.index_before + 1];
+      jump.control_before = sweep.Control(before);
+      jump.control_after = sweep.Control(after);
+      jump.amplitude_before = before.amplitude;
+      jump.amplitude_after = after.amplitude;
+    }
   }
   return sweeps;
 }
