@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 
 #include "dwellfit/estimator/analysis/parameter_uncertainty.h"
 #include "dwellfit/estimator/common/string_printf.h"

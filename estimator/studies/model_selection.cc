@@ -518,22 +518,14 @@ void WarnAbout(ModelSelectionReport* report, const std::vector<int>& candidates,
   }
 }
 
-// Steps 1 and 3 of the rule: the candidates, and the one near-best on the
-// most scores (the lowest BIC among those tied).
-int Choose(ModelSelectionReport* report, const std::vector<int>& candidates) {
-  int chosen = -1;
-  for (int i : candidates) {
-    const VariantResult& v = report->variants[i];
-    if (chosen < 0) {
-      chosen = i;
-      continue;
-    }
-    const VariantResult& so_far = report->variants[chosen];
-    if (v.near_best > so_far.near_best || (v.near_best == so_far.near_best && v.bic < so_far.bic)) {
-      chosen = i;
-    }
-  }
-  return chosen;
+// Step 3 of the rule: the candidate near-best on the most scores (the
+// lowest BIC among those tied, the first of equals).
+int Choose(const ModelSelectionReport& report, const std::vector<int>& candidates) {
+  return *std::min_element(candidates.begin(), candidates.end(), [&](int i, int j) {
+    const VariantResult& a = report.variants[i];
+    const VariantResult& b = report.variants[j];
+    return a.near_best > b.near_best || (a.near_best == b.near_best && a.bic < b.bic);
+  });
 }
 
 }  // namespace
@@ -547,10 +539,8 @@ void RecommendVariant(ModelSelectionReport* report) {
     if (!v.unstable) stable.push_back(i);
   }
   const std::vector<int>& candidates = stable.empty() ? eligible : stable;
-  for (int i = 0; i < static_cast<int>(report->variants.size()); ++i) {
-    const bool candidate = std::find(candidates.begin(), candidates.end(), i) != candidates.end();
-    report->variants[i].near_best = candidate ? 0 : -1;
-  }
+  for (VariantResult& v : report->variants) v.near_best = -1;
+  for (int i : candidates) report->variants[i].near_best = 0;
   report->jump_tolerance_hz = ResonanceWidthHz(*report, candidates);
   const double best_amplitude =
       Best(*report, candidates, [](const VariantResult& v) { return v.upper_branch_percent; });
@@ -566,7 +556,7 @@ void RecommendVariant(ModelSelectionReport* report) {
     return;
   }
   CountNearBest(report, candidates);
-  report->recommended = Choose(report, candidates);
+  report->recommended = Choose(*report, candidates);
   WarnAbout(report, candidates, !stable.empty());
   const VariantResult& chosen = report->variants[report->recommended];
   report->verdict = StringPrintf(

@@ -23,10 +23,6 @@ double MaxOf(const std::vector<double>& values) {
                         : *std::max_element(values.begin(), values.end());
 }
 
-std::string FitCounts(const VariantResult& v) {
-  return StringPrintf("%zu (%d / %d)", v.fits.size(), v.fits_not_converged, v.fits_failed);
-}
-
 // "2.13 (4.05 Hz)": a median error in % with its Hz.
 std::string PercentAndHz(double percent, double hz) {
   if (!std::isfinite(percent)) return "-";
@@ -56,7 +52,8 @@ void MainTable(const ModelSelectionReport& report, std::ostream& out) {
         << Cell(MedianOf(v.validation.jump_down_percent), "%.2f") << " | "
         << (v.unstable ? "no" : "yes") << " | "
         << (v.near_best < 0 ? std::string("not a candidate") : std::to_string(v.near_best)) << " | "
-        << FitCounts(v) << " |\n";
+        << StringPrintf("%zu (%d / %d)", v.fits.size(), v.fits_not_converged, v.fits_failed)
+        << " |\n";
   }
 }
 
