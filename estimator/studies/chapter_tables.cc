@@ -25,13 +25,11 @@ struct PairedFit {
 PairedFit FitBothWays(const IdentifyConfig& config) {
   PairedFit fit;
   fit.data = ResolveRun(config);
-  const PenaltyOptions configured = fit.data.options.solve.penalties;
   fit.data.options.solve.penalties.bifurcation_range.enabled = true;
   fit.with_penalty = FitRun(fit.data).best;
   fit.data.options.solve.penalties.bifurcation_range.enabled = false;
   fit.data.options.solve.penalties.branch_stability.enabled = false;
   fit.without_penalty = FitRun(fit.data).best;
-  fit.data.options.solve.penalties = configured;
   fit.omega_ref_rad_s =
       config.omega_ref_rad_s.value_or(fit.with_penalty.parameters[kNaturalFrequency]);
   return fit;
@@ -46,11 +44,10 @@ struct Row {
   double truth;
 };
 
-std::vector<Row> Rows(const PairedFit& fit, const IdentificationOptions& options,
-                      const ParameterVector& truth) {
+std::vector<Row> Rows(const PairedFit& fit, const ParameterVector& truth) {
   std::vector<Row> rows;
   for (int i = 0; i < kNumParameters; ++i) {
-    if (i == kNaturalFrequency && options.fixed[kNaturalFrequency]) continue;
+    if (i == kNaturalFrequency && fit.data.options.fixed[kNaturalFrequency]) continue;
     const bool omega = i == kNaturalFrequency;
     auto shown = [&](const ParameterVector& p) { return omega ? RadPerSecondToHz(p[i]) : p[i]; };
     rows.push_back({omega ? "w [Hz]" : ParameterName(i), shown(fit.with_penalty.parameters),
@@ -150,7 +147,7 @@ std::string ChapterTablesMarkdown(const IdentifyConfig& numerical, const Paramet
   out << "## Table 3.3: numerical data (`" << DatasetName(numerical) << "`)\n\n"
       << "| parameter | known value | with penalty | error % | without penalty | error % |\n"
       << "|---|---|---|---|---|---|\n";
-  for (const Row& row : Rows(thesis, thesis.data.options, truth)) {
+  for (const Row& row : Rows(thesis, truth)) {
     out << "| " << row.name << " | " << StringPrintf("%.6g", row.truth) << " | "
         << StringPrintf("%.8g", row.with_penalty) << " | "
         << PercentError(row.with_penalty, row.truth) << " | "
@@ -166,7 +163,7 @@ std::string ChapterTablesMarkdown(const IdentifyConfig& numerical, const Paramet
       << "Percent comparison: |with - without| / |with|.\n\n"
       << "| parameter | with penalty | without penalty | percent comparison |\n"
       << "|---|---|---|---|\n";
-  for (const Row& row : Rows(beam, beam.data.options, ParameterVector{})) {
+  for (const Row& row : Rows(beam, ParameterVector{})) {
     out << "| " << row.name << " | " << StringPrintf("%.6g", row.with_penalty) << " | "
         << StringPrintf("%.6g", row.without_penalty) << " | "
         << PercentError(row.without_penalty, row.with_penalty) << " |\n";
