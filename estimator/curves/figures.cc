@@ -3,11 +3,13 @@
 #include <stdlib.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "boost/algorithm/string/join.hpp"
 #include "dwellfit/estimator/common/string_printf.h"
 
 namespace dwellfit {
@@ -43,10 +45,7 @@ std::string Preamble(const FigureSet& figures) {
         "dwells = \"predictions.csv\"\n"
         "set grid lc rgb \"#dddddd\"\n"
         "set key opaque box\n";
-  std::string corner;
-  for (size_t i = 0; i < figures.corner_lines.size(); ++i)
-    corner += (i > 0 ? "\n" : "") + figures.corner_lines[i];
-  gp << "estimates = " << Quoted(corner) << "\n";
+  gp << "estimates = " << Quoted(boost::algorithm::join(figures.corner_lines, "\n")) << "\n";
   gp << "amplitude_unit = " << Quoted(figures.amplitude_unit) << "\n\n";
   return gp.str();
 }
@@ -133,9 +132,7 @@ std::string ReadFile(const std::filesystem::path& path) {
 std::string FigureFileStem(const FigureSweep& sweep) {
   std::string stem = "figure_" + sweep.role + "_" + sweep.id;
   for (char& c : stem) {
-    const bool safe = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
-                      c == '.' || c == '-' || c == '_';
-    if (!safe) c = '_';
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '-' && c != '_') c = '_';
   }
   return stem;
 }

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <functional>
 #include <limits>
 
 #include "boost/math/tools/toms748_solve.hpp"
@@ -37,28 +36,18 @@ FrequencyQuadratic MakeQuadratic(const ParameterVector& p, double a_base, double
   return q;
 }
 
-// The roots x- <= x+ (NaN where the discriminant is negative); `clamp` sets
-// a discriminant rounded just below 0 at a piece's end to 0.
-void QuadraticRoots(const FrequencyQuadratic& q, bool clamp, double* x_minus, double* x_plus) {
-  *x_minus = *x_plus = kNaN;
-  double disc = q.disc;
-  if (disc < 0.0 && clamp) disc = 0.0;
-  if (!(disc >= 0.0) || !(q.c2 > 0.0)) return;
-  const double s = std::sqrt(disc);
+// Omega [rad/s] on `side` (0: left root x-, 1: right root x+ >= x-) at
+// amplitude a; NaN where that root is not a positive x. A discriminant
+// rounded just below 0 at a piece's end counts as 0.
+double SideFrequency(const ParameterVector& p, double a_base, double a, int side) {
+  const FrequencyQuadratic q = MakeQuadratic(p, a_base, a);
+  if (std::isnan(q.disc) || !(q.c2 > 0.0)) return kNaN;
+  const double s = std::sqrt(std::max(q.disc, 0.0));
   const double big = -0.5 * (q.c1 + std::copysign(s, q.c1));
   double r1 = big / q.c2;
   double r2 = big != 0.0 ? q.c0 / big : r1;
   if (r1 > r2) std::swap(r1, r2);
-  *x_minus = r1;
-  *x_plus = r2;
-}
-
-// Omega [rad/s] on `side` (0: left root, 1: right root) at amplitude a; NaN
-// where that root is not a positive x.
-double SideFrequency(const ParameterVector& p, double a_base, double a, int side, bool clamp) {
-  double x_minus, x_plus;
-  QuadraticRoots(MakeQuadratic(p, a_base, a), clamp, &x_minus, &x_plus);
-  const double x = side == 0 ? x_minus : x_plus;
+  const double x = side == 0 ? r1 : r2;
   return x > 0.0 ? std::sqrt(x) : kNaN;
 }
 
@@ -156,25 +145,32 @@ bool InRange(const CurveSpec& spec, double control) {
   return control >= spec.control_low - slack && control <= spec.control_high + slack;
 }
 
+// The swept control on `side` at amplitude a: Omega [rad/s] or a_base.
+double SideControl(const ParameterVector& p, const CurveSpec& spec, double a, int side) {
+  if (spec.kind == SweepKind::kFrequency) return SideFrequency(p, spec.a_base, a, side % 2);
+  const auto k = ResponseCoefficients<double>::FromParameters(p.data(), spec.omega_rad_s);
+  return std::sqrt(k.G(a));
+}
+
 // Walks the samples of one side in tracing order, keeping those inside the
 // swept range, and adds the exact point where the curve crosses an end of the
 // range between two samples (so the curve spans the whole range).
 class RangeWalker {
  public:
-  RangeWalker(const CurveSpec& spec, std::function<double(double)> control, int side,
+  RangeWalker(const ParameterVector& p, const CurveSpec& spec, int side,
               std::vector<RawPoint>* trace)
-      : spec_(spec), control_(std::move(control)), side_(side), trace_(trace) {}
+      : p_(p), spec_(spec), side_(side), trace_(trace) {}
 
   void Add(double a) {
-    const double c = control_(a);
+    const double c = Control(a);
     const bool in = std::isfinite(c) && InRange(spec_, c);
     if (has_previous_ && in != previous_in_ && std::isfinite(c) && std::isfinite(previous_c_)) {
       const double outside = in ? previous_c_ : c;
       const double bound = outside < spec_.control_low ? spec_.control_low : spec_.control_high;
-      const double crossing = Toms748([&](double x) { return control_(x) - bound; },
+      const double crossing = Toms748([&](double x) { return Control(x) - bound; },
                                       std::min(previous_a_, a), std::max(previous_a_, a));
       if (std::isfinite(crossing)) {
-        Push(crossing, control_(crossing), in);
+        Push(crossing, Control(crossing), in);
         open_ = in;
       }
     }
@@ -197,8 +193,10 @@ class RangeWalker {
                        frequency ? spec_.a_base : control, side_, breaks});
   }
 
+  double Control(double a) const { return SideControl(p_, spec_, a, side_); }
+
+  const ParameterVector& p_;
   const CurveSpec& spec_;
-  std::function<double(double)> control_;
   int side_;
   std::vector<RawPoint>* trace_;
   bool has_previous_ = false, previous_in_ = false, open_ = false;
@@ -217,10 +215,7 @@ std::vector<RawPoint> FrequencyTrace(const ParameterVector& p, const CurveSpec& 
     const std::vector<double> samples =
         PieceSamples(pieces[piece].first, pieces[piece].second, spec.points_per_side);
     for (int side = 0; side < 2; ++side) {
-      RangeWalker walker(
-          spec,
-          [&p, &spec, side](double a) { return SideFrequency(p, spec.a_base, a, side, true); },
-          static_cast<int>(2 * piece + side), &trace);
+      RangeWalker walker(p, spec, static_cast<int>(2 * piece + side), &trace);
       for (size_t i = 0; i < samples.size(); ++i)
         walker.Add(side == 0 ? samples[i] : samples[samples.size() - 1 - i]);
     }
@@ -246,39 +241,9 @@ std::vector<RawPoint> AmplitudeTrace(const ParameterVector& p, const CurveSpec& 
   std::vector<RawPoint> trace;
   if (!std::isfinite(a_hi)) return trace;
   const int n = 2 * spec.points_per_side;
-  RangeWalker walker(
-      spec, [&k](double a) { return std::sqrt(k.G(a)); }, 0, &trace);
+  RangeWalker walker(p, spec, 0, &trace);
   for (int i = 0; i <= n; ++i) walker.Add(a_hi * i / n);
   return trace;
-}
-
-}  // namespace
-
-bool CurveSpec::IsValid(std::string* why) const {
-  auto fail = [why](const std::string& text) {
-    *why = text;
-    return false;
-  };
-  if (kind == SweepKind::kFrequency && !(a_base > 0.0 && std::isfinite(a_base)))
-    return fail(StringPrintf("a frequency curve needs a base level a_base > 0 (got %g)", a_base));
-  if (kind == SweepKind::kAmplitude && !(omega_rad_s > 0.0 && std::isfinite(omega_rad_s)))
-    return fail("an amplitude curve needs a drive frequency > 0");
-  const double min_low = kind == SweepKind::kFrequency ? 0.0 : -1.0;
-  if (!(control_low > min_low && control_high > control_low && std::isfinite(control_high)))
-    return fail(StringPrintf("the swept range [%g, %g] must be finite, positive and increasing",
-                             control_low, control_high));
-  if (points_per_side < 10 || points_per_side > 1000000)
-    return fail(StringPrintf("points_per_side %d is outside [10, 1000000]", points_per_side));
-  return true;
-}
-
-namespace {
-
-// The swept control on `side` at amplitude a: Omega [rad/s] or a_base.
-double SideControl(const ParameterVector& p, const CurveSpec& spec, double a, int side) {
-  if (spec.kind == SweepKind::kFrequency) return SideFrequency(p, spec.a_base, a, side % 2, true);
-  const auto k = ResponseCoefficients<double>::FromParameters(p.data(), spec.omega_rad_s);
-  return std::sqrt(k.G(a));
 }
 
 CurvePoint PointAt(const ParameterVector& p, const CurveSpec& spec, double a, int side) {
@@ -291,10 +256,7 @@ CurvePoint PointAt(const ParameterVector& p, const CurveSpec& spec, double a, in
 // of dG/da(a, Omega(a)) on [a0, a1]; false when it cannot be bracketed.
 bool FindFold(const ParameterVector& p, const CurveSpec& spec, double a0, double a1, int side,
               CurvePoint* fold) {
-  auto dg = [&](double a) {
-    const CurvePoint point = PointAt(p, spec, a, side);
-    return point.dG_da;
-  };
+  auto dg = [&](double a) { return PointAt(p, spec, a, side).dG_da; };
   const double a = Toms748(dg, std::min(a0, a1), std::max(a0, a1));
   if (!std::isfinite(a)) return false;
   *fold = PointAt(p, spec, a, side);
@@ -326,6 +288,24 @@ void AddBackbone(const ParameterVector& p, const std::vector<RawPoint>& trace,
 }
 
 }  // namespace
+
+bool CurveSpec::IsValid(std::string* why) const {
+  auto fail = [why](const std::string& text) {
+    *why = text;
+    return false;
+  };
+  if (kind == SweepKind::kFrequency && !(a_base > 0.0 && std::isfinite(a_base)))
+    return fail(StringPrintf("a frequency curve needs a base level a_base > 0 (got %g)", a_base));
+  if (kind == SweepKind::kAmplitude && !(omega_rad_s > 0.0 && std::isfinite(omega_rad_s)))
+    return fail("an amplitude curve needs a drive frequency > 0");
+  const double min_low = kind == SweepKind::kFrequency ? 0.0 : -1.0;
+  if (!(control_low > min_low && control_high > control_low && std::isfinite(control_high)))
+    return fail(StringPrintf("the swept range [%g, %g] must be finite, positive and increasing",
+                             control_low, control_high));
+  if (points_per_side < 10 || points_per_side > 1000000)
+    return fail(StringPrintf("points_per_side %d is outside [10, 1000000]", points_per_side));
+  return true;
+}
 
 ResponseCurve TraceResponseCurve(const ParameterVector& p, const CurveSpec& spec) {
   std::string why;
@@ -399,12 +379,13 @@ std::vector<CurveRoot> CurveAmplitudesAt(const ParameterVector& p, const Respons
   }
   std::sort(roots.begin(), roots.end(),
             [](const CurveRoot& x, const CurveRoot& y) { return x.a < y.a; });
-  std::vector<CurveRoot> distinct;
-  for (const CurveRoot& root : roots) {
-    if (!distinct.empty() && std::abs(root.a - distinct.back().a) <= 1e-12 * root.a) continue;
-    distinct.push_back(root);
-  }
-  return distinct;
+  // One of each group of roots equal to rounding (the trace's points at the control).
+  roots.erase(std::unique(roots.begin(), roots.end(),
+                          [](const CurveRoot& kept, const CurveRoot& root) {
+                            return std::abs(root.a - kept.a) <= 1e-12 * root.a;
+                          }),
+              roots.end());
+  return roots;
 }
 
 double CurveAmplitudeOnBranch(const std::vector<CurveRoot>& roots, Branch branch, double a_guess) {

@@ -98,8 +98,7 @@ class DwellRun {
   }
 
   RigDwellTruth Settle();
-  void Record(DwellTrace* trace);
-  void Finish(const RigDwellTruth& truth);
+  void Record(DwellTrace* trace);  // then leaves `state` at the dwell's end
 
  private:
   // Integrates one period from t_; returns the first harmonic H of u over it.
@@ -117,7 +116,6 @@ class DwellRun {
   RigEquation equation_;
   State x_;
   Stepper stepper_;
-  Complex last_harmonic_;
 };
 
 RigDwellTruth DwellRun::Settle() {
@@ -138,14 +136,15 @@ RigDwellTruth DwellRun::Settle() {
       break;
     }
   }
-  last_harmonic_ = history.back();
   truth.settle_periods = static_cast<int>(history.size());
-  truth.amplitude = std::abs(last_harmonic_);
-  truth.lag_rad = -std::arg(last_harmonic_);
+  truth.amplitude = std::abs(history.back());
+  truth.lag_rad = -std::arg(history.back());
+  state_->amplitude = truth.amplitude;
   return truth;
 }
 
 void DwellRun::Record(DwellTrace* trace) {
+  const RigEquation& e = equation_;
   const double fs = options_.sample_rate_hz;
   const double tau = options_.channels.skew_samples / fs;
   const int n = static_cast<int>(std::lround(options_.record_periods * period_ * fs));
@@ -166,7 +165,6 @@ void DwellRun::Record(DwellTrace* trace) {
   std::size_t next = 0;
   auto observe = [&](const State& x, double t) {
     for (; next < events.size() && events[next].first <= t; ++next) {
-      const RigEquation& e = equation_;
       if (events[next].second == 0) {
         const double y =
             e.base_pole > 0.0 ? e.a_base * x[2] : e.a_base * std::cos(e.omega * t + e.phase0);
@@ -181,16 +179,11 @@ void DwellRun::Record(DwellTrace* trace) {
   odeint::integrate_times(stepper_, equation_, x_, times.begin(), times.end(), period_ / 32,
                           observe);
   t_ = times.back();
-}
-
-void DwellRun::Finish(const RigDwellTruth& truth) {
-  const RigEquation& e = equation_;
   state_->u = e.scale * x_[0];
   state_->v = e.omega * e.scale * x_[1];
   state_->y_base = e.a_base * x_[2];
   state_->y_response = e.volt_scale * x_[3];
   state_->phase = std::fmod(e.phase0 + e.omega * t_, kTwoPi);
-  state_->amplitude = truth.amplitude;
 }
 
 // |H(f)| of a one-pole filter (1 without one).
@@ -234,25 +227,26 @@ void CheckPlan(const DwellPlan& plan, const RigOptions& options) {
 }  // namespace
 
 bool RigOptions::IsValid(std::string* error) const {
+  auto fail = [error](const std::string& what) {
+    *error = what;
+    return false;
+  };
   if (!channels.IsValid(error) || !gauge.IsValid(error)) return false;
   if (!(sample_rate_hz > 0.0 && std::isfinite(sample_rate_hz)) || record_periods < 1) {
-    *error = "sample_rate_hz must be positive and record_periods at least 1";
-    return false;
+    return fail("sample_rate_hz must be positive and record_periods at least 1");
   }
   if (!(settle_tolerance > 0.0) || settle_window_periods < 1 ||
       max_settle_periods < 2 * settle_window_periods) {
-    *error =
+    return fail(
         "settle_tolerance must be positive, window_periods >= 1 and max_periods at least "
-        "twice window_periods";
-    return false;
+        "twice window_periods");
   }
   if (!(noise_relative_sigma >= 0.0 && noise_relative_sigma < 1.0)) {
-    *error = StringPrintf("noise relative_sigma must lie in [0, 1), got %g", noise_relative_sigma);
-    return false;
+    return fail(
+        StringPrintf("noise relative_sigma must lie in [0, 1), got %g", noise_relative_sigma));
   }
   if (!(integration_tolerance > 0.0 && integration_tolerance < 1e-3)) {
-    *error = "integration_tolerance must lie in (0, 1e-3)";
-    return false;
+    return fail("integration_tolerance must lie in (0, 1e-3)");
   }
   return true;
 }
@@ -263,9 +257,7 @@ RigRun SimulateRig(const DwellPlan& plan, const RigOptions& options, const RigPr
   std::mt19937_64 random(options.noise_seed);
   int total = 0;
   for (const SweepPlan& sweep : plan.sweeps) {
-    for (SweepDirection direction : sweep.directions) {
-      total += static_cast<int>(ControlGrid(sweep, direction).size());
-    }
+    total += (sweep.NumSteps() + 1) * static_cast<int>(sweep.directions.size());
   }
   RigRun run;
   for (const SweepPlan& sweep : plan.sweeps) {
@@ -284,7 +276,6 @@ RigRun SimulateRig(const DwellPlan& plan, const RigOptions& options, const RigPr
         DwellTrace trace{sweep.id, direction, sweep.kind, HzToRadPerSecond(f_hz),
                          options.sample_rate_hz};
         dwell.Record(&trace);
-        dwell.Finish(dwell_truth);
         AddNoise(options, gauge, a_base, dwell_truth, f_hz, &random, &trace);
         DwellPoint point;
         point.drive_frequency_rad_s = HzToRadPerSecond(f_hz);

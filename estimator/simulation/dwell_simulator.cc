@@ -37,14 +37,6 @@ double MiddleRoot(const ResponseCoefficients<double>& k, const TurningPoints& tp
                          0.5 * (tp.a_lower_end + tp.a_upper_end));
 }
 
-Branch OtherBranch(Branch side) { return side == Branch::kLower ? Branch::kUpper : Branch::kLower; }
-
-struct JumpAt {
-  int sweep = 0;        // index into the output sweeps
-  int index_after = 0;  // first dwell on the new branch
-  Branch from = Branch::kLower;
-};
-
 }  // namespace
 
 double RoundToSignificantDigits(double value, int digits) {
@@ -124,43 +116,33 @@ bool SweepPlan::IsValid(std::string* error) const {
 }
 
 bool DwellPlan::IsValid(std::string* error) const {
+  auto fail = [error](const std::string& what) {
+    *error = what;
+    return false;
+  };
   for (int i = 0; i < kNumParameters; ++i) {
     if (!std::isfinite(truth[i])) {
-      *error = std::string("truth parameter ") + ParameterName(i) + " is not finite";
-      return false;
+      return fail(std::string("truth parameter ") + ParameterName(i) + " is not finite");
     }
   }
-  if (!(truth[kEtaE] > 0.0)) {
-    *error = "truth eta_e must be positive, got " + G12(truth[kEtaE]);
-    return false;
-  }
+  if (!(truth[kEtaE] > 0.0)) return fail("truth eta_e must be positive, got " + G12(truth[kEtaE]));
   if (!(truth[kNaturalFrequency] > 0.0)) {
-    *error = "truth omega must be positive, got " + G12(truth[kNaturalFrequency]) + " rad/s";
-    return false;
+    return fail("truth omega must be positive, got " + G12(truth[kNaturalFrequency]) + " rad/s");
   }
   if (truth[kMu1] < 0.0 || truth[kMu2] < 0.0) {
-    *error = "truth damping mu1 and mu2 must not be negative";
-    return false;
+    return fail("truth damping mu1 and mu2 must not be negative");
   }
-  if (sweeps.empty()) {
-    *error = "the plan has no sweeps";
-    return false;
-  }
+  if (sweeps.empty()) return fail("the plan has no sweeps");
   std::set<std::string> ids;
   for (const SweepPlan& sweep : sweeps) {
     std::string why;
-    if (!sweep.IsValid(&why)) {
-      *error = "sweep '" + sweep.id + "': " + why;
-      return false;
-    }
+    if (!sweep.IsValid(&why)) return fail("sweep '" + sweep.id + "': " + why);
     if (!ids.insert(sweep.id).second) {
-      *error = "sweep id '" + sweep.id + "' is used twice; ids must be unique";
-      return false;
+      return fail("sweep id '" + sweep.id + "' is used twice; ids must be unique");
     }
   }
   if (!(noise.relative_sigma >= 0.0 && noise.relative_sigma < 1.0)) {
-    *error = "noise relative_sigma must be in [0, 1), got " + G12(noise.relative_sigma);
-    return false;
+    return fail("noise relative_sigma must be in [0, 1), got " + G12(noise.relative_sigma));
   }
   return true;
 }
@@ -211,7 +193,7 @@ SettledDwell SettleDwell(const ParameterVector& truth, double omega_drive_rad_s,
     }
   } else if ((side == Branch::kLower && !lower_exists) ||
              (side == Branch::kUpper && !upper_exists)) {
-    side = OtherBranch(side);
+    side = side == Branch::kLower ? Branch::kUpper : Branch::kLower;
     dwell.jumped = !from_rest;
   }
   dwell.side = side;
@@ -229,7 +211,6 @@ std::vector<Sweep> SimulateDwells(const DwellPlan& plan) {
   std::string error;
   if (!plan.IsValid(&error)) throw InputError("dwell plan: " + error);
   std::vector<Sweep> sweeps;
-  std::vector<JumpAt> jumps;
   for (const SweepPlan& sweep_plan : plan.sweeps) {
     Branch side = sweep_plan.start_branch;
     double a = 0.0;  // at rest before the first dwell
@@ -247,8 +228,10 @@ std::vector<Sweep> SimulateDwells(const DwellPlan& plan) {
         const SettledDwell dwell =
             SettleDwell(plan.truth, point.drive_frequency_rad_s, point.a_base, side, a);
         if (dwell.jumped && !sweep.points.empty()) {
-          jumps.push_back(
-              {static_cast<int>(sweeps.size()), static_cast<int>(sweep.points.size()), side});
+          JumpBracket jump;  // its controls and amplitudes once the noise is on
+          jump.kind = side == Branch::kLower ? JumpKind::kJumpUp : JumpKind::kJumpDown;
+          jump.index_before = static_cast<int>(sweep.points.size()) - 1;
+          sweep.jumps.push_back(jump);
         }
         side = dwell.side;
         a = dwell.amplitude;
@@ -272,18 +255,15 @@ std::vector<Sweep> SimulateDwells(const DwellPlan& plan) {
       }
     }
   }
-  for (const JumpAt& jump : jumps) {
-    Sweep& sweep = sweeps[jump.sweep];
-    const DwellPoint& before = sweep.points[jump.index_after - 1];
-    const DwellPoint& after = sweep.points[jump.index_after];
-    JumpBracket bracket;
-    bracket.kind = jump.from == Branch::kLower ? JumpKind::kJumpUp : JumpKind::kJumpDown;
-    bracket.index_before = jump.index_after - 1;
-    bracket.control_before = sweep.Control(before);
-    bracket.control_after = sweep.Control(after);
-    bracket.amplitude_before = before.amplitude;
-    bracket.amplitude_after = after.amplitude;
-    sweep.jumps.push_back(bracket);
+  for (Sweep& sweep : sweeps) {
+    for (JumpBracket& jump : sweep.jumps) {
+      const DwellPoint& before = sweep.points[jump.index_before];
+      const DwellPoint& after = sweep.points[jump.index_before + 1];
+      jump.control_before = sweep.Control(before);
+      jump.control_after = sweep.Control(after);
+      jump.amplitude_before = before.amplitude;
+      jump.amplitude_after = after.amplitude;
+    }
   }
   return sweeps;
 }
@@ -306,19 +286,17 @@ void DescribeSimulation(const DwellPlan& plan, const std::vector<Sweep>& sweeps,
     auto control = [frequency](double value) {
       return frequency ? G12(RadPerSecondToHz(value)) + " Hz" : "a_base " + G12(value);
     };
-    double a_min = sweep.points.front().amplitude;
-    double a_max = a_min;
-    for (const DwellPoint& point : sweep.points) {
-      a_min = std::min(a_min, point.amplitude);
-      a_max = std::max(a_max, point.amplitude);
-    }
+    const auto [low, high] = std::minmax_element(
+        sweep.points.begin(), sweep.points.end(),
+        [](const DwellPoint& x, const DwellPoint& y) { return x.amplitude < y.amplitude; });
     const DwellPoint& first = sweep.points.front();
     *out << sweep.Name() << ": " << SweepKindName(sweep.kind) << " sweep at "
          << (frequency ? "a_base " + G12(first.a_base)
                        : G12(RadPerSecondToHz(first.drive_frequency_rad_s)) + " Hz")
          << ", " << control(sweep.Control(first)) << " -> "
          << control(sweep.Control(sweep.points.back())) << ", " << sweep.points.size()
-         << " dwells, a " << StringPrintf("%.4g", a_min) << " .. " << StringPrintf("%.4g", a_max);
+         << " dwells, a " << StringPrintf("%.4g", low->amplitude) << " .. "
+         << StringPrintf("%.4g", high->amplitude);
     if (sweep.jumps.empty()) *out << ", no jump";
     for (const JumpBracket& jump : sweep.jumps) {
       *out << ", " << JumpKindName(jump.kind) << " between " << control(jump.control_before)

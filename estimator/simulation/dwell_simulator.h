@@ -108,9 +108,8 @@ double ResponseLag(const ParameterVector& truth, double omega_drive_rad_s, doubl
 // Simulates every sweep of `plan`: one Sweep per (sweep, direction), in plan
 // order, with kind, direction, id, points (drive_frequency_rad_s, a_base,
 // amplitude with noise, the noise-free phase lag ResponseLag, true branch;
-// source_line 0) and the true jumps
-// (controls in rad/s or a_base, amplitudes as output). Deterministic. Throws
-// InputError when the plan is not valid.
+// source_line 0) and the true jumps (controls in rad/s or a_base, amplitudes
+// as output). Deterministic. Throws InputError when the plan is not valid.
 std::vector<Sweep> SimulateDwells(const DwellPlan& plan);
 
 // A short human-readable account of the plan in effect and of each simulated

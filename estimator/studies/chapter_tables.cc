@@ -1,11 +1,10 @@
 #include "dwellfit/estimator/studies/chapter_tables.h"
 
-#include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 #include <vector>
 
+#include "dwellfit/estimator/analysis/prediction_intervals.h"
 #include "dwellfit/estimator/analysis/sweep_prediction.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/fit/identification.h"
@@ -26,13 +25,11 @@ struct PairedFit {
 PairedFit FitBothWays(const IdentifyConfig& config) {
   PairedFit fit;
   fit.data = ResolveRun(config);
-  const PenaltyOptions configured = fit.data.options.solve.penalties;
   fit.data.options.solve.penalties.bifurcation_range.enabled = true;
   fit.with_penalty = FitRun(fit.data).best;
   fit.data.options.solve.penalties.bifurcation_range.enabled = false;
   fit.data.options.solve.penalties.branch_stability.enabled = false;
   fit.without_penalty = FitRun(fit.data).best;
-  fit.data.options.solve.penalties = configured;
   fit.omega_ref_rad_s =
       config.omega_ref_rad_s.value_or(fit.with_penalty.parameters[kNaturalFrequency]);
   return fit;
@@ -47,24 +44,22 @@ struct Row {
   double truth;
 };
 
-std::vector<Row> Rows(const PairedFit& fit, const IdentificationOptions& options,
-                      const ParameterVector& truth) {
+std::vector<Row> Rows(const PairedFit& fit, const ParameterVector& truth) {
   std::vector<Row> rows;
   for (int i = 0; i < kNumParameters; ++i) {
-    if (i == kNaturalFrequency && options.fixed[kNaturalFrequency]) continue;
+    if (i == kNaturalFrequency && fit.data.options.fixed[kNaturalFrequency]) continue;
     const bool omega = i == kNaturalFrequency;
-    rows.push_back(
-        {omega ? "w [Hz]" : ParameterName(i),
-         omega ? RadPerSecondToHz(fit.with_penalty.parameters[i]) : fit.with_penalty.parameters[i],
-         omega ? RadPerSecondToHz(fit.without_penalty.parameters[i])
-               : fit.without_penalty.parameters[i],
-         omega ? RadPerSecondToHz(truth[i]) : truth[i]});
+    auto shown = [&](const ParameterVector& p) { return omega ? RadPerSecondToHz(p[i]) : p[i]; };
+    rows.push_back({omega ? "w [Hz]" : ParameterName(i), shown(fit.with_penalty.parameters),
+                    shown(fit.without_penalty.parameters), shown(truth)});
   }
+  auto effective = [&](const ParameterVector& p) {
+    return EffectiveNonlinearity(p, fit.omega_ref_rad_s);
+  };
   rows.push_back({"effective nonlinearity at " +
                       StringPrintf("%.4g", RadPerSecondToHz(fit.omega_ref_rad_s)) + " Hz",
-                  EffectiveNonlinearity(fit.with_penalty.parameters, fit.omega_ref_rad_s),
-                  EffectiveNonlinearity(fit.without_penalty.parameters, fit.omega_ref_rad_s),
-                  EffectiveNonlinearity(truth, fit.omega_ref_rad_s)});
+                  effective(fit.with_penalty.parameters), effective(fit.without_penalty.parameters),
+                  effective(truth)});
   return rows;
 }
 
@@ -74,12 +69,18 @@ std::string PercentError(double estimate, double reference) {
 }
 
 void SolverLines(const PairedFit& fit, std::ostream& out) {
-  out << "- with penalty: final cost " << StringPrintf("%.6g", fit.with_penalty.final_cost) << ", "
-      << fit.with_penalty.iterations << " iterations, "
-      << (fit.with_penalty.converged ? "converged" : "not converged") << "\n";
-  out << "- without penalty: final cost " << StringPrintf("%.6g", fit.without_penalty.final_cost)
-      << ", " << fit.without_penalty.iterations << " iterations, "
-      << (fit.without_penalty.converged ? "converged" : "not converged") << "\n\n";
+  for (const IdentificationResult* r : {&fit.with_penalty, &fit.without_penalty}) {
+    out << (r == &fit.with_penalty ? "- with" : "- without") << " penalty: final cost "
+        << StringPrintf("%.6g", r->final_cost) << ", " << r->iterations << " iterations, "
+        << (r->converged ? "converged" : "not converged") << "\n";
+  }
+  out << "\n";
+}
+
+// The config's path from its "datasets/" on.
+std::string DatasetName(const IdentifyConfig& config) {
+  const std::string::size_type at = config.config_path.rfind("datasets/");
+  return config.config_path.substr(at == std::string::npos ? 0 : at);
 }
 
 // Every measured jump: its bracket and both models' folds (Hz for frequency
@@ -119,16 +120,11 @@ void JumpTable(const PairedFit& fit, std::ostream& out) {
       }
     }
   }
-  auto median = [](std::vector<double> values) {
-    if (values.empty()) return std::string("-");
-    std::sort(values.begin(), values.end());
-    const size_t n = values.size();
-    return StringPrintf("%.2f", n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]));
-  };
   if (!held_out_with.empty()) {
     out << "\nMedian error of the predicted jump-down frequency over the " << held_out_with.size()
-        << " held-out frequency sweeps (a missing fold counts 100 %): " << median(held_out_with)
-        << " % with the penalty, " << median(held_out_without) << " % without.\n";
+        << " held-out frequency sweeps (a missing fold counts 100 %): "
+        << StringPrintf("%.2f", MedianOf(held_out_with)) << " % with the penalty, "
+        << StringPrintf("%.2f", MedianOf(held_out_without)) << " % without.\n";
   }
   out << "\n";
 }
@@ -148,14 +144,10 @@ std::string ChapterTablesMarkdown(const IdentifyConfig& numerical, const Paramet
          "holds each enforced jump inside its bracket.\n\n";
 
   const PairedFit thesis = FitBothWays(numerical);
-  out << "## Table 3.3: numerical data (`"
-      << numerical.config_path.substr(numerical.config_path.rfind("datasets/") == std::string::npos
-                                          ? 0
-                                          : numerical.config_path.rfind("datasets/"))
-      << "`)\n\n"
+  out << "## Table 3.3: numerical data (`" << DatasetName(numerical) << "`)\n\n"
       << "| parameter | known value | with penalty | error % | without penalty | error % |\n"
       << "|---|---|---|---|---|---|\n";
-  for (const Row& row : Rows(thesis, thesis.data.options, truth)) {
+  for (const Row& row : Rows(thesis, truth)) {
     out << "| " << row.name << " | " << StringPrintf("%.6g", row.truth) << " | "
         << StringPrintf("%.8g", row.with_penalty) << " | "
         << PercentError(row.with_penalty, row.truth) << " | "
@@ -167,15 +159,11 @@ std::string ChapterTablesMarkdown(const IdentifyConfig& numerical, const Paramet
   JumpTable(thesis, out);
 
   const PairedFit beam = FitBothWays(measured);
-  out << "## Table 3.4: measured data (`"
-      << measured.config_path.substr(measured.config_path.rfind("datasets/") == std::string::npos
-                                         ? 0
-                                         : measured.config_path.rfind("datasets/"))
-      << "`)\n\n"
+  out << "## Table 3.4: measured data (`" << DatasetName(measured) << "`)\n\n"
       << "Percent comparison: |with - without| / |with|.\n\n"
       << "| parameter | with penalty | without penalty | percent comparison |\n"
       << "|---|---|---|---|\n";
-  for (const Row& row : Rows(beam, beam.data.options, ParameterVector{})) {
+  for (const Row& row : Rows(beam, ParameterVector{})) {
     out << "| " << row.name << " | " << StringPrintf("%.6g", row.with_penalty) << " | "
         << StringPrintf("%.6g", row.without_penalty) << " | "
         << PercentError(row.without_penalty, row.with_penalty) << " |\n";

@@ -12,22 +12,13 @@
 namespace dwellfit {
 namespace {
 
-SweepPlan FrequencySweep(double a_base, double from_hz, double to_hz, double step_hz) {
+// Sweep "F" of the frequency [Hz] at base level `held`, or "A" of a_base at
+// the drive frequency `held` [Hz]: from, to, step of the stepped control.
+SweepPlan Sweep(SweepKind kind, double held, double from, double to, double step) {
   SweepPlan sweep;
-  sweep.id = "F";
-  sweep.kind = SweepKind::kFrequency;
-  sweep.held_a_base = a_base;
-  sweep.from = from_hz;
-  sweep.to = to_hz;
-  sweep.step = step_hz;
-  return sweep;
-}
-
-SweepPlan AmplitudeSweep(double frequency_hz, double from, double to, double step) {
-  SweepPlan sweep;
-  sweep.id = "A";
-  sweep.kind = SweepKind::kAmplitude;
-  sweep.held_frequency_hz = frequency_hz;
+  sweep.id = kind == SweepKind::kFrequency ? "F" : "A";
+  sweep.kind = kind;
+  (kind == SweepKind::kFrequency ? sweep.held_a_base : sweep.held_frequency_hz) = held;
   sweep.from = from;
   sweep.to = to;
   sweep.step = step;
@@ -39,7 +30,8 @@ SweepPlan AmplitudeSweep(double frequency_hz, double from, double to, double ste
 DwellPlan ThesisCase() {
   DwellPlan plan;
   plan.truth = {100.0, 0.2, 300.0, 1e4, 9e8, HzToRadPerSecond(40.0)};
-  plan.sweeps = {FrequencySweep(0.01, 38.0, 46.0, 0.1), AmplitudeSweep(41.5, 0.002, 0.05, 0.001)};
+  plan.sweeps = {Sweep(SweepKind::kFrequency, 0.01, 38.0, 46.0, 0.1),
+                 Sweep(SweepKind::kAmplitude, 41.5, 0.002, 0.05, 0.001)};
   return plan;
 }
 
@@ -48,7 +40,8 @@ DwellPlan ThesisCase() {
 DwellPlan SofteningCase() {
   DwellPlan plan;
   plan.truth = {50.0, 0.5, 100.0, 1e3, -4e8, HzToRadPerSecond(60.0)};
-  plan.sweeps = {FrequencySweep(0.02, 52.0, 62.0, 0.1), AmplitudeSweep(59.3, 0.002, 0.05, 0.001)};
+  plan.sweeps = {Sweep(SweepKind::kFrequency, 0.02, 52.0, 62.0, 0.1),
+                 Sweep(SweepKind::kAmplitude, 59.3, 0.002, 0.05, 0.001)};
   return plan;
 }
 
@@ -116,6 +109,39 @@ FamilyMember Member(const std::string& base, const std::string& transform, Dwell
   return {base + " " + transform + " " + variant.name, std::move(plan), variant.fixed, false};
 }
 
+// The base config on the member's sweeps: both fitted, none validated, the
+// fixed parameters at their true values, every other guess from the data.
+IdentifyConfig MemberConfig(const IdentifyConfig& base, const FamilyMember& member) {
+  IdentifyConfig config = base;
+  config.fit_sweeps = {{"F", std::nullopt}, {"A", std::nullopt}};
+  config.validate_sweeps.clear();
+  config.jump_overrides.clear();
+  config.omega_ref_rad_s.reset();
+  config.multi_start.starts = 1;
+  if (member.bifurcation_penalty) {
+    BifurcationRangeOptions& range = config.identification.solve.penalties.bifurcation_range;
+    range.enabled = true;
+    range.enforce = {JumpTarget::kFrequencyJumpUp, JumpTarget::kFrequencyJumpDown,
+                     JumpTarget::kAmplitudeJumpUp, JumpTarget::kAmplitudeJumpDown};
+  }
+  for (int i = 0; i < kNumParameters; ++i) {
+    config.identification.fixed[i] = member.fixed[i];
+    config.initial_guess[i].reset();
+    if (member.fixed[i]) config.initial_guess[i] = member.plan.truth[i];
+    config.identification.initial[i] = member.plan.truth[i];  // placeholder, replaced
+  }
+  return config;
+}
+
+// The error as a class that does not move with the last bits of a platform's
+// arithmetic: below 1e-9, below the tolerance, or its power of ten.
+std::string ErrorClass(double error) {
+  if (!std::isfinite(error)) return "not finite";
+  if (error <= 1e-9) return "< 1e-9";
+  if (error <= kFamilyTolerance) return "< 1e-6";
+  return StringPrintf("1e%+03d", static_cast<int>(std::floor(std::log10(error))));
+}
+
 }  // namespace
 
 std::vector<FamilyMember> ConvergenceFamily() {
@@ -148,34 +174,6 @@ std::vector<FamilyMember> ConvergenceFamily() {
   return family;
 }
 
-namespace {
-
-// The base config on the member's sweeps: both fitted, none validated, the
-// fixed parameters at their true values, every other guess from the data.
-IdentifyConfig MemberConfig(const IdentifyConfig& base, const FamilyMember& member) {
-  IdentifyConfig config = base;
-  config.fit_sweeps = {{"F", std::nullopt}, {"A", std::nullopt}};
-  config.validate_sweeps.clear();
-  config.jump_overrides.clear();
-  config.omega_ref_rad_s.reset();
-  config.multi_start.starts = 1;
-  if (member.bifurcation_penalty) {
-    BifurcationRangeOptions& range = config.identification.solve.penalties.bifurcation_range;
-    range.enabled = true;
-    range.enforce = {JumpTarget::kFrequencyJumpUp, JumpTarget::kFrequencyJumpDown,
-                     JumpTarget::kAmplitudeJumpUp, JumpTarget::kAmplitudeJumpDown};
-  }
-  for (int i = 0; i < kNumParameters; ++i) {
-    config.identification.fixed[i] = member.fixed[i];
-    config.initial_guess[i].reset();
-    if (member.fixed[i]) config.initial_guess[i] = member.plan.truth[i];
-    config.identification.initial[i] = member.plan.truth[i];  // placeholder, replaced
-  }
-  return config;
-}
-
-}  // namespace
-
 FamilyOutcome RunFamilyMember(const IdentifyConfig& base, const FamilyMember& member) {
   FamilyOutcome outcome;
   outcome.member = member;
@@ -184,7 +182,6 @@ FamilyOutcome RunFamilyMember(const IdentifyConfig& base, const FamilyMember& me
     const IdentificationResult result = FitRun(run).best;
     outcome.status = result.status;
     outcome.message = result.message;
-    outcome.iterations = result.iterations;
     for (int i = 0; i < kNumParameters; ++i) {
       if (member.fixed[i]) continue;
       const double truth = member.plan.truth[i];
@@ -199,19 +196,6 @@ FamilyOutcome RunFamilyMember(const IdentifyConfig& base, const FamilyMember& me
   }
   return outcome;
 }
-
-namespace {
-
-// The error as a class that does not move with the last bits of a platform's
-// arithmetic: below 1e-9, below the tolerance, or its power of ten.
-std::string ErrorClass(double error) {
-  if (!std::isfinite(error)) return "not finite";
-  if (error <= 1e-9) return "< 1e-9";
-  if (error <= kFamilyTolerance) return "< 1e-6";
-  return StringPrintf("1e%+03d", static_cast<int>(std::floor(std::log10(error))));
-}
-
-}  // namespace
 
 std::string ConvergenceFamilyMarkdown(const std::vector<FamilyOutcome>& outcomes) {
   const auto reached = std::count_if(outcomes.begin(), outcomes.end(),

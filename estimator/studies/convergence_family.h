@@ -53,7 +53,6 @@ struct FamilyOutcome {
   FitStatus status = FitStatus::kInvalidInput;
   std::string message;
   double max_relative_error = 0.0;  // over the free parameters
-  int iterations = 0;
 
   bool ReachedTruth() const {
     return status == FitStatus::kConverged && max_relative_error <= kFamilyTolerance;

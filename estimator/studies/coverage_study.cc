@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 
 #include "dwellfit/estimator/analysis/parameter_uncertainty.h"
 #include "dwellfit/estimator/common/string_printf.h"
@@ -87,8 +86,7 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
   study.replicas = options.replicas;
   study.method = options.method;
   study.penalty = config.identification.solve.penalties.bifurcation_range.enabled;
-  study.omega_ref_rad_s =
-      config.omega_ref_rad_s ? *config.omega_ref_rad_s : plan.truth[kNaturalFrequency];
+  study.omega_ref_rad_s = config.omega_ref_rad_s.value_or(plan.truth[kNaturalFrequency]);
 
   // Rows: the free parameters, then alpha_e (index kNumParameters).
   std::vector<int> rows;

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <vector>
 
+#include "dwellfit/estimator/analysis/prediction_intervals.h"
 #include "dwellfit/estimator/analysis/sweep_prediction.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/string_printf.h"
@@ -106,12 +107,7 @@ double Largest(const std::vector<double>& values) {
   return values.empty() ? 0.0 : *std::max_element(values.begin(), values.end());
 }
 
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
+double Median(const std::vector<double>& values) { return values.empty() ? 0.0 : MedianOf(values); }
 
 double PercentError(double estimate, double reference) {
   if (reference == 0.0) return estimate == 0.0 ? 0.0 : 100.0;
@@ -150,10 +146,6 @@ std::string Header(const std::vector<Method>& methods, const std::string& first)
   }
   return text + " |\n" + rule + "\n";
 }
-
-}  // namespace
-
-namespace {
 
 // Fits of every method on one dataset (several replicas for the noise study).
 struct Comparison {
@@ -199,6 +191,16 @@ double Mean(const std::vector<MethodFit>& fits, const Value& value) {
   return sum / static_cast<double>(fits.size());
 }
 
+// A row of each method's mean over its fits of `value`, printed with `format`.
+template <typename Value>
+void MeanRow(const Comparison& c, const std::string& name, const char* format, const Value& value,
+             std::ostream& out) {
+  Row(
+      c, name, "",
+      [&](const std::vector<MethodFit>& fits) { return StringPrintf(format, Mean(fits, value)); },
+      out);
+}
+
 void SolverRows(const Comparison& c, bool wall_time, std::ostream& out) {
   Row(
       c, "converged", "",
@@ -208,42 +210,20 @@ void SolverRows(const Comparison& c, bool wall_time, std::ostream& out) {
         return StringPrintf("%d of %zu", n, fits.size());
       },
       out);
-  Row(
-      c, "iterations", "",
-      [](const std::vector<MethodFit>& fits) {
-        return StringPrintf("%.4g",
-                            Mean(fits, [](const MethodFit& f) { return f.result.iterations; }));
-      },
-      out);
-  Row(
-      c, "fitted jump-downs: largest error %", "",
-      [](const std::vector<MethodFit>& fits) {
-        return StringPrintf("%.3g", Mean(fits, [](const MethodFit& f) {
-                              return Largest(f.fitted_jump_down_errors);
-                            }));
-      },
-      out);
-  Row(
-      c, "held-out jump-downs: median error %", "",
-      [](const std::vector<MethodFit>& fits) {
-        return StringPrintf("%.3g", Mean(fits, [](const MethodFit& f) {
-                              return Median(f.held_out_jump_down_errors);
-                            }));
-      },
-      out);
+  MeanRow(
+      c, "iterations", "%.4g", [](const MethodFit& f) { return f.result.iterations; }, out);
+  MeanRow(
+      c, "fitted jump-downs: largest error %", "%.3g",
+      [](const MethodFit& f) { return Largest(f.fitted_jump_down_errors); }, out);
+  MeanRow(
+      c, "held-out jump-downs: median error %", "%.3g",
+      [](const MethodFit& f) { return Median(f.held_out_jump_down_errors); }, out);
   if (wall_time) {
-    Row(
-        c, "wall time [s]", "",
-        [](const std::vector<MethodFit>& fits) {
-          return StringPrintf("%.3g", Mean(fits, [](const MethodFit& f) { return f.seconds; }));
-        },
-        out);
+    MeanRow(
+        c, "wall time [s]", "%.3g", [](const MethodFit& f) { return f.seconds; }, out);
   }
+  out << "\n";
 }
-
-}  // namespace
-
-namespace {
 
 // Table 3.1: estimate (and percent error) of every quantity by every method.
 void TruthTable(const Comparison& c, const ParameterVector& truth, bool wall_time,
@@ -267,7 +247,6 @@ void TruthTable(const Comparison& c, const ParameterVector& truth, bool wall_tim
         out);
   }
   SolverRows(c, wall_time, out);
-  out << "\n";
 }
 
 // Table 3.2: estimates side by side, each compared with the last method's.
@@ -286,56 +265,35 @@ void SideBySideTable(const Comparison& c, bool wall_time, std::ostream& out) {
         out);
   }
   SolverRows(c, wall_time, out);
-  out << "\n";
 }
 
-const MethodFit& FitOf(const Comparison& c, const std::string& name, int replica = 0) {
+const std::vector<MethodFit>& FitsOf(const Comparison& c, const std::string& name) {
   for (size_t m = 0; m < c.methods.size(); ++m) {
-    if (c.methods[m].name == name) return c.fits[m][replica];
+    if (c.methods[m].name == name) return c.fits[m];
   }
   throw InputError("method comparison: no method '" + name + "'");
 }
 
-// The largest relative difference [%] between two fits over the quantities.
-double LargestDifference(const Comparison& c, const MethodFit& a, const MethodFit& b) {
+const MethodFit& FitOf(const Comparison& c, const std::string& name, int replica = 0) {
+  return FitsOf(c, name)[replica];
+}
+
+// The largest relative difference [%] of `a` from `b` over the quantities.
+double LargestDifference(const Comparison& c, const ParameterVector& a, const ParameterVector& b) {
   double largest = 0.0;
   for (const Quantity& q : c.quantities) {
-    largest =
-        std::max(largest, PercentError(ValueOf(a.result.parameters, q.index, c.omega_ref_rad_s),
-                                       ValueOf(b.result.parameters, q.index, c.omega_ref_rad_s)));
+    largest = std::max(largest, PercentError(ValueOf(a, q.index, c.omega_ref_rad_s),
+                                             ValueOf(b, q.index, c.omega_ref_rad_s)));
   }
   return largest;
 }
 
-double LargestError(const Comparison& c, const MethodFit& fit, const ParameterVector& truth) {
-  double largest = 0.0;
-  for (const Quantity& q : c.quantities) {
-    largest =
-        std::max(largest, PercentError(ValueOf(fit.result.parameters, q.index, c.omega_ref_rad_s),
-                                       ValueOf(truth, q.index, c.omega_ref_rad_s)));
-  }
-  return largest;
+// The largest difference between two methods' fits of one replica.
+double LargestDifference(const Comparison& c, const std::string& a, const std::string& b,
+                         int replica = 0) {
+  return LargestDifference(c, FitOf(c, a, replica).result.parameters,
+                           FitOf(c, b, replica).result.parameters);
 }
-
-}  // namespace
-
-bool MethodComparisonOptions::IsValid(std::string* error) const {
-  if (noise_seeds < 1) {
-    *error = StringPrintf("noise_seeds must be at least 1, got %d", noise_seeds);
-    return false;
-  }
-  if (!(relative_noise > 0.0 && relative_noise < 1.0)) {
-    *error = StringPrintf("relative_noise must lie in (0, 1), got %g", relative_noise);
-    return false;
-  }
-  if (!(std::abs(phase_bias_deg) < 90.0)) {
-    *error = StringPrintf("phase_bias_deg must lie in (-90, 90), got %g", phase_bias_deg);
-    return false;
-  }
-  return true;
-}
-
-namespace {
 
 void Introduction(const MethodComparisonOptions& options, std::ostream& out) {
   out << "# The chapter's methods compared\n\n"
@@ -380,21 +338,18 @@ std::vector<std::optional<std::vector<Sweep>>> NoisyReplicas(
 
 void Findings(const Comparison& exact, const Comparison& noisy, const Comparison& measured,
               const DwellPlan& plan, const MethodComparisonOptions& options, std::ostream& out) {
-  const MethodFit& phase = FitOf(exact, "phase lag");
-  const MethodFit& biased = FitOf(exact, "phase lag, biased phase");
   out << "## Findings\n\n"
       << StringPrintf(
              "- **Phase errors.** On exact data the phase-lag fit is exact (largest "
              "error %.2g %%); with the phase %+g degrees off its largest error is "
              "%.3g %%.\n",
-             LargestError(exact, phase, plan.truth), options.phase_bias_deg,
-             LargestError(exact, biased, plan.truth));
+             LargestDifference(exact, FitOf(exact, "phase lag").result.parameters, plan.truth),
+             options.phase_bias_deg,
+             LargestDifference(exact, FitOf(exact, "phase lag, biased phase").result.parameters,
+                               plan.truth));
   auto mean_largest = [](const Comparison& c, const std::string& name) {
-    for (size_t m = 0; m < c.methods.size(); ++m) {
-      if (c.methods[m].name != name) continue;
-      return Mean(c.fits[m], [](const MethodFit& f) { return Largest(f.fitted_jump_down_errors); });
-    }
-    return 0.0;
+    return Mean(FitsOf(c, name),
+                [](const MethodFit& f) { return Largest(f.fitted_jump_down_errors); });
   };
   out << StringPrintf(
       "- **Least squares alone and the jump-downs.** Largest fitted jump-down error: with %g %% "
@@ -407,19 +362,16 @@ void Findings(const Comparison& exact, const Comparison& noisy, const Comparison
       Median(FitOf(measured, "Newton + ranges").held_out_jump_down_errors));
   double noisy_difference = 0.0;
   for (int r = 0; r < options.noise_seeds; ++r) {
-    noisy_difference =
-        std::max(noisy_difference, LargestDifference(noisy, FitOf(noisy, "all roots + ranges", r),
-                                                     FitOf(noisy, "Newton + ranges", r)));
+    noisy_difference = std::max(
+        noisy_difference, LargestDifference(noisy, "all roots + ranges", "Newton + ranges", r));
   }
   out << StringPrintf(
       "- **All roots against Newton refinement.** Largest difference between their estimates: "
       "%.2g %% on exact data, %.3g %% over the noisy replicas, %.3g %% on the measured beam. "
       "Per residual evaluation the all-roots residual is the slower; "
       "`build/benchmarks/method_residual_benchmark` measures the ratio.\n\n",
-      LargestDifference(exact, FitOf(exact, "all roots + ranges"), FitOf(exact, "Newton + ranges")),
-      noisy_difference,
-      LargestDifference(measured, FitOf(measured, "all roots + ranges"),
-                        FitOf(measured, "Newton + ranges")));
+      LargestDifference(exact, "all roots + ranges", "Newton + ranges"), noisy_difference,
+      LargestDifference(measured, "all roots + ranges", "Newton + ranges"));
 }
 
 std::string DatasetName(const IdentifyConfig& config) {
@@ -428,6 +380,22 @@ std::string DatasetName(const IdentifyConfig& config) {
 }
 
 }  // namespace
+
+bool MethodComparisonOptions::IsValid(std::string* error) const {
+  if (noise_seeds < 1) {
+    *error = StringPrintf("noise_seeds must be at least 1, got %d", noise_seeds);
+    return false;
+  }
+  if (!(relative_noise > 0.0 && relative_noise < 1.0)) {
+    *error = StringPrintf("relative_noise must lie in (0, 1), got %g", relative_noise);
+    return false;
+  }
+  if (!(std::abs(phase_bias_deg) < 90.0)) {
+    *error = StringPrintf("phase_bias_deg must lie in (-90, 90), got %g", phase_bias_deg);
+    return false;
+  }
+  return true;
+}
 
 std::string MethodComparisonMarkdown(const IdentifyConfig& numerical, const DwellPlan& plan,
                                      const IdentifyConfig& measured,

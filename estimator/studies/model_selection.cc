@@ -1,21 +1,19 @@
 #include "dwellfit/estimator/studies/model_selection.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <exception>
 #include <limits>
 #include <map>
 #include <set>
-#include <thread>
 #include <utility>
 
-#include "dwellfit/estimator/analysis/parameter_uncertainty.h"
 #include "dwellfit/estimator/analysis/sweep_prediction.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/run/resolved_run.h"
-#include "dwellfit/estimator/studies/model_selection_predictions.h"
+#include "tbb/parallel_for.h"
+#include "tbb/task_arena.h"
 
 namespace dwellfit {
 namespace {
@@ -48,10 +46,24 @@ bool SelectedByAny(const Sweep& sweep, const std::vector<SweepSelection>& select
                      [&](const SweepSelection& s) { return s.Selects(sweep); });
 }
 
+// Every combination of the block's choices, delta slowest, omega fastest.
+std::vector<ModelVariant> ModelVariants(const ModelSelectionConfig& selection) {
+  std::vector<ModelVariant> variants;
+  for (const ParameterChoice& delta : selection.delta) {
+    for (const ParameterChoice& mu2 : selection.mu2) {
+      for (const ParameterChoice& omega : selection.omega) {
+        variants.push_back(ModelVariant{delta, mu2, omega});
+      }
+    }
+  }
+  return variants;
+}
+
 // One held-out sweep predicted: its predictions (with their parameter
-// uncertainty when `covariance` is given) and errors; with no usable fit,
-// every measured jump and upper branch counts 100 % and the relative RMS
-// is left out.
+// uncertainty when `covariance` is given) and their errors (a missing
+// prediction counts 100 %, in Hz the measured frequency); with no usable
+// fit, every measured jump and upper branch counts 100 % and the relative
+// RMS is left out.
 struct SweepResult {
   PredictionErrors errors;
   std::vector<HeldOutPrediction> predictions;
@@ -62,9 +74,28 @@ SweepResult PredictHeldOutSweep(const Sweep& sweep, const ParameterVector& param
                                 const std::array<bool, kNumParameters>& fixed) {
   SweepResult result;
   result.predictions = PredictHeldOut(sweep, parameters, usable, covariance, fixed);
+  PredictionErrors& errors = result.errors;
+  for (const HeldOutPrediction& p : result.predictions) {
+    const bool known = std::isfinite(p.predicted);
+    const double percent = known ? std::abs(p.ErrorPercent()) : 100.0;
+    const double hz = known ? std::abs(p.predicted - p.measured) : p.measured;
+    switch (p.quantity) {
+      case HeldOutQuantity::kJumpDown:
+        errors.jump_down_percent.push_back(percent);
+        errors.jump_down_hz.push_back(hz);
+        break;
+      case HeldOutQuantity::kJumpUp:
+        errors.jump_up_percent.push_back(percent);
+        errors.jump_up_hz.push_back(hz);
+        break;
+      case HeldOutQuantity::kUpperBranchAmplitude:
+        errors.upper_branch_percent.push_back(percent);
+        break;
+    }
+  }
   const double relative_rms =
       usable ? PredictSweep(parameters, sweep, /*fitted=*/false).relative_rms_error : kNaN;
-  result.errors = ErrorsOf(result.predictions, relative_rms);
+  if (std::isfinite(relative_rms)) errors.relative_rms.push_back(relative_rms);
   return result;
 }
 
@@ -221,7 +252,6 @@ bool Predicts(const Plan& plan, int set, const Sweep& sweep) {
 TaskResult RunTask(const IdentifyConfig& config, const ModelVariant& variant,
                    const std::vector<Sweep>& sweeps, const Plan& plan, int set) {
   TaskResult task;
-  task.fit.fitted_sweeps.clear();
   for (const SweepSelection& s : plan.training[set]) task.fit.fitted_sweeps.push_back(s.Name());
   const IdentifyConfig variant_config = VariantConfig(config, variant, plan.training[set]);
   const std::array<bool, kNumParameters>& fixed = variant_config.identification.fixed;
@@ -270,16 +300,12 @@ std::vector<TaskResult> RunTasks(const IdentifyConfig& config,
   const int sets = static_cast<int>(plan.training.size());
   const int count = static_cast<int>(variants.size()) * sets;
   std::vector<TaskResult> results(count);
-  std::atomic<int> next{0};
-  auto work = [&]() {
-    for (int i = next++; i < count; i = next++) {
-      results[i] = RunTask(config, variants[i / sets], sweeps, plan, i % sets);
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::min(threads, count); ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& thread : pool) thread.join();
+  tbb::task_arena(std::max(1, std::min(threads, count))).execute([&] {
+    tbb::parallel_for(
+        0, count,
+        [&](int i) { results[i] = RunTask(config, variants[i / sets], sweeps, plan, i % sets); },
+        tbb::simple_partitioner());
+  });
   for (const TaskResult& result : results) {
     if (result.error) std::rethrow_exception(result.error);
   }
@@ -297,8 +323,12 @@ void Criteria(VariantResult* result) {
   result->bic = minus_two_log_likelihood + result->free_parameters * std::log(n);
 }
 
+// The spread of `value` (of a fit's parameters) over the fits.
+template <typename Value>
 ParameterSpread SpreadOf(const std::string& name, ParameterIndex index,
-                         const std::vector<double>& values) {
+                         const std::vector<const VariantFit*>& fits, const Value& value) {
+  std::vector<double> values;
+  for (const VariantFit* fit : fits) values.push_back(value(fit->parameters));
   ParameterSpread spread;
   spread.name = name;
   spread.index = index;
@@ -322,19 +352,13 @@ std::vector<ParameterSpread> Spreads(const IdentifyConfig& config,
   for (int j = 0; j < kNumParameters; ++j) {
     if (fixed[j]) continue;
     const bool frequency = j == kNaturalFrequency;
-    std::vector<double> values;
-    for (const VariantFit* fit : usable) {
-      values.push_back(frequency ? RadPerSecondToHz(fit->parameters[j]) : fit->parameters[j]);
-    }
-    spreads.push_back(
-        SpreadOf(frequency ? "w [Hz]" : ParameterName(j), static_cast<ParameterIndex>(j), values));
+    spreads.push_back(SpreadOf(
+        frequency ? "w [Hz]" : ParameterName(j), static_cast<ParameterIndex>(j), usable,
+        [&](const ParameterVector& p) { return frequency ? RadPerSecondToHz(p[j]) : p[j]; }));
     if (j != kAlpha) continue;
-    std::vector<double> effective;
-    for (const VariantFit* fit : usable) {
-      const ParameterVector& p = fit->parameters;
-      effective.push_back(p[kAlpha] - 2.0 / 3.0 * p[kDelta] * omega_ref * omega_ref);
-    }
-    spreads.push_back(SpreadOf("alpha_e", kAlpha, effective));
+    spreads.push_back(SpreadOf("alpha_e", kAlpha, usable, [&](const ParameterVector& p) {
+      return EffectiveNonlinearity(p, omega_ref);
+    }));
   }
   return spreads;
 }
@@ -494,22 +518,14 @@ void WarnAbout(ModelSelectionReport* report, const std::vector<int>& candidates,
   }
 }
 
-// Steps 1 and 3 of the rule: the candidates, and the one near-best on the
-// most scores (the lowest BIC among those tied).
-int Choose(ModelSelectionReport* report, const std::vector<int>& candidates) {
-  int chosen = -1;
-  for (int i : candidates) {
-    const VariantResult& v = report->variants[i];
-    if (chosen < 0) {
-      chosen = i;
-      continue;
-    }
-    const VariantResult& so_far = report->variants[chosen];
-    if (v.near_best > so_far.near_best || (v.near_best == so_far.near_best && v.bic < so_far.bic)) {
-      chosen = i;
-    }
-  }
-  return chosen;
+// Step 3 of the rule: the candidate near-best on the most scores (the
+// lowest BIC among those tied, the first of equals).
+int Choose(const ModelSelectionReport& report, const std::vector<int>& candidates) {
+  return *std::min_element(candidates.begin(), candidates.end(), [&](int i, int j) {
+    const VariantResult& a = report.variants[i];
+    const VariantResult& b = report.variants[j];
+    return a.near_best > b.near_best || (a.near_best == b.near_best && a.bic < b.bic);
+  });
 }
 
 }  // namespace
@@ -523,10 +539,8 @@ void RecommendVariant(ModelSelectionReport* report) {
     if (!v.unstable) stable.push_back(i);
   }
   const std::vector<int>& candidates = stable.empty() ? eligible : stable;
-  for (int i = 0; i < static_cast<int>(report->variants.size()); ++i) {
-    const bool candidate = std::find(candidates.begin(), candidates.end(), i) != candidates.end();
-    report->variants[i].near_best = candidate ? 0 : -1;
-  }
+  for (VariantResult& v : report->variants) v.near_best = -1;
+  for (int i : candidates) report->variants[i].near_best = 0;
   report->jump_tolerance_hz = ResonanceWidthHz(*report, candidates);
   const double best_amplitude =
       Best(*report, candidates, [](const VariantResult& v) { return v.upper_branch_percent; });
@@ -542,7 +556,7 @@ void RecommendVariant(ModelSelectionReport* report) {
     return;
   }
   CountNearBest(report, candidates);
-  report->recommended = Choose(report, candidates);
+  report->recommended = Choose(*report, candidates);
   WarnAbout(report, candidates, !stable.empty());
   const VariantResult& chosen = report->variants[report->recommended];
   report->verdict = StringPrintf(
@@ -575,28 +589,25 @@ int ModelVariant::FreeParameters(const IdentifyConfig& config) const {
   return static_cast<int>(std::count(fixed.begin(), fixed.end(), false));
 }
 
-std::vector<ModelVariant> ModelVariants(const ModelSelectionConfig& selection) {
-  std::vector<ModelVariant> variants;
-  for (const ParameterChoice& delta : selection.delta) {
-    for (const ParameterChoice& mu2 : selection.mu2) {
-      for (const ParameterChoice& omega : selection.omega) {
-        variants.push_back(ModelVariant{delta, mu2, omega});
-      }
-    }
-  }
-  return variants;
+void AddPredictionIntervals(VariantResult* result) {
+  std::vector<std::vector<HeldOutPrediction>*> levels;
+  for (CrossValidationFold& fold : result->folds) levels.push_back(&fold.predictions);
+  const PredictionCoverage coverage = AddPredictionIntervals(levels);
+  result->jump_down_coverage = coverage.jump_down;
+  result->jump_up_coverage = coverage.jump_up;
+  result->upper_branch_coverage = coverage.upper_branch;
 }
 
 void PredictionErrors::Add(const PredictionErrors& other) {
-  jump_down_percent.insert(jump_down_percent.end(), other.jump_down_percent.begin(),
-                           other.jump_down_percent.end());
-  jump_up_percent.insert(jump_up_percent.end(), other.jump_up_percent.begin(),
-                         other.jump_up_percent.end());
-  relative_rms.insert(relative_rms.end(), other.relative_rms.begin(), other.relative_rms.end());
-  jump_down_hz.insert(jump_down_hz.end(), other.jump_down_hz.begin(), other.jump_down_hz.end());
-  jump_up_hz.insert(jump_up_hz.end(), other.jump_up_hz.begin(), other.jump_up_hz.end());
-  upper_branch_percent.insert(upper_branch_percent.end(), other.upper_branch_percent.begin(),
-                              other.upper_branch_percent.end());
+  const auto append = [](std::vector<double>* to, const std::vector<double>& from) {
+    to->insert(to->end(), from.begin(), from.end());
+  };
+  append(&jump_down_percent, other.jump_down_percent);
+  append(&jump_down_hz, other.jump_down_hz);
+  append(&jump_up_percent, other.jump_up_percent);
+  append(&jump_up_hz, other.jump_up_hz);
+  append(&upper_branch_percent, other.upper_branch_percent);
+  append(&relative_rms, other.relative_rms);
 }
 
 ModelSelectionReport RunModelSelection(const IdentifyConfig& config, int threads) {

@@ -1,76 +1,25 @@
 // Model selection: the config's fit repeated for every model variant of its
 // `model_selection:` block (delta, mu2 and w each free or held at a value),
-// each scored by
-//   - its fitted cost, AIC and BIC on the config's fitted sweeps, and
-//   - cross-validation over the levels (sweep ids) of a pool of sweeps:
-//     every level predicted by a fit that did not see it.
-// Every fit is the one pipeline of `identify` (ResolveRun, FitRun) on a copy
-// of the config with the variant's fixed parameters and the fold's sweeps.
-// docs/model-selection.md states all of the below with the beam's numbers.
+// each scored by its fitted cost, AIC and BIC, and by leave-one-level-out
+// cross-validation over a pool of sweeps. Every fit is the one pipeline of
+// `identify` (ResolveRun, FitRun). docs/model-selection.md states the
+// prediction errors, the stability test, the recommendation rule (also in
+// ModelSelectionReport::rule) and the prediction intervals, with the beam's
+// numbers.
 //
-// Likelihood: the residuals of the last stage (vertical: a_i - a_model, or
-// ln(a_i/a_model) with `residual.error: relative`, over sigma when given)
-// taken as independent Gaussian with one variance estimated from the fit,
-// sigma^2 = RSS / n, RSS = 2 x the data cost (penalties left out):
+// Likelihood: the last stage's residuals taken as independent Gaussian with
+// one variance estimated from the fit, sigma^2 = RSS / n, RSS = 2 x the data
+// cost (penalties left out):
 //   -2 ln L = n (ln(2 pi RSS / n) + 1),
 //   AIC = -2 ln L + 2 k,   BIC = -2 ln L + k ln n,
 // n the fitted dwells, k the free model parameters (the variance, common to
-// every variant, is not counted). Dwells of a slow continuous sweep are
-// correlated, so on measured data these criteria overstate the evidence
-// for the larger model; cross-validation does not rely on that assumption.
+// every variant, is not counted). Dwells of a slow sweep are correlated, so
+// on measured data these criteria overstate the evidence for the larger
+// model; cross-validation does not rely on that assumption.
 //
-// Prediction errors of a held-out frequency sweep (PredictJumps,
-// PredictSweep):
-//   - each measured jump: e = |f_model - f_measured| / f_measured in percent
-//     and |f_model - f_measured| in Hz (f_measured the bracket's centre; a
-//     fold the model lacks counts 100 %), jump-downs and jump-ups apart;
-//   - the upper-branch amplitude of an up-sweep with a measured jump-down:
-//     the mean measured amplitude A of its dwells before the jump whose
-//     amplitude exceeds half the sweep's peak, against the mean of the
-//     model's amplitudes on that branch at the same dwells, A_model:
-//     e = 100 (A_model - A) / A (signed; scored as |e|);
-//   - the sweep's relative RMS amplitude error (every dwell).
-//
-// Stability: over the variant's usable fits (its own and every
-// cross-validation fit), each free parameter's relative range
-// (max - min) / |median|, and that of the effective nonlinearity
-// alpha_e = alpha - (2/3) delta Omega_ref^2 (Omega_ref the config's
-// reference, else the fits' median w): with delta free, alpha and delta
-// trade off along a valley and only alpha_e is determined. A variant is
-// unstable when w's range exceeds kUnstableFrequencyRange or eta_e's, mu1's
-// or alpha_e's exceeds kUnstableScaleRange.
-//
-// Recommended variant (the rule, also in ModelSelectionReport::rule):
-//   1. candidates: the variants whose every fit converged; the stable ones
-//      when any is stable (else all, said in the verdict);
-//   2. on each of three scores -- the median held-out jump-down error and
-//      jump-up error (in Hz) and the median held-out upper-branch amplitude
-//      error (in %) -- a candidate is near-best when within the tolerance of
-//      the best candidate's score: for the jumps the resonance's half-power
-//      width mu1/pi Hz (2 mu1 rad/s, median over the candidates' own fits),
-//      for the amplitudes a quarter of the best score and at least one
-//      percentage point;
-//   3. the candidate near-best on the most scores wins; among those tied,
-//      the lowest BIC (so the smaller model wins a tie).
-//   The verdict says when the recommended variant is much worse than the
-//   best on amplitudes (more than twice its error and beyond the tolerance)
-//   or unstable. Scores come from cross-validation when it scored any
-//   jump-down, else from the config's validate sweeps; with neither, the
-//   lowest BIC.
-//
-// 95 % prediction intervals of every held-out level (cross-validation only;
-// the rule of estimator/analysis/prediction_intervals.h, which identify
-// applies to its validation sweeps): for a predicted quantity q (a jump's frequency in Hz, the
-// upper-branch amplitude), q_model +/- 1.96 sqrt(s_p^2 + s_m^2), with
-//   - s_p^2 = g^T C g: the fold's parameter uncertainty by the delta method,
-//     C the fold fit's PredictionCovariance (its dwells-alone covariance with
-//     the enforced jumps as observations), g = dq/dp by central differences;
-//   - s_m = q_model x the RMS of the relative errors (q_model - q) / q of the
-//     same quantity at every other held-out level: the model error the
-//     cross-validation shows, none of it from the level itself (the
-//     training levels' own jump-downs are held in their brackets by the
-//     penalty, so their errors say nothing of the model's).
-// The report counts how often the measured value falls inside.
+// Effective nonlinearity alpha_e = alpha - (2/3) delta Omega_ref^2 (Omega_ref
+// the config's reference, else the fits' median w): with delta free, alpha
+// and delta trade off along a valley and only alpha_e is determined.
 //
 // Fits run on `threads` threads, each fit's residuals on one; the report
 // does not depend on the thread count.
@@ -87,7 +36,9 @@
 
 namespace dwellfit {
 
-// Stability thresholds (see above): relative ranges over a variant's fits.
+// A variant is unstable when, over its usable fits, w's relative range
+// (max - min) / |median| exceeds kUnstableFrequencyRange or eta_e's, mu1's or
+// alpha_e's exceeds kUnstableScaleRange.
 inline constexpr double kUnstableFrequencyRange = 0.10;
 inline constexpr double kUnstableScaleRange = 1.0;
 // The amplitude score's tolerance: this share of the best score, at least
@@ -104,10 +55,8 @@ struct ModelVariant {
   int FreeParameters(const IdentifyConfig& config) const;
 };
 
-// Every combination of the block's choices, delta slowest, omega fastest.
-std::vector<ModelVariant> ModelVariants(const ModelSelectionConfig& selection);
-
-// Errors of predicted sweeps (see above), pooled over the sweeps scored.
+// Errors of predicted sweeps (docs/model-selection.md), pooled over the
+// sweeps scored.
 struct PredictionErrors {
   std::vector<double> jump_down_percent;  // one per measured jump-down
   std::vector<double> jump_down_hz;       // the same in Hz
@@ -141,7 +90,7 @@ struct CrossValidationFold {
 struct ParameterSpread {
   std::string name;  // "eta_e", ..., "w [Hz]" (values in Hz), "alpha_e"
   ParameterIndex index = kEtaE;
-  double min = 0.0, median = 0.0, max = 0.0;  // physical units (w in rad/s)
+  double min = 0.0, median = 0.0, max = 0.0;  // physical units (w in Hz)
   double relative_range = 0.0;                // (max - min) / |median|; inf when median is 0
 };
 
@@ -214,14 +163,15 @@ std::string RecommendedConfigYaml(const IdentifyConfig& config, const ModelSelec
 // The config with `variant` applied (free, or fixed at its value).
 IdentifyConfig WithVariant(const IdentifyConfig& config, const ModelVariant& variant);
 
-// Applies the rule (above) to report->variants (their eligible, unstable,
-// scores, BIC and own fits' mu1): sets recommended, near_best, the
-// tolerances, rule, verdict and warnings. Part of RunModelSelection;
-// exposed for tests.
+// Applies the rule (docs/model-selection.md) to report->variants (their
+// eligible, unstable, scores, BIC and own fits' mu1): sets recommended,
+// near_best, the tolerances, rule, verdict and warnings. Part of
+// RunModelSelection; exposed for tests.
 void RecommendVariant(ModelSelectionReport* report);
 
 // Fills every fold's predictions' model_sd, half_width and inside, and the
-// variant's coverage (see above). Part of RunModelSelection; exposed for tests.
+// variant's coverage (estimator/analysis/prediction_intervals.h). Part of
+// RunModelSelection; exposed for tests.
 void AddPredictionIntervals(VariantResult* result);
 
 }  // namespace dwellfit

@@ -1,9 +1,11 @@
 // ModelSelectionCsv and ModelSelectionMarkdown: the study's tables.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
 #include <string>
 
+#include "boost/algorithm/string/join.hpp"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/studies/model_selection.h"
 
@@ -17,13 +19,8 @@ std::string Cell(double value, const char* format = "%.4g") {
 }
 
 double MaxOf(const std::vector<double>& values) {
-  double max = std::numeric_limits<double>::quiet_NaN();
-  for (double v : values) max = std::isnan(max) || v > max ? v : max;
-  return max;
-}
-
-std::string FitCounts(const VariantResult& v) {
-  return StringPrintf("%zu (%d / %d)", v.fits.size(), v.fits_not_converged, v.fits_failed);
+  return values.empty() ? std::numeric_limits<double>::quiet_NaN()
+                        : *std::max_element(values.begin(), values.end());
 }
 
 // "2.13 (4.05 Hz)": a median error in % with its Hz.
@@ -55,14 +52,13 @@ void MainTable(const ModelSelectionReport& report, std::ostream& out) {
         << Cell(MedianOf(v.validation.jump_down_percent), "%.2f") << " | "
         << (v.unstable ? "no" : "yes") << " | "
         << (v.near_best < 0 ? std::string("not a candidate") : std::to_string(v.near_best)) << " | "
-        << FitCounts(v) << " |\n";
+        << StringPrintf("%zu (%d / %d)", v.fits.size(), v.fits_not_converged, v.fits_failed)
+        << " |\n";
   }
 }
 
 std::string Joined(const std::vector<std::string>& names) {
-  std::string text;
-  for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
-  return text;
+  return boost::algorithm::join(names, ", ");
 }
 
 // A held-out value with its unit: Hz for jumps, the data's unit for amplitudes.
@@ -243,10 +239,6 @@ std::string ModelSelectionMarkdown(const ModelSelectionReport& report) {
   return out.str();
 }
 
-}  // namespace dwellfit
-
-namespace dwellfit {
-
 std::string RecommendedConfigYaml(const IdentifyConfig& config,
                                   const ModelSelectionReport& report) {
   if (report.recommended < 0) return "";
@@ -255,9 +247,8 @@ std::string RecommendedConfigYaml(const IdentifyConfig& config,
   out << "# The variant select_model recommends for " << config.config_path << ":\n#   "
       << chosen.variant.Name() << "\n#   " << report.verdict << "\n"
       << "# Rule: " << report.rule << ".\n"
-      << "# Run it as is: identify --config <this file>. Paths are absolute.\n";
-  std::string yaml = ConfigToYaml(WithVariant(config, chosen.variant));
-  out << yaml;
+      << "# Run it as is: identify --config <this file>. Paths are absolute.\n"
+      << ConfigToYaml(WithVariant(config, chosen.variant));
   return out.str();
 }
 

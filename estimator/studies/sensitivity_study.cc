@@ -9,8 +9,9 @@
 #include <memory>
 #include <mutex>
 #include <sstream>
-#include <thread>
 
+#include "boost/algorithm/string/classification.hpp"
+#include "boost/algorithm/string/trim.hpp"
 #include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/analysis/parameter_uncertainty.h"
 #include "dwellfit/estimator/common/input_error.h"
@@ -20,6 +21,8 @@
 #include "dwellfit/estimator/fit/staged_solve.h"
 #include "dwellfit/estimator/run/resolved_run.h"
 #include "dwellfit/estimator/studies/replica_run.h"
+#include "tbb/parallel_for.h"
+#include "tbb/task_arena.h"
 #include "yaml-cpp/yaml.h"
 
 namespace dwellfit {
@@ -52,9 +55,7 @@ std::vector<std::string> SplitOutside(const std::string& text, char separator) {
 }
 
 std::string Trim(const std::string& text) {
-  const size_t begin = text.find_first_not_of(" \t");
-  if (begin == std::string::npos) return "";
-  return text.substr(begin, text.find_last_not_of(" \t") - begin + 1);
+  return boost::algorithm::trim_copy_if(text, boost::algorithm::is_any_of(" \t"));
 }
 
 // The values of every case: the Cartesian product of the axes, the last axis
@@ -125,119 +126,6 @@ FitRow RunOneFit(const IdentifyConfig& config, const SensitivityOptions& options
   return row;
 }
 
-}  // namespace
-
-std::vector<VaryAxis> ParseVaryFlag(const std::string& flag_value, const std::string& origin) {
-  std::vector<VaryAxis> axes;
-  if (Trim(flag_value).empty()) return axes;
-  for (const std::string& part : SplitOutside(flag_value, ';')) {
-    const size_t equals = part.find('=');
-    VaryAxis axis;
-    axis.key = Trim(part.substr(0, equals));
-    if (equals == std::string::npos || axis.key.empty()) {
-      throw InputError(origin, 0, axis.key,
-                       "'" + part +
-                           "' is not key=value1|value2|...; e.g. "
-                           "'penalties.bifurcation_range.exponent=2|4|10'");
-    }
-    for (const std::string& value : SplitOutside(part.substr(equals + 1), '|')) {
-      if (Trim(value).empty()) {
-        throw InputError(origin, 0, axis.key, "an empty value in '" + part + "'");
-      }
-      axis.values.push_back(Trim(value));
-    }
-    for (const VaryAxis& other : axes) {
-      if (other.key == axis.key) throw InputError(origin, 0, axis.key, "the key is varied twice");
-    }
-    axes.push_back(axis);
-  }
-  return axes;
-}
-
-bool SensitivityOptions::IsValid(std::string* why) const {
-  auto fail = [why](const std::string& text) {
-    *why = text;
-    return false;
-  };
-  if (replicas < 1) return fail("--replicas must be >= 1");
-  if (!plan && replicas != 1)
-    return fail("--replicas needs --plan (replicas are noisy simulations of a plan)");
-  if (!(noise >= 0.0) || !std::isfinite(noise)) return fail("--noise must be >= 0");
-  if (threads < 1) return fail("--threads must be >= 1");
-  if (shards < 1 || shard < 0 || shard >= shards)
-    return fail(StringPrintf("--shard %d/%d: need 0 <= k < N", shard, shards));
-  return true;
-}
-
-SensitivityStudy RunSensitivityStudy(const SensitivityOptions& options, const Progress& progress) {
-  std::string why;
-  if (!options.IsValid(&why)) throw InputError("flags", 0, "", why);
-  const auto start = std::chrono::steady_clock::now();
-  SensitivityStudy study;
-  for (const VaryAxis& axis : options.vary) study.axis_keys.push_back(axis.key);
-  const std::vector<std::vector<std::string>> cases = Cases(options.vary);
-  std::vector<IdentifyConfig> configs;  // loaded up front: a bad value fails at once
-  for (const auto& values : cases) {
-    std::vector<ConfigOverride> overrides = options.overrides;
-    for (size_t j = 0; j < values.size(); ++j)
-      overrides.push_back({options.vary[j].key, values[j], "--vary"});
-    configs.push_back(LoadIdentifyConfig(options.config_path, overrides));
-  }
-  study.cases = static_cast<int>(cases.size());
-  study.replicas = options.replicas;
-  study.total_fits = study.cases * study.replicas;
-  study.shard = options.shard;
-  study.shards = options.shards;
-  if (options.plan) {
-    study.truth = options.plan->truth;
-    (*study.truth)[kNaturalFrequency] = RadPerSecondToHz(options.plan->truth[kNaturalFrequency]);
-  }
-  std::vector<int> fits;
-  for (int i = options.shard; i < study.total_fits; i += options.shards) fits.push_back(i);
-  study.rows.resize(fits.size());
-  std::atomic<int> next{0}, done{0};
-  auto worker = [&]() {
-    for (int k = next++; k < static_cast<int>(fits.size()); k = next++) {
-      const int fit = fits[k];
-      study.rows[k] = RunOneFit(configs[fit / options.replicas], options, fit);
-      study.rows[k].settings = cases[fit / options.replicas];
-      const int finished = ++done;
-      if (progress) progress(finished, static_cast<int>(fits.size()));
-    }
-  };
-  std::vector<std::thread> threads;
-  for (int t = 1; t < options.threads; ++t) threads.emplace_back(worker);
-  worker();
-  for (std::thread& thread : threads) thread.join();
-  study.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return study;
-}
-
-std::string FitsToCsv(const SensitivityStudy& study) {
-  std::ostringstream csv;
-  csv << "fit,case,replica,seed";
-  for (const std::string& key : study.axis_keys) csv << ',' << CsvField(key);
-  csv << ",status,cost,iterations";
-  for (int i = 0; i < kNumParameters; ++i) {
-    const std::string name = i == kNaturalFrequency ? "omega_hz" : ParameterName(i);
-    csv << ',' << name << ',' << name << "_se";
-  }
-  csv << '\n';
-  for (const FitRow& row : study.rows) {
-    csv << row.fit << ',' << row.case_index << ',' << row.replica << ',' << row.seed;
-    for (const std::string& value : row.settings) csv << ',' << CsvField(value);
-    csv << ',' << row.status << ',' << FormatRoundTrip(row.cost) << ',' << row.iterations;
-    for (int i = 0; i < kNumParameters; ++i) {
-      csv << ',' << FormatRoundTrip(row.estimate[i]) << ','
-          << FormatRoundTrip(row.standard_error[i]);
-    }
-    csv << '\n';
-  }
-  return csv.str();
-}
-
-namespace {
-
 bool Usable(const FitRow& row) {
   return row.status == FitStatusName(FitStatus::kConverged) ||
          row.status == FitStatusName(FitStatus::kNoConvergence);
@@ -249,14 +137,13 @@ std::string ParameterColumn(int i) {
 
 // One case's block of summary.yaml.
 void SummarizeCase(const SensitivityStudy& study, int case_index, std::ostringstream* yaml) {
-  std::vector<const FitRow*> rows;
+  std::vector<const FitRow*> rows, usable;
+  int converged = 0;
   for (const FitRow& row : study.rows) {
-    if (row.case_index == case_index) rows.push_back(&row);
-  }
-  int usable = 0, converged = 0;
-  for (const FitRow* row : rows) {
-    usable += Usable(*row);
-    converged += row->status == FitStatusName(FitStatus::kConverged);
+    if (row.case_index != case_index) continue;
+    rows.push_back(&row);
+    if (Usable(row)) usable.push_back(&row);
+    converged += row.status == FitStatusName(FitStatus::kConverged);
   }
   *yaml << "  - case: " << case_index << "\n";
   if (!rows.empty() && !study.axis_keys.empty()) {
@@ -265,7 +152,7 @@ void SummarizeCase(const SensitivityStudy& study, int case_index, std::ostringst
       *yaml << "      " << study.axis_keys[j] << ": \"" << rows[0]->settings[j] << "\"\n";
     }
   }
-  *yaml << "    fits: " << rows.size() << "\n    usable: " << usable
+  *yaml << "    fits: " << rows.size() << "\n    usable: " << usable.size()
         << "\n    converged: " << converged << "\n"
         << StringPrintf("    success_rate: %.6g\n",
                         rows.empty() ? 0.0 : static_cast<double>(converged) / rows.size());
@@ -273,19 +160,18 @@ void SummarizeCase(const SensitivityStudy& study, int case_index, std::ostringst
   for (int i = 0; i < kNumParameters; ++i) {
     double sum = 0.0, sum_se = 0.0;
     int with_se = 0;
-    for (const FitRow* row : rows) {
-      if (!Usable(*row)) continue;
+    for (const FitRow* row : usable) {
       sum += row->estimate[i];
       if (row->standard_error[i] > 0.0) sum_se += row->standard_error[i], ++with_se;
     }
-    const double mean = usable > 0 ? sum / usable : NAN;
+    const double n = static_cast<double>(usable.size());
+    const double mean = n > 0 ? sum / n : NAN;
     double squares = 0.0;
-    for (const FitRow* row : rows) {
-      if (Usable(*row)) squares += (row->estimate[i] - mean) * (row->estimate[i] - mean);
-    }
+    for (const FitRow* row : usable)
+      squares += (row->estimate[i] - mean) * (row->estimate[i] - mean);
     *yaml << "      " << ParameterColumn(i) << ": {"
           << StringPrintf("mean: %.10g, std: %.6g, mean_se: %.6g", mean,
-                          usable > 1 ? std::sqrt(squares / (usable - 1)) : 0.0,
+                          n > 1 ? std::sqrt(squares / (n - 1)) : 0.0,
                           with_se > 0 ? sum_se / with_se : 0.0);
     if (study.truth) {
       const double truth = (*study.truth)[i];
@@ -295,82 +181,6 @@ void SummarizeCase(const SensitivityStudy& study, int case_index, std::ostringst
     *yaml << "}\n";
   }
 }
-
-}  // namespace
-
-std::string SummaryToYaml(const SensitivityStudy& study) {
-  std::ostringstream yaml;
-  yaml << "# dwellfit sensitivity study: per case, over the usable fits (status converged or "
-          "no_convergence).\n# success_rate = converged / fits; bias = mean - truth (the "
-          "plan's). omega in Hz.\n";
-  yaml << "fits: " << study.rows.size() << "\ncases:\n";
-  for (int c = 0; c < study.cases; ++c) SummarizeCase(study, c, &yaml);
-  return yaml.str();
-}
-
-std::string StudyToYaml(const SensitivityStudy& study) {
-  std::ostringstream yaml;
-  yaml << "# What dwellfit's sensitivity merge needs to join shards.\n";
-  yaml << "axis_keys: [";
-  for (size_t j = 0; j < study.axis_keys.size(); ++j)
-    yaml << (j > 0 ? ", " : "") << '"' << study.axis_keys[j] << '"';
-  yaml << "]\ncases: " << study.cases << "\nreplicas: " << study.replicas
-       << "\ntotal_fits: " << study.total_fits << "\nshard: " << study.shard
-       << "\nshards: " << study.shards << "\n";
-  if (study.truth) {
-    yaml << "truth: [";
-    for (int i = 0; i < kNumParameters; ++i)
-      yaml << (i > 0 ? ", " : "") << FormatRoundTrip((*study.truth)[i]);
-    yaml << "]\n";
-  }
-  return yaml.str();
-}
-
-std::string StudyFigureScript(const SensitivityStudy& study) {
-  std::ostringstream gp;
-  gp << "# Figures of a dwellfit sensitivity study, from fits.csv. PNG: gnuplot figures.gp;\n"
-        "# SVG: gnuplot -e \"fmt='svg'\" figures.gp\n"
-        "if (!exists(\"fmt\")) fmt = \"png\"\n"
-        "if (fmt eq \"svg\") {\n  set terminal svg size 1100,700 dynamic noenhanced background "
-        "\"white\"\n"
-        "} else {\n  set terminal pngcairo size 1100,700 noenhanced font \"sans,9\"\n}\n"
-        "set datafile separator \",\"\nset style fill solid 0.6 border -1\nset grid\n"
-        "ok(x) = (strcol('status') eq \"converged\" || strcol('status') eq \"no_convergence\")\n";
-  gp << "set output \"histograms.\".fmt\nset multiplot layout 2,3 title \"estimates over "
-     << study.rows.size() << " fits" << (study.truth ? " (red: the truth)" : "") << "\"\n";
-  for (int i = 0; i < kNumParameters; ++i) {
-    const std::string name = ParameterColumn(i);
-    gp << "stats 'fits.csv' using (ok(0) ? column('" << name << "') : NaN) name \"S\" nooutput\n"
-       << "w = (S_max > S_min) ? (S_max - S_min) / 30.0 : (abs(S_max) > 0 ? abs(S_max) * 1e-6 : "
-          "1e-6)\n"
-       << "set title \"" << name << "\"\nset xtics rotate by -30\n";
-    if (study.truth) {
-      gp << StringPrintf(
-          "set arrow 1 from %.17g, graph 0 to %.17g, graph 1 nohead lw 2 lc rgb "
-          "\"#d62728\"\n",
-          (*study.truth)[i], (*study.truth)[i]);
-    }
-    gp << "plot 'fits.csv' using (ok(0) ? w * floor(column('" << name
-       << "') / w + 0.5) : NaN):(1.0) smooth frequency with boxes notitle\n";
-  }
-  gp << "unset multiplot\nunset output\nunset arrow 1\n";
-  if (study.axis_keys.size() == 1) {
-    gp << "# Profile: cost and estimates against " << study.axis_keys[0] << "\n"
-       << "set output \"profile.\".fmt\nset multiplot layout 2,4 title \"profile over "
-       << study.axis_keys[0] << "\"\nset xlabel \"" << study.axis_keys[0] << "\"\n"
-       << "set title \"cost\"\nplot 'fits.csv' using (ok(0) ? column(5) : NaN):'cost' with "
-          "points pt 7 notitle\n";
-    for (int i = 0; i < kNumParameters; ++i) {
-      gp << "set title \"" << ParameterColumn(i)
-         << "\"\nplot 'fits.csv' using (ok(0) ? column(5) : NaN):'" << ParameterColumn(i)
-         << "' with points pt 7 notitle\n";
-    }
-    gp << "unset multiplot\nunset output\n";
-  }
-  return gp.str();
-}
-
-namespace {
 
 std::string ReadText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -475,7 +285,187 @@ void ReadFitRows(const std::string& path, const SensitivityStudy& shape,
   }
 }
 
+// study.yaml: what MergeShards needs (keys, sizes, shard, truth).
+std::string StudyToYaml(const SensitivityStudy& study) {
+  std::ostringstream yaml;
+  yaml << "# What dwellfit's sensitivity merge needs to join shards.\n";
+  yaml << "axis_keys: [";
+  for (size_t j = 0; j < study.axis_keys.size(); ++j)
+    yaml << (j > 0 ? ", " : "") << '"' << study.axis_keys[j] << '"';
+  yaml << "]\ncases: " << study.cases << "\nreplicas: " << study.replicas
+       << "\ntotal_fits: " << study.total_fits << "\nshard: " << study.shard
+       << "\nshards: " << study.shards << "\n";
+  if (study.truth) {
+    yaml << "truth: [";
+    for (int i = 0; i < kNumParameters; ++i)
+      yaml << (i > 0 ? ", " : "") << FormatRoundTrip((*study.truth)[i]);
+    yaml << "]\n";
+  }
+  return yaml.str();
+}
+
+// figures.gp: the histogram of every estimate and, with one axis, the
+// profile: the cost and every estimate against the axis value.
+std::string StudyFigureScript(const SensitivityStudy& study) {
+  std::ostringstream gp;
+  gp << "# Figures of a dwellfit sensitivity study, from fits.csv. PNG: gnuplot figures.gp;\n"
+        "# SVG: gnuplot -e \"fmt='svg'\" figures.gp\n"
+        "if (!exists(\"fmt\")) fmt = \"png\"\n"
+        "if (fmt eq \"svg\") {\n  set terminal svg size 1100,700 dynamic noenhanced background "
+        "\"white\"\n"
+        "} else {\n  set terminal pngcairo size 1100,700 noenhanced font \"sans,9\"\n}\n"
+        "set datafile separator \",\"\nset style fill solid 0.6 border -1\nset grid\n"
+        "ok(x) = (strcol('status') eq \"converged\" || strcol('status') eq \"no_convergence\")\n";
+  gp << "set output \"histograms.\".fmt\nset multiplot layout 2,3 title \"estimates over "
+     << study.rows.size() << " fits" << (study.truth ? " (red: the truth)" : "") << "\"\n";
+  for (int i = 0; i < kNumParameters; ++i) {
+    const std::string name = ParameterColumn(i);
+    gp << "stats 'fits.csv' using (ok(0) ? column('" << name << "') : NaN) name \"S\" nooutput\n"
+       << "w = (S_max > S_min) ? (S_max - S_min) / 30.0 : (abs(S_max) > 0 ? abs(S_max) * 1e-6 : "
+          "1e-6)\n"
+       << "set title \"" << name << "\"\nset xtics rotate by -30\n";
+    if (study.truth) {
+      gp << StringPrintf(
+          "set arrow 1 from %.17g, graph 0 to %.17g, graph 1 nohead lw 2 lc rgb "
+          "\"#d62728\"\n",
+          (*study.truth)[i], (*study.truth)[i]);
+    }
+    gp << "plot 'fits.csv' using (ok(0) ? w * floor(column('" << name
+       << "') / w + 0.5) : NaN):(1.0) smooth frequency with boxes notitle\n";
+  }
+  gp << "unset multiplot\nunset output\nunset arrow 1\n";
+  if (study.axis_keys.size() == 1) {
+    gp << "# Profile: cost and estimates against " << study.axis_keys[0] << "\n"
+       << "set output \"profile.\".fmt\nset multiplot layout 2,4 title \"profile over "
+       << study.axis_keys[0] << "\"\nset xlabel \"" << study.axis_keys[0] << "\"\n"
+       << "set title \"cost\"\nplot 'fits.csv' using (ok(0) ? column(5) : NaN):'cost' with "
+          "points pt 7 notitle\n";
+    for (int i = 0; i < kNumParameters; ++i) {
+      gp << "set title \"" << ParameterColumn(i)
+         << "\"\nplot 'fits.csv' using (ok(0) ? column(5) : NaN):'" << ParameterColumn(i)
+         << "' with points pt 7 notitle\n";
+    }
+    gp << "unset multiplot\nunset output\n";
+  }
+  return gp.str();
+}
+
 }  // namespace
+
+std::vector<VaryAxis> ParseVaryFlag(const std::string& flag_value, const std::string& origin) {
+  std::vector<VaryAxis> axes;
+  if (Trim(flag_value).empty()) return axes;
+  for (const std::string& part : SplitOutside(flag_value, ';')) {
+    const size_t equals = part.find('=');
+    VaryAxis axis;
+    axis.key = Trim(part.substr(0, equals));
+    if (equals == std::string::npos || axis.key.empty()) {
+      throw InputError(origin, 0, axis.key,
+                       "'" + part +
+                           "' is not key=value1|value2|...; e.g. "
+                           "'penalties.bifurcation_range.exponent=2|4|10'");
+    }
+    for (const std::string& value : SplitOutside(part.substr(equals + 1), '|')) {
+      if (Trim(value).empty()) {
+        throw InputError(origin, 0, axis.key, "an empty value in '" + part + "'");
+      }
+      axis.values.push_back(Trim(value));
+    }
+    for (const VaryAxis& other : axes) {
+      if (other.key == axis.key) throw InputError(origin, 0, axis.key, "the key is varied twice");
+    }
+    axes.push_back(axis);
+  }
+  return axes;
+}
+
+bool SensitivityOptions::IsValid(std::string* why) const {
+  auto fail = [why](const std::string& text) {
+    *why = text;
+    return false;
+  };
+  if (replicas < 1) return fail("--replicas must be >= 1");
+  if (!plan && replicas != 1)
+    return fail("--replicas needs --plan (replicas are noisy simulations of a plan)");
+  if (!(noise >= 0.0) || !std::isfinite(noise)) return fail("--noise must be >= 0");
+  if (threads < 1) return fail("--threads must be >= 1");
+  if (shards < 1 || shard < 0 || shard >= shards)
+    return fail(StringPrintf("--shard %d/%d: need 0 <= k < N", shard, shards));
+  return true;
+}
+
+SensitivityStudy RunSensitivityStudy(const SensitivityOptions& options, const Progress& progress) {
+  std::string why;
+  if (!options.IsValid(&why)) throw InputError("flags", 0, "", why);
+  const auto start = std::chrono::steady_clock::now();
+  SensitivityStudy study;
+  for (const VaryAxis& axis : options.vary) study.axis_keys.push_back(axis.key);
+  const std::vector<std::vector<std::string>> cases = Cases(options.vary);
+  std::vector<IdentifyConfig> configs;  // loaded up front: a bad value fails at once
+  for (const auto& values : cases) {
+    std::vector<ConfigOverride> overrides = options.overrides;
+    for (size_t j = 0; j < values.size(); ++j)
+      overrides.push_back({options.vary[j].key, values[j], "--vary"});
+    configs.push_back(LoadIdentifyConfig(options.config_path, overrides));
+  }
+  study.cases = static_cast<int>(cases.size());
+  study.replicas = options.replicas;
+  study.total_fits = study.cases * study.replicas;
+  study.shard = options.shard;
+  study.shards = options.shards;
+  if (options.plan) {
+    study.truth = options.plan->truth;
+    (*study.truth)[kNaturalFrequency] = RadPerSecondToHz(options.plan->truth[kNaturalFrequency]);
+  }
+  std::vector<int> fits;
+  for (int i = options.shard; i < study.total_fits; i += options.shards) fits.push_back(i);
+  study.rows.resize(fits.size());
+  const int count = static_cast<int>(fits.size());
+  std::atomic<int> done{0};
+  auto run_fit = [&](int k) {
+    study.rows[k] = RunOneFit(configs[fits[k] / options.replicas], options, fits[k]);
+    study.rows[k].settings = cases[fits[k] / options.replicas];
+    const int finished = ++done;
+    if (progress) progress(finished, count);
+  };
+  tbb::task_arena(options.threads).execute([&] {
+    tbb::parallel_for(0, count, run_fit, tbb::simple_partitioner());
+  });
+  study.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return study;
+}
+
+std::string FitsToCsv(const SensitivityStudy& study) {
+  std::ostringstream csv;
+  csv << "fit,case,replica,seed";
+  for (const std::string& key : study.axis_keys) csv << ',' << CsvField(key);
+  csv << ",status,cost,iterations";
+  for (int i = 0; i < kNumParameters; ++i) {
+    csv << ',' << ParameterColumn(i) << ',' << ParameterColumn(i) << "_se";
+  }
+  csv << '\n';
+  for (const FitRow& row : study.rows) {
+    csv << row.fit << ',' << row.case_index << ',' << row.replica << ',' << row.seed;
+    for (const std::string& value : row.settings) csv << ',' << CsvField(value);
+    csv << ',' << row.status << ',' << FormatRoundTrip(row.cost) << ',' << row.iterations;
+    for (int i = 0; i < kNumParameters; ++i) {
+      csv << ',' << FormatRoundTrip(row.estimate[i]) << ','
+          << FormatRoundTrip(row.standard_error[i]);
+    }
+    csv << '\n';
+  }
+  return csv.str();
+}
+
+std::string SummaryToYaml(const SensitivityStudy& study) {
+  std::ostringstream yaml;
+  yaml << "# dwellfit sensitivity study: per case, over the usable fits (status converged or "
+          "no_convergence).\n# success_rate = converged / fits; bias = mean - truth (the "
+          "plan's). omega in Hz.\n";
+  yaml << "fits: " << study.rows.size() << "\ncases:\n";
+  for (int c = 0; c < study.cases; ++c) SummarizeCase(study, c, &yaml);
+  return yaml.str();
+}
 
 SensitivityStudy MergeShards(const std::vector<std::string>& folders) {
   if (folders.empty()) throw InputError("--merge", 0, "", "give the shards' folders");

@@ -1,14 +1,8 @@
-// Sensitivity study: many fits of one config, varying what the caller says.
-//
-// Cases are the Cartesian product of the `vary` axes, each axis a config key
-// with a list of values (any key identify's --set accepts: the penalty
-// exponent, weight and Lambda, multi_start.starts (random starts), an
-// initial_guess of a fixed parameter (a profile), `fixed`, `fit`, ...). Each
-// case is fitted `replicas` times: with a dwell plan, replica r simulates the
-// plan with relative noise `noise` and seed first_seed + r (as the coverage
-// study does); without one, the config's own data (one replica). Every fit
-// takes the one path of a measured run (resolved_run.h: ResolveRun, FitRun)
-// and the uncertainty at its estimate.
+// Sensitivity study: many fits of one config, varying what the caller says
+// (docs/sensitivity.md: the axes, replicas, outputs and shards). Cases are
+// the Cartesian product of the `vary` axes; each is fitted `replicas` times
+// (noisy replicas of a dwell plan, ResolveReplicaRun; without a plan, the
+// config's own data once), every fit on the one path of a measured run.
 //
 // Fit i = case * replicas + replica; fits run on `threads` threads (each fit
 // single-threaded) into slots by index, so the output does not depend on the
@@ -88,23 +82,14 @@ using Progress = std::function<void(int done, int total)>;
 SensitivityStudy RunSensitivityStudy(const SensitivityOptions& options,
                                      const Progress& progress = nullptr);
 
-// fits.csv: fit,case,replica,seed,<axis keys>,status,cost,iterations, then
-// value and _se of eta_e, mu1, mu2, delta, alpha, omega_hz.
+// fits.csv and summary.yaml (docs/sensitivity.md).
 std::string FitsToCsv(const SensitivityStudy& study);
-// study.yaml: what MergeShards needs (keys, sizes, shard, truth).
-std::string StudyToYaml(const SensitivityStudy& study);
-// summary.yaml: per case, the fits, how many are usable and converged, the
-// success rate, and per parameter mean, standard deviation, mean standard
-// error and, with a truth, the bias.
 std::string SummaryToYaml(const SensitivityStudy& study);
-// sensitivity.gp: histograms of every estimate per case and, with one axis,
-// the profile: the mean cost and every estimate against the axis value.
-std::string StudyFigureScript(const SensitivityStudy& study);
 
-// The files of a study's output folder: fits.csv, summary.yaml, study.yaml
-// and, with `figures`, figures.gp and the histogram (and profile) images
-// gnuplot draws from it; a missing or failing gnuplot is a line on
-// `warnings`, never an error.
+// The files of a study's output folder (docs/sensitivity.md): fits.csv,
+// summary.yaml, study.yaml (what MergeShards needs) and, with `figures`,
+// figures.gp and the images gnuplot draws from it; a missing or failing
+// gnuplot is a line on `warnings`, never an error.
 std::vector<std::pair<std::string, std::string>> StudyFiles(const SensitivityStudy& study,
                                                             bool figures, std::ostream& warnings);
 
