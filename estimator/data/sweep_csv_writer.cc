@@ -13,20 +13,11 @@
 
 namespace dwellfit {
 
-namespace {
-
-// The shortest round-trip text of `value` into `buffer`; returns its end.
-char* ToCharsRoundTrip(double value, char (&buffer)[64]) {
-  const std::to_chars_result result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  CHECK(result.ec == std::errc()) << "64 characters hold any double";
-  return result.ptr;
-}
-
-}  // namespace
-
 std::string FormatRoundTrip(double value) {
   char buffer[64];
-  return std::string(buffer, ToCharsRoundTrip(value, buffer));
+  const std::to_chars_result result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  CHECK(result.ec == std::errc()) << "64 characters hold any double";
+  return std::string(buffer, result.ptr);
 }
 
 std::string FormatFrequencyHz(double omega_rad_s) {
