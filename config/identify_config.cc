@@ -47,12 +47,6 @@ double RadPerSecond(double hz, const ConfigValue& value, const ConfigSource& sou
   return rad_s;
 }
 
-std::string RelativeToWhat(const ConfigValue& value, const ConfigSource& source) {
-  return source.OverrideFor(value.path) != nullptr
-             ? "a relative path given on the command line is relative to the working directory"
-             : "a relative path in the config is relative to the config file's directory";
-}
-
 std::vector<std::string> ReadDataFiles(const ConfigValue& value, const ConfigSource& source,
                                        const fs::path& config_dir) {
   const std::vector<ConfigValue> entries = ReadList(value, source);
@@ -74,8 +68,12 @@ std::vector<std::string> ReadDataFiles(const ConfigValue& value, const ConfigSou
     }
     if (!fs::is_regular_file(resolved, error)) {
       throw source.Error(entry.path, entry.mark,
-                         "data file '" + text + "' not found at " + resolved + " (" +
-                             RelativeToWhat(entry, source) + ")");
+                         "data file '" + text + "' not found at " + resolved +
+                             (source.OverrideFor(entry.path) != nullptr
+                                  ? " (a relative path given on the command line is relative to "
+                                    "the working directory)"
+                                  : " (a relative path in the config is relative to the config "
+                                    "file's directory)"));
     }
     for (std::size_t i = 0; i < files.size(); ++i) {
       if (files[i] == resolved) {
