@@ -1,6 +1,7 @@
 #include "dwellfit/config/config_override.h"
 
 #include <set>
+#include <sstream>
 
 #include "dwellfit/estimator/common/input_error.h"
 
@@ -125,22 +126,13 @@ std::vector<ConfigOverride> ParseSetFlag(const std::string& flag_value, const st
 
 ConfigOverride ListFlagOverride(const std::string& key_path, const std::string& comma_list,
                                 const std::string& origin, OverrideAction action) {
-  std::string yaml = "[";
-  std::string::size_type begin = 0;
-  bool first = true;
-  while (begin <= comma_list.size()) {
-    std::string::size_type comma = comma_list.find(',', begin);
-    if (comma == std::string::npos) comma = comma_list.size();
-    const std::string item = Trim(comma_list.substr(begin, comma - begin));
-    if (!item.empty()) {
-      if (!first) yaml += ", ";
-      yaml += item;
-      first = false;
-    }
-    begin = comma + 1;
+  std::string entries;
+  std::istringstream items(comma_list);
+  for (std::string item; std::getline(items, item, ',');) {
+    item = Trim(item);
+    if (!item.empty()) entries += (entries.empty() ? "" : ", ") + item;
   }
-  yaml += "]";
-  return ConfigOverride{key_path, yaml, origin, action};
+  return ConfigOverride{key_path, "[" + entries + "]", origin, action};
 }
 
 std::string DescribeOverride(const ConfigOverride& override_value) {

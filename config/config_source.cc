@@ -8,6 +8,7 @@
 #include <system_error>
 #include <utility>
 
+#include "dwellfit/config/strict_yaml.h"
 #include "yaml-cpp/depthguard.h"
 #include "yaml-cpp/eventhandler.h"
 #include "yaml-cpp/parser.h"
@@ -72,12 +73,6 @@ std::vector<std::string> SplitKeyPath(const std::string& key_path) {
     if (dot == std::string::npos) return segments;
     begin = dot + 1;
   }
-}
-
-const char* NodeKindName(const YAML::Node& node) {
-  if (node.IsSequence()) return "list";
-  if (node.IsMap()) return "block of keys";
-  return "single value";
 }
 
 int OneBasedLine(const YAML::Mark& mark) { return mark.is_null() ? 0 : mark.line + 1; }
@@ -339,7 +334,7 @@ YAML::Node ConfigSource::WalkToParent(const ConfigOverride& override_value,
       next.reset(Rebind(&map, segments[i], YAML::Node(YAML::NodeType::Map)));
     } else if (!child.IsMap()) {
       throw InputError(override_value.origin, 0, override_value.key_path,
-                       "'" + walked + "' holds a " + NodeKindName(child) +
+                       "'" + walked + "' holds " + DescribeKind(child) +
                            ", not a block of keys; set '" + walked + "' itself");
     } else {
       next.reset(Rebind(&map, segments[i], ShallowCopy(child)));
@@ -363,7 +358,7 @@ void ConfigSource::ApplyOne(const ConfigOverride& override_value) {
   if (!root_.IsDefined() || root_.IsNull()) root_ = YAML::Node(YAML::NodeType::Map);
   if (!root_.IsMap()) {
     throw InputError(file_, OneBasedLine(root_.Mark()), "",
-                     "the config is a " + std::string(NodeKindName(root_)) +
+                     "the config is " + std::string(DescribeKind(root_)) +
                          ", not a block of keys, so " + DescribeOverride(override_value) +
                          " cannot be applied");
   }

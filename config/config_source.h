@@ -38,9 +38,7 @@ class ConfigSource {
   // in the file keeps its values.
   void Apply(const std::vector<ConfigOverride>& overrides);
 
-  const std::string& file() const { return file_; }
   const YAML::Node& root() const { return root_; }
-  const std::vector<ConfigOverride>& applied() const { return applied_; }
 
   // The last override that set `key_path`, a block containing it, or created
   // such a block; nullptr when the value comes from the file.

@@ -33,10 +33,6 @@ std::array<PlanKey, 4> GridKeys(SweepKind kind) {
            {"a_base_step", "the base level step"}}};
 }
 
-SweepKind OtherKind(SweepKind kind) {
-  return kind == SweepKind::kFrequency ? SweepKind::kAmplitude : SweepKind::kFrequency;
-}
-
 // A non-empty list, given as a list (a single value is not taken for one);
 // `expected` describes it in the error.
 std::vector<ConfigValue> ReadNonEmptyList(const ConfigValue& value, const ConfigSource& source,
@@ -81,7 +77,8 @@ std::optional<SweepKind> StatedKind(const YAML::Node& block) {
 // A grid key of the other kind of sweep is reported as such, not as a typo.
 void CheckNoGridKeyOfOtherKind(const ConfigValue& value, const ConfigSource& source, SweepKind kind,
                                const std::vector<std::string>& allowed) {
-  const SweepKind other = OtherKind(kind);
+  const SweepKind other =
+      kind == SweepKind::kFrequency ? SweepKind::kAmplitude : SweepKind::kFrequency;
   for (const auto& entry : value.node) {
     const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : "";
     for (const PlanKey& grid_key : GridKeys(other)) {

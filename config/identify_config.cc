@@ -47,12 +47,6 @@ double RadPerSecond(double hz, const ConfigValue& value, const ConfigSource& sou
   return rad_s;
 }
 
-std::string RelativeToWhat(const ConfigValue& value, const ConfigSource& source) {
-  return source.OverrideFor(value.path) != nullptr
-             ? "a relative path given on the command line is relative to the working directory"
-             : "a relative path in the config is relative to the config file's directory";
-}
-
 std::vector<std::string> ReadDataFiles(const ConfigValue& value, const ConfigSource& source,
                                        const fs::path& config_dir) {
   const std::vector<ConfigValue> entries = ReadList(value, source);
@@ -74,8 +68,12 @@ std::vector<std::string> ReadDataFiles(const ConfigValue& value, const ConfigSou
     }
     if (!fs::is_regular_file(resolved, error)) {
       throw source.Error(entry.path, entry.mark,
-                         "data file '" + text + "' not found at " + resolved + " (" +
-                             RelativeToWhat(entry, source) + ")");
+                         "data file '" + text + "' not found at " + resolved +
+                             (source.OverrideFor(entry.path) != nullptr
+                                  ? " (a relative path given on the command line is relative to "
+                                    "the working directory)"
+                                  : " (a relative path in the config is relative to the config "
+                                    "file's directory)"));
     }
     for (std::size_t i = 0; i < files.size(); ++i) {
       if (files[i] == resolved) {
@@ -196,6 +194,8 @@ ParameterVector WithPlaceholders(const KnownParameters& known) {
   return initial;
 }
 
+// Throws the IsValid `message` of options read from `block`, at the block's
+// line, naming the overrides that changed values inside it.
 void ThrowInvalidBlock(const ConfigValue& block, const ConfigSource& source,
                        const std::string& message) {
   std::string set_by;
@@ -205,6 +205,20 @@ void ThrowInvalidBlock(const ConfigValue& block, const ConfigSource& source,
   std::string what = message;
   if (!set_by.empty()) what += " (values set on the command line: " + set_by + ")";
   throw source.Error(block.path, block.mark, what);
+}
+
+// The options of the block `key` of `parent`, read by `read` (the defaults
+// when absent), reported by ThrowInvalidBlock unless valid.
+template <typename Options>
+Options ReadValid(const StrictMap& parent, const std::string& key, const ConfigSource& source,
+                  Options (*read)(const ConfigValue&, const ConfigSource&)) {
+  const std::optional<ConfigValue> value = parent.Optional(key);
+  const Options options = value ? read(*value, source) : Options();
+  std::string message;
+  if (!options.IsValid(&message)) {
+    ThrowInvalidBlock(value ? *value : parent.block(), source, message);
+  }
+  return options;
 }
 
 MultiStartOptions ReadMultiStart(const ConfigValue& value, const ConfigSource& source) {
@@ -218,8 +232,6 @@ MultiStartOptions ReadMultiStart(const ConfigValue& value, const ConfigSource& s
     multi_start.seed = static_cast<std::uint64_t>(seed);
   }
   block.Read("threads", &multi_start.threads);
-  std::string message;
-  if (!multi_start.IsValid(&message)) ThrowInvalidBlock(value, source, message);
   return multi_start;
 }
 
@@ -273,14 +285,7 @@ std::vector<ResidualKind> ReadStages(const ConfigValue& value, const ConfigSourc
       ResidualKindName(ResidualKind::kPhaseLag), ResidualKindName(ResidualKind::kAllRoots)};
   std::vector<ResidualKind> stages;
   for (const ConfigValue& entry : ReadList(value, source)) {
-    const std::string name = ReadNonEmptyString(entry, source);
-    ResidualKind kind;
-    if (!ResidualKindFromName(name, &kind)) {
-      throw source.Error(entry.path, entry.mark,
-                         "unknown stage '" + EscapeForMessage(name) + "'" +
-                             DidYouMean(name, allowed) + "; allowed: " + JoinNames(allowed));
-    }
-    stages.push_back(kind);
+    ResidualKindFromName(ReadOneOf(entry, source, "stage", allowed), &stages.emplace_back());
   }
   if (stages.empty()) {
     throw source.Error(value.path, value.mark,
@@ -294,14 +299,9 @@ ResidualOptions ReadResidual(const ConfigValue& value, const ConfigSource& sourc
   const StrictMap block(value, source, {"error", "use_point_sigma", "amplitude_floor"});
   ResidualOptions residual;
   if (const auto error = block.Optional("error")) {
-    const std::string name = ReadNonEmptyString(*error, source);
-    if (!ErrorMeasureFromName(name, &residual.error)) {
-      const std::vector<std::string> allowed = {ErrorMeasureName(ErrorMeasure::kAbsolute),
-                                                ErrorMeasureName(ErrorMeasure::kRelative)};
-      throw source.Error(error->path, error->mark,
-                         "unknown error measure '" + EscapeForMessage(name) + "'" +
-                             DidYouMean(name, allowed) + "; allowed: " + JoinNames(allowed));
-    }
+    const std::vector<std::string> allowed = {ErrorMeasureName(ErrorMeasure::kAbsolute),
+                                              ErrorMeasureName(ErrorMeasure::kRelative)};
+    ErrorMeasureFromName(ReadOneOf(*error, source, "error measure", allowed), &residual.error);
   }
   block.Read("use_point_sigma", &residual.use_point_sigma);
   if (const auto floor = block.Optional("amplitude_floor")) {
@@ -386,15 +386,10 @@ std::string ReadJumpSweep(const StrictMap& block, const ConfigSource& source) {
 }
 
 JumpKind ReadJumpKind(const ConfigValue& value, const ConfigSource& source) {
-  const std::string name = ReadNonEmptyString(value, source);
-  for (JumpKind kind : {JumpKind::kJumpUp, JumpKind::kJumpDown}) {
-    if (name == JumpKindName(kind)) return kind;
-  }
   const std::vector<std::string> allowed = {JumpKindName(JumpKind::kJumpUp),
                                             JumpKindName(JumpKind::kJumpDown)};
-  throw source.Error(value.path, value.mark,
-                     "unknown jump kind '" + EscapeForMessage(name) + "'" +
-                         DidYouMean(name, allowed) + "; allowed: " + JoinNames(allowed));
+  return ReadOneOf(value, source, "jump kind", allowed) == allowed[0] ? JumpKind::kJumpUp
+                                                                      : JumpKind::kJumpDown;
 }
 
 // One entry of `jumps`: a sweep and exactly one of between_hz, between_a_base
@@ -484,13 +479,9 @@ std::vector<JumpTarget> ReadJumpTargets(const ConfigValue& value, const ConfigSo
   }
   std::vector<JumpTarget> targets;
   for (const ConfigValue& entry : ReadList(value, source)) {
-    const std::string name = ReadNonEmptyString(entry, source);
+    const std::string name = ReadOneOf(entry, source, "jump", allowed);
     JumpTarget target;
-    if (!JumpTargetFromName(name, &target)) {
-      throw source.Error(entry.path, entry.mark,
-                         "unknown jump '" + EscapeForMessage(name) + "'" +
-                             DidYouMean(name, allowed) + "; allowed: " + JoinNames(allowed));
-    }
+    JumpTargetFromName(name, &target);
     if (std::find(targets.begin(), targets.end(), target) != targets.end()) {
       throw source.Error(entry.path, entry.mark, "jump '" + name + "' is listed twice; keep one");
     }
@@ -518,32 +509,12 @@ BranchStabilityOptions ReadBranchStability(const ConfigValue& value, const Confi
   return stability;
 }
 
-// Throws the `IsValid` message of an options struct read from `block`, at the
-// block's line, naming the overrides that changed values inside it.
-
-ConfigValue OrAbsent(const std::optional<ConfigValue>& value, const std::string& path) {
-  return value.has_value() ? *value : ConfigValue{YAML::Node(), path, YAML::Mark::null_mark()};
-}
-
 // The `penalties` block; each sub-block's IsValid is reported at its line.
 PenaltyOptions ReadPenalties(const ConfigValue& value, const ConfigSource& source) {
   const StrictMap block(value, source, {"bifurcation_range", "branch_stability"});
   PenaltyOptions penalties;
-  std::string message;
-  const ConfigValue range =
-      OrAbsent(block.Optional("bifurcation_range"), value.path + ".bifurcation_range");
-  if (range.node.IsDefined()) penalties.bifurcation_range = ReadBifurcationRange(range, source);
-  if (!penalties.bifurcation_range.IsValid(&message)) {
-    ThrowInvalidBlock(range.node.IsDefined() ? range : value, source, message);
-  }
-  const ConfigValue stability =
-      OrAbsent(block.Optional("branch_stability"), value.path + ".branch_stability");
-  if (stability.node.IsDefined()) {
-    penalties.branch_stability = ReadBranchStability(stability, source);
-  }
-  if (!penalties.branch_stability.IsValid(&message)) {
-    ThrowInvalidBlock(stability.node.IsDefined() ? stability : value, source, message);
-  }
+  penalties.bifurcation_range = ReadValid(block, "bifurcation_range", source, ReadBifurcationRange);
+  penalties.branch_stability = ReadValid(block, "branch_stability", source, ReadBranchStability);
   return penalties;
 }
 
@@ -571,9 +542,9 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
   config.validate_sweeps = Selections(validate);
 
   IdentificationOptions& identification = config.identification;
-  const ConfigValue initial_guess = OrAbsent(top.Optional("initial_guess"), "initial_guess");
-  if (initial_guess.node.IsDefined())
-    config.initial_guess = ReadInitialGuess(initial_guess, source);
+  if (const auto value = top.Optional("initial_guess")) {
+    config.initial_guess = ReadInitialGuess(*value, source);
+  }
   identification.initial = WithPlaceholders(config.initial_guess);
   if (const auto value = top.Optional("fixed")) {
     identification.fixed = ReadFixed(*value, source, config.initial_guess);
@@ -583,10 +554,7 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
   if (const auto value = top.Optional("residual")) {
     identification.solve.residual = ReadResidual(*value, source);
   }
-  const ConfigValue solver = OrAbsent(top.Optional("solver"), "solver");
-  if (solver.node.IsDefined()) identification.solve.solver = ReadSolver(solver, source);
-  std::string message;
-  if (!identification.solve.solver.IsValid(&message)) ThrowInvalidBlock(solver, source, message);
+  identification.solve.solver = ReadValid(top, "solver", source, ReadSolver);
   if (const auto value = top.Optional("penalties")) {
     identification.solve.penalties = ReadPenalties(*value, source);
   }
@@ -594,17 +562,8 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
   if (const auto value = top.Optional("model_selection")) {
     config.model_selection = ReadModelSelectionConfig(*value, source, config.initial_guess);
   }
-  if (const auto value = top.Optional("multi_start")) {
-    config.multi_start = ReadMultiStart(*value, source);
-  }
-
-  const ConfigValue jump_detection = OrAbsent(top.Optional("jump_detection"), "jump_detection");
-  if (jump_detection.node.IsDefined()) {
-    config.jump_detection = ReadJumpDetection(jump_detection, source);
-  }
-  if (!config.jump_detection.IsValid(&message)) {
-    ThrowInvalidBlock(jump_detection, source, message);
-  }
+  config.multi_start = ReadValid(top, "multi_start", source, ReadMultiStart);
+  config.jump_detection = ReadValid(top, "jump_detection", source, ReadJumpDetection);
   if (const auto value = top.Optional("jumps")) {
     config.jump_overrides = ReadJumpOverrides(*value, source);
   }

@@ -4,17 +4,11 @@
 #include <vector>
 
 #include "dwellfit/config/identify_config.h"
+#include "dwellfit/estimator/data/sweep_csv_writer.h"
 #include "yaml-cpp/yaml.h"
 
 namespace dwellfit {
 namespace {
-
-// The shortest text that reads back as exactly `value`.
-std::string ExactNumber(double value) {
-  char buffer[64];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  return std::string(buffer, result.ptr);
-}
 
 // 15 significant digits: recovers the decimal a person typed from a value
 // that went through a unit conversion (Hz -> rad/s -> Hz).
@@ -23,6 +17,15 @@ std::string ConvertedNumber(double value) {
   const auto result =
       std::to_chars(buffer, buffer + sizeof(buffer), value, std::chars_format::general, 15);
   return std::string(buffer, result.ptr);
+}
+
+// `key: value`; a double as its FormatRoundTrip.
+template <typename T>
+void Put(YAML::Emitter& out, const char* key, const T& value) {
+  out << YAML::Key << key << YAML::Value << value;
+}
+void Put(YAML::Emitter& out, const char* key, double value) {
+  Put(out, key, FormatRoundTrip(value));
 }
 
 void EmitSelections(YAML::Emitter& out, const char* key,
@@ -36,18 +39,18 @@ void EmitPenalties(YAML::Emitter& out, const PenaltyOptions& penalties) {
   const BifurcationRangeOptions& range = penalties.bifurcation_range;
   out << YAML::Key << "penalties" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "bifurcation_range" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "enabled" << YAML::Value << range.enabled;
-  out << YAML::Key << "exponent" << YAML::Value << range.exponent;
-  out << YAML::Key << "weight" << YAML::Value << ExactNumber(range.weight);
+  Put(out, "enabled", range.enabled);
+  Put(out, "exponent", range.exponent);
+  Put(out, "weight", range.weight);
   out << YAML::Key << "enforce" << YAML::Value << YAML::Flow << YAML::BeginSeq;
   for (JumpTarget target : range.enforce) out << JumpTargetName(target);
   out << YAML::EndSeq;
   out << YAML::EndMap;
   const BranchStabilityOptions& stability = penalties.branch_stability;
   out << YAML::Key << "branch_stability" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "enabled" << YAML::Value << stability.enabled;
-  out << YAML::Key << "lambda" << YAML::Value << ExactNumber(stability.lambda);
-  out << YAML::Key << "weight" << YAML::Value << ExactNumber(stability.weight);
+  Put(out, "enabled", stability.enabled);
+  Put(out, "lambda", stability.lambda);
+  Put(out, "weight", stability.weight);
   out << YAML::EndMap;
   out << YAML::EndMap;
 }
@@ -62,11 +65,11 @@ void EmitJumpOverrides(YAML::Emitter& out, const std::vector<JumpOverride>& jump
   out << YAML::BeginSeq;
   for (const JumpOverride& jump : jumps) {
     out << YAML::BeginMap;
-    out << YAML::Key << "sweep" << YAML::Value << jump.sweep;
+    Put(out, "sweep", jump.sweep);
     if (jump.none) {
-      out << YAML::Key << "none" << YAML::Value << true;
+      Put(out, "none", true);
     } else {
-      out << YAML::Key << "kind" << YAML::Value << JumpKindName(jump.kind);
+      Put(out, "kind", JumpKindName(jump.kind));
       const bool frequency = jump.control == SweepKind::kFrequency;
       out << YAML::Key << (frequency ? "between_hz" : "between_a_base") << YAML::Value << YAML::Flow
           << YAML::BeginSeq;
@@ -74,12 +77,12 @@ void EmitJumpOverrides(YAML::Emitter& out, const std::vector<JumpOverride>& jump
         out << ConvertedNumber(RadPerSecondToHz(jump.control_before))
             << ConvertedNumber(RadPerSecondToHz(jump.control_after));
       } else {
-        out << ExactNumber(jump.control_before) << ExactNumber(jump.control_after);
+        out << FormatRoundTrip(jump.control_before) << FormatRoundTrip(jump.control_after);
       }
       out << YAML::EndSeq;
       if (frequency) {
-        out << YAML::Comment(ExactNumber(jump.control_before) + ", " +
-                             ExactNumber(jump.control_after) + " rad/s");
+        out << YAML::Comment(FormatRoundTrip(jump.control_before) + ", " +
+                             FormatRoundTrip(jump.control_after) + " rad/s");
       }
     }
     out << YAML::EndMap;
@@ -96,9 +99,9 @@ void EmitInitialGuess(YAML::Emitter& out, const IdentifyConfig& config) {
           << "auto";
     } else if (i == kNaturalFrequency) {
       out << YAML::Key << "omega_hz" << YAML::Value << ConvertedNumber(RadPerSecondToHz(initial[i]))
-          << YAML::Comment(ExactNumber(initial[i]) + " rad/s");
+          << YAML::Comment(FormatRoundTrip(initial[i]) + " rad/s");
     } else {
-      out << YAML::Key << ParameterName(i) << YAML::Value << ExactNumber(initial[i]);
+      Put(out, ParameterName(i), initial[i]);
     }
   }
   out << YAML::EndMap;
@@ -117,49 +120,45 @@ void EmitFitSettings(YAML::Emitter& out, const IdentificationOptions& identifica
   out << YAML::EndSeq;
 
   out << YAML::Key << "residual" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "error" << YAML::Value
-      << ErrorMeasureName(identification.solve.residual.error);
-  out << YAML::Key << "use_point_sigma" << YAML::Value
-      << identification.solve.residual.use_point_sigma;
+  Put(out, "error", ErrorMeasureName(identification.solve.residual.error));
+  Put(out, "use_point_sigma", identification.solve.residual.use_point_sigma);
+  // yaml-cpp's own text of a double, as this key has always been written.
   out << YAML::Key << "amplitude_floor" << YAML::Value
       << identification.solve.residual.amplitude_floor;
   out << YAML::EndMap;
 
   const SolverSettings& solver = identification.solve.solver;
   out << YAML::Key << "solver" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "max_iterations" << YAML::Value << solver.max_iterations;
-  out << YAML::Key << "function_tolerance" << YAML::Value << ExactNumber(solver.function_tolerance);
-  out << YAML::Key << "start_function_tolerance" << YAML::Value
-      << ExactNumber(solver.start_function_tolerance);
-  out << YAML::Key << "gradient_tolerance" << YAML::Value << ExactNumber(solver.gradient_tolerance);
-  out << YAML::Key << "parameter_tolerance" << YAML::Value
-      << ExactNumber(solver.parameter_tolerance);
+  Put(out, "max_iterations", solver.max_iterations);
+  Put(out, "function_tolerance", solver.function_tolerance);
+  Put(out, "start_function_tolerance", solver.start_function_tolerance);
+  Put(out, "gradient_tolerance", solver.gradient_tolerance);
+  Put(out, "parameter_tolerance", solver.parameter_tolerance);
   if (keys == ConfigKeys::kAll) {
-    out << YAML::Key << "num_threads" << YAML::Value << solver.num_threads;
+    Put(out, "num_threads", solver.num_threads);
   }
-  out << YAML::Key << "nonmonotonic_steps" << YAML::Value << solver.nonmonotonic_steps;
-  out << YAML::Key << "valley_polish" << YAML::Value << solver.valley_polish;
+  Put(out, "nonmonotonic_steps", solver.nonmonotonic_steps);
+  Put(out, "valley_polish", solver.valley_polish);
   out << YAML::EndMap;
 }
 
 void EmitMultiStartAndJumpDetection(YAML::Emitter& out, const IdentifyConfig& config,
                                     ConfigKeys keys) {
   out << YAML::Key << "multi_start" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "starts" << YAML::Value << config.multi_start.starts;
-  out << YAML::Key << "spread" << YAML::Value << ExactNumber(config.multi_start.spread);
-  out << YAML::Key << "seed" << YAML::Value << config.multi_start.seed;
+  Put(out, "starts", config.multi_start.starts);
+  Put(out, "spread", config.multi_start.spread);
+  Put(out, "seed", config.multi_start.seed);
   if (keys == ConfigKeys::kAll) {
-    out << YAML::Key << "threads" << YAML::Value << config.multi_start.threads;
+    Put(out, "threads", config.multi_start.threads);
   }
   out << YAML::EndMap;
 
   const JumpDetectionOptions& jump_detection = config.jump_detection;
   out << YAML::Key << "jump_detection" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "min_ratio" << YAML::Value << ExactNumber(jump_detection.min_ratio);
-  out << YAML::Key << "min_relative_amplitude" << YAML::Value
-      << ExactNumber(jump_detection.min_relative_amplitude);
-  out << YAML::Key << "noise_multiple" << YAML::Value << ExactNumber(jump_detection.noise_multiple);
-  out << YAML::Key << "min_candidate_steps" << YAML::Value << jump_detection.min_candidate_steps;
+  Put(out, "min_ratio", jump_detection.min_ratio);
+  Put(out, "min_relative_amplitude", jump_detection.min_relative_amplitude);
+  Put(out, "noise_multiple", jump_detection.noise_multiple);
+  Put(out, "min_candidate_steps", jump_detection.min_candidate_steps);
   out << YAML::EndMap;
 }
 
@@ -171,7 +170,7 @@ void EmitChoices(YAML::Emitter& out, const char* key, const std::vector<Paramete
       out << "free";
     } else {
       out << (omega ? ConvertedNumber(RadPerSecondToHz(*choice.value))
-                    : ExactNumber(*choice.value));
+                    : FormatRoundTrip(*choice.value));
     }
   }
   out << YAML::EndSeq;
@@ -182,11 +181,10 @@ void EmitModelSelection(YAML::Emitter& out, const ModelSelectionConfig& selectio
   EmitChoices(out, "delta", selection.delta, false);
   EmitChoices(out, "mu2", selection.mu2, false);
   EmitChoices(out, "omega_hz", selection.omega, true);
-  out << YAML::Key << "cross_validation" << YAML::Value
-      << CrossValidationSchemeName(selection.scheme);
-  out << YAML::Key << "training" << YAML::Value << CrossValidationTrainingName(selection.training);
+  Put(out, "cross_validation", CrossValidationSchemeName(selection.scheme));
+  Put(out, "training", CrossValidationTrainingName(selection.training));
   EmitSelections(out, "pool", selection.pool);
-  out << YAML::Key << "threads" << YAML::Value << selection.threads;
+  Put(out, "threads", selection.threads);
   out << YAML::EndMap;
 }
 
@@ -215,11 +213,10 @@ std::string ConfigToYaml(const IdentifyConfig& config, ConfigKeys keys) {
   if (config.omega_ref_rad_s.has_value()) {
     out << YAML::Key << "effective_nonlinearity_reference_hz" << YAML::Value
         << ConvertedNumber(RadPerSecondToHz(*config.omega_ref_rad_s))
-        << YAML::Comment(ExactNumber(*config.omega_ref_rad_s) + " rad/s");
+        << YAML::Comment(FormatRoundTrip(*config.omega_ref_rad_s) + " rad/s");
   }  // unset: the identified omega (the key's default)
   if (config.model_selection.has_value()) EmitModelSelection(out, *config.model_selection);
-  if (keys == ConfigKeys::kAll)
-    out << YAML::Key << "output_dir" << YAML::Value << config.output_dir;
+  if (keys == ConfigKeys::kAll) Put(out, "output_dir", config.output_dir);
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

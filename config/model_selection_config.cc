@@ -1,5 +1,6 @@
 #include "dwellfit/config/model_selection_config.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "dwellfit/config/strict_yaml.h"
@@ -7,24 +8,20 @@
 
 namespace dwellfit {
 
+namespace {
+
+// The names of the enum values, in the enums' order.
+constexpr const char* kSchemeNames[] = {"none", "leave_one_level_out"};
+constexpr const char* kTrainingNames[] = {"config", "all"};
+
+}  // namespace
+
 const char* CrossValidationSchemeName(CrossValidationScheme scheme) {
-  switch (scheme) {
-    case CrossValidationScheme::kNone:
-      return "none";
-    case CrossValidationScheme::kLeaveOneLevelOut:
-      return "leave_one_level_out";
-  }
-  return "?";
+  return kSchemeNames[static_cast<int>(scheme)];
 }
 
 const char* CrossValidationTrainingName(CrossValidationTraining training) {
-  switch (training) {
-    case CrossValidationTraining::kConfig:
-      return "config";
-    case CrossValidationTraining::kAll:
-      return "all";
-  }
-  return "?";
+  return kTrainingNames[static_cast<int>(training)];
 }
 
 ModelSelectionConfig ModelSelectionConfig::Defaults() {
@@ -112,6 +109,15 @@ std::vector<ParameterChoice> ReadChoices(const ConfigValue& value, const ConfigS
   return choices;
 }
 
+// The enum value `value` names, one of `names` (in the enum's order).
+template <typename Enum, std::size_t N>
+Enum ReadEnum(const ConfigValue& value, const ConfigSource& source, const std::string& what,
+              const char* const (&names)[N]) {
+  const std::vector<std::string> allowed(names, names + N);
+  const std::string name = ReadOneOf(value, source, what, allowed);
+  return static_cast<Enum>(std::find(allowed.begin(), allowed.end(), name) - allowed.begin());
+}
+
 std::vector<SweepSelection> ReadPool(const ConfigValue& value, const ConfigSource& source) {
   std::vector<SweepSelection> pool;
   for (const ConfigValue& entry : ReadList(value, source)) {
@@ -149,20 +155,11 @@ ModelSelectionConfig ReadModelSelectionConfig(const ConfigValue& value, const Co
     config.omega = ReadChoices(*v, source, kNaturalFrequency, initial_guess);
   }
   if (const auto v = block.Optional("cross_validation")) {
-    const std::string name =
-        ReadOneOf(*v, source, "cross-validation scheme",
-                  {CrossValidationSchemeName(CrossValidationScheme::kNone),
-                   CrossValidationSchemeName(CrossValidationScheme::kLeaveOneLevelOut)});
     config.scheme =
-        name == "none" ? CrossValidationScheme::kNone : CrossValidationScheme::kLeaveOneLevelOut;
+        ReadEnum<CrossValidationScheme>(*v, source, "cross-validation scheme", kSchemeNames);
   }
   if (const auto v = block.Optional("training")) {
-    const std::string name =
-        ReadOneOf(*v, source, "training set",
-                  {CrossValidationTrainingName(CrossValidationTraining::kConfig),
-                   CrossValidationTrainingName(CrossValidationTraining::kAll)});
-    config.training =
-        name == "all" ? CrossValidationTraining::kAll : CrossValidationTraining::kConfig;
+    config.training = ReadEnum<CrossValidationTraining>(*v, source, "training set", kTrainingNames);
   }
   if (const auto v = block.Optional("pool")) config.pool = ReadPool(*v, source);
   if (const auto v = block.Optional("threads")) config.threads = ReadInt(*v, source);

@@ -9,13 +9,6 @@
 namespace dwellfit {
 namespace {
 
-const char* DescribeKind(const YAML::Node& node) {
-  if (node.IsSequence()) return "a list";
-  if (node.IsMap()) return "a block of keys";
-  if (node.IsNull()) return "nothing";
-  return "a single value";
-}
-
 // The scalar text of `value`, or an error saying `expected` was wanted.
 const std::string& ScalarText(const ConfigValue& value, const ConfigSource& source,
                               const std::string& expected) {
@@ -43,21 +36,16 @@ std::size_t EditDistance(const std::string& a, const std::string& b) {
   return d[a.size()][b.size()];
 }
 
-// The text without a leading '+', which std::from_chars does not accept.
-std::string WithoutPlus(const std::string& text) {
-  return !text.empty() && text[0] == '+' ? text.substr(1) : text;
-}
-
 // `value` read as a Number by std::from_chars (a leading '+' allowed). The
 // error names `kind` for a value that is not a single one, else `expected`.
 template <typename Number>
 Number ReadNumber(const ConfigValue& value, const ConfigSource& source, const std::string& kind,
                   const std::string& expected) {
   const std::string& text = ScalarText(value, source, kind);
-  const std::string digits = WithoutPlus(text);
+  const char* begin = text.data() + (text.size() > 0 && text[0] == '+');  // from_chars rejects '+'
+  const char* end = text.data() + text.size();
   Number number = 0;
-  const char* end = digits.data() + digits.size();
-  const auto [stop, error] = std::from_chars(digits.data(), end, number);
+  const auto [stop, error] = std::from_chars(begin, end, number);
   if (error != std::errc() || stop != end) {
     throw source.Error(value.path, value.mark,
                        "expected " + expected + ", got '" + EscapeForMessage(text) + "'");
@@ -67,6 +55,13 @@ Number ReadNumber(const ConfigValue& value, const ConfigSource& source, const st
 
 }  // namespace
 
+const char* DescribeKind(const YAML::Node& node) {
+  if (node.IsSequence()) return "a list";
+  if (node.IsMap()) return "a block of keys";
+  if (node.IsNull()) return "nothing";
+  return "a single value";
+}
+
 ConfigValue DocumentValue(const ConfigSource& source) {
   // No position: "missing key" errors at the top level have no line to show.
   return ConfigValue{source.root(), "", YAML::Mark::null_mark()};
@@ -75,7 +70,7 @@ ConfigValue DocumentValue(const ConfigSource& source) {
 StrictMap::StrictMap(const ConfigValue& block, const ConfigSource& source,
                      std::vector<std::string> allowed_keys)
     : block_(block), source_(source), allowed_keys_(std::move(allowed_keys)) {
-  const std::string where = block_.path.empty() ? "at the top level" : "in '" + block_.path + "'";
+  const std::string where = Where();
   if (!block_.node.IsDefined() || block_.node.IsNull()) return;
   if (!block_.node.IsMap()) {
     throw source_.Error(block_.path, block_.mark,
@@ -113,6 +108,10 @@ std::string StrictMap::ChildPath(const std::string& key) const {
   return block_.path.empty() ? key : block_.path + "." + key;
 }
 
+std::string StrictMap::Where() const {
+  return block_.path.empty() ? "at the top level" : "in '" + block_.path + "'";
+}
+
 std::optional<ConfigValue> StrictMap::Optional(const std::string& key) const {
   const auto entry = entries_.find(key);
   if (entry == entries_.end()) return std::nullopt;
@@ -134,10 +133,9 @@ void StrictMap::Read(const std::string& key, bool* value) const {
 ConfigValue StrictMap::Required(const std::string& key, const std::string& hint) const {
   const auto entry = entries_.find(key);
   if (entry != entries_.end()) return entry->second;
-  const std::string where = block_.path.empty() ? "at the top level" : "in '" + block_.path + "'";
   // Located at the block's key: "missing" has no line of its own.
   throw source_.Error(ChildPath(key), block_.mark,
-                      "missing required key '" + key + "' " + where + "; " + hint);
+                      "missing required key '" + key + "' " + Where() + "; " + hint);
 }
 
 double ReadFiniteDouble(const ConfigValue& value, const ConfigSource& source) {

@@ -48,6 +48,7 @@ class StrictMap {
 
  private:
   std::string ChildPath(const std::string& key) const;
+  std::string Where() const;  // "in 'solver'" or "at the top level"
 
   ConfigValue block_;
   const ConfigSource& source_;
@@ -72,6 +73,8 @@ std::string ReadOneOf(const ConfigValue& value, const ConfigSource& source, cons
 // keep the list's path and carry their own position.
 std::vector<ConfigValue> ReadList(const ConfigValue& value, const ConfigSource& source);
 
+// "a list", "a block of keys", "nothing" or "a single value".
+const char* DescribeKind(const YAML::Node& node);
 // "a, b, c".
 std::string JoinNames(const std::vector<std::string>& names);
 // " (did you mean 'max_iterations'?)" when `word` is a likely typo of one of

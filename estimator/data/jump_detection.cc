@@ -101,6 +101,13 @@ double Median(std::vector<double> values) {
   return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + middle));
 }
 
+// The largest amplitude of `points` (0 for none).
+double LargestAmplitude(const std::vector<DwellPoint>& points) {
+  double largest = 0.0;
+  for (const DwellPoint& point : points) largest = std::max(largest, point.amplitude);
+  return largest;
+}
+
 // Labels the points of `sweep` by its single jump (or kOnly without one): a
 // jump down leaves the upper branch for the lower; a jump up the reverse.
 void LabelBranches(Sweep* sweep) {
@@ -121,23 +128,16 @@ std::optional<JumpBracket> JumpIntoMissingData(const JumpDetectionOptions& optio
   if (sweep.points.empty()) return std::nullopt;
   const int last = static_cast<int>(sweep.points.size()) - 1;
   const DwellPoint& before = sweep.points[last];
-  double largest_amplitude = 0.0;
-  for (const DwellPoint& point : sweep.points) {
-    largest_amplitude = std::max(largest_amplitude, point.amplitude);
+  if (before.amplitude < options.min_relative_amplitude * LargestAmplitude(sweep.points)) {
+    return std::nullopt;
   }
-  if (before.amplitude < options.min_relative_amplitude * largest_amplitude) return std::nullopt;
   for (const MissingDwell& row : sweep.missing) {
     // Rows after the last dwell are all missing; the first at another
     // control closes the bracket.
     if (row.points_before <= last || sweep.Control(row) == sweep.Control(before)) continue;
-    JumpBracket jump;
-    jump.kind = JumpKind::kJumpDown;
-    jump.index_before = last;
-    jump.control_before = sweep.Control(before);
-    jump.control_after = sweep.Control(row);
-    jump.amplitude_before = before.amplitude;
-    jump.amplitude_after = 0.0;
-    jump.into_missing_data = true;
+    JumpBracket jump{JumpKind::kJumpDown, last, sweep.Control(before), sweep.Control(row),
+                     before.amplitude};
+    jump.into_missing_data = true;  // amplitude_after stays 0
     return jump;
   }
   return std::nullopt;
@@ -156,12 +156,10 @@ JumpEvidence WeighJumpEvidence(const JumpDetectionOptions& options, const Sweep&
   std::string error;
   CHECK(options.IsValid(&error)) << error;
   const std::vector<DwellPoint>& points = sweep.points;
-  double largest_amplitude = 0.0;
   for (const DwellPoint& point : points) {
     CHECK_GT(point.amplitude, 0.0) << "dwell amplitudes must be positive (loader drops a <= 0)";
-    largest_amplitude = std::max(largest_amplitude, point.amplitude);
   }
-  const double amplitude_floor = options.min_relative_amplitude * largest_amplitude;
+  const double amplitude_floor = options.min_relative_amplitude * LargestAmplitude(points);
 
   // Candidate steps i -> i+1: r = ln(a_{i+1} / a_i), x = ln(c_{i+1} / c_i).
   std::vector<int> candidates;
@@ -224,14 +222,10 @@ void DetectJumps(const JumpDetectionOptions& options, Sweep* sweep) {
   if (evidence.accepted) {
     const DwellPoint& before = sweep->points[evidence.step];
     const DwellPoint& after = sweep->points[evidence.step + 1];
-    JumpBracket jump;
-    jump.kind = after.amplitude > before.amplitude ? JumpKind::kJumpUp : JumpKind::kJumpDown;
-    jump.index_before = evidence.step;
-    jump.control_before = sweep->Control(before);
-    jump.control_after = sweep->Control(after);
-    jump.amplitude_before = before.amplitude;
-    jump.amplitude_after = after.amplitude;
-    sweep->jumps.push_back(jump);
+    const JumpKind kind =
+        after.amplitude > before.amplitude ? JumpKind::kJumpUp : JumpKind::kJumpDown;
+    sweep->jumps.push_back(JumpBracket{kind, evidence.step, sweep->Control(before),
+                                       sweep->Control(after), before.amplitude, after.amplitude});
   } else if (const std::optional<JumpBracket> jump = JumpIntoMissingData(options, *sweep)) {
     sweep->jumps.push_back(*jump);
   }
@@ -301,14 +295,8 @@ void ApplyJumpOverride(const JumpOverride& jump_override, const std::string& con
     }
     fail(what + "; give the controls of the last dwell before the jump and the first after it");
   }
-  JumpBracket jump;
-  jump.kind = jump_override.kind;
-  jump.index_before = index_before;
-  jump.control_before = before;
-  jump.control_after = after;
-  jump.amplitude_before = points[index_before].amplitude;
-  jump.amplitude_after = points[index_before + 1].amplitude;
-  sweep->jumps = {jump};
+  sweep->jumps = {JumpBracket{jump_override.kind, index_before, before, after,
+                              points[index_before].amplitude, points[index_before + 1].amplitude}};
   sweep->jumps_from_config = true;
   LabelBranches(sweep);
 }
@@ -337,12 +325,8 @@ std::string DescribeJumps(const Sweep& sweep) {
   std::string text = sweep.Name() + ": ";
   const std::string from_config = sweep.jumps_from_config ? " [config]" : "";
   if (sweep.jumps.empty()) {
-    double largest_amplitude = 0.0;
-    for (const DwellPoint& point : sweep.points) {
-      largest_amplitude = std::max(largest_amplitude, point.amplitude);
-    }
     return text + "no jump (" + std::to_string(sweep.points.size()) + " dwells, largest a " +
-           ShortScientific(largest_amplitude) + ")" + from_config;
+           ShortScientific(LargestAmplitude(sweep.points)) + ")" + from_config;
   }
   for (size_t j = 0; j < sweep.jumps.size(); ++j) {
     if (j > 0) text += "; ";

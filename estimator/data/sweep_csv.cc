@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/data/sweep_csv_writer.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 
 namespace dwellfit {
@@ -78,13 +79,6 @@ const Range kAmplitudeRange = {
 const Range kSigmaRange = {kMinMagnitude, kMaxMagnitude, "the standard deviation sigma", "sigma^2",
                            "sigma is in the unit of a"};
 
-// The shortest text that reads back as `value`.
-std::string FormatNumber(double value) {
-  char text[32];
-  const auto [end, error] = std::to_chars(text, text + sizeof(text), value);
-  return error == std::errc() ? std::string(text, end) : std::to_string(value);
-}
-
 // Parses the whole of `text` as a finite double, locale-independently.
 double ParseNumber(const Location& where, const char* column, const char* text) {
   const char* begin = text;
@@ -128,8 +122,8 @@ double ParseInRange(const Location& where, const char* column, const char* text,
   if (value < range.min || value > range.max) {
     throw InputError(where.file, where.line, column,
                      std::string(range.meaning) + " " + EscapeForMessage(text) +
-                         " is outside the accepted range [" + FormatNumber(range.min) + ", " +
-                         FormatNumber(range.max) + "], beyond which the model's powers (" +
+                         " is outside the accepted range [" + FormatRoundTrip(range.min) + ", " +
+                         FormatRoundTrip(range.max) + "], beyond which the model's powers (" +
                          range.power + ") and squared residuals overflow or underflow; " +
                          range.advice);
   }
@@ -224,13 +218,6 @@ bool ReadRow(const std::string& path, CsvReader* reader, RowFields* row) {
   }
 }
 
-// Which optional columns the header has.
-struct OptionalColumns {
-  bool phase_deg = false;
-  bool phase_rad = false;
-  bool sigma = false;
-};
-
 // One row's values, parsed and checked one by one.
 struct RowValues {
   int line = 0;
@@ -243,7 +230,7 @@ struct RowValues {
   std::optional<double> sigma;
 };
 
-RowValues ParseRow(const Location& where, const RowFields& row, const OptionalColumns& columns) {
+RowValues ParseRow(const Location& where, const RowFields& row) {
   RowValues values;
   values.line = where.line;
   values.id = row.sweep;
@@ -261,12 +248,13 @@ RowValues ParseRow(const Location& where, const RowFields& row, const OptionalCo
   if (values.amplitude > 0.0) {
     values.amplitude = ParseInRange(where, kAmplitudeColumn, row.a, kAmplitudeRange);
   }
-  if (columns.phase_deg) {
+  if (row.phase_deg != nullptr) {
     values.phase_rad = kRadiansPerDegree * ParseNumber(where, kPhaseDegColumn, row.phase_deg);
-  } else if (columns.phase_rad) {
+  } else if (row.phase_rad != nullptr) {
     values.phase_rad = ParseNumber(where, kPhaseRadColumn, row.phase_rad);
   }
-  if (columns.sigma) values.sigma = ParseInRange(where, kSigmaColumn, row.sigma, kSigmaRange);
+  if (row.sigma != nullptr)
+    values.sigma = ParseInRange(where, kSigmaColumn, row.sigma, kSigmaRange);
   return values;
 }
 
@@ -320,8 +308,9 @@ void CheckOrder(const Location& where, const RowValues& row, const SweepBuilder&
   throw InputError(
       where.file, where.line, column,
       "sweep '" + EscapeForMessage(builder.sweep.Name()) + "' is " + (up ? "an up" : "a down") +
-          "-sweep, but " + column + (up ? " falls" : " rises") + " from " + FormatNumber(before) +
-          " (line " + std::to_string(last.line) + ") to " + FormatNumber(now) +
+          "-sweep, but " + column + (up ? " falls" : " rises") + " from " +
+          FormatRoundTrip(before) + " (line " + std::to_string(last.line) + ") to " +
+          FormatRoundTrip(now) +
           "; rows must be in measurement order, the control rising in an up-sweep and falling in "
           "a down-sweep (repeats allowed). The order places the jumps, so it is not repaired: "
           "restore the measured order (a shuffled, reversed or twice-appended file shows this), "
@@ -456,10 +445,6 @@ LoadedSweeps LoadSweepsCsv(const std::string& path) {
   std::optional<CsvReader> reader;
   OpenCsv(path, &reader);
   const int header_line = ReadHeader(path, &*reader);
-  OptionalColumns columns;
-  columns.phase_deg = reader->has_column(kPhaseDegColumn);
-  columns.phase_rad = reader->has_column(kPhaseRadColumn);
-  columns.sigma = reader->has_column(kSigmaColumn);
 
   std::vector<SweepBuilder> builders;
   std::map<std::pair<std::string, SweepDirection>, size_t> index_of;
@@ -467,7 +452,7 @@ LoadedSweeps LoadSweepsCsv(const std::string& path) {
   RowFields fields;
   while (ReadRow(path, &*reader, &fields)) {
     const Location where{path, static_cast<int>(reader->get_file_line())};
-    const RowValues row = ParseRow(where, fields, columns);
+    const RowValues row = ParseRow(where, fields);
     // Rows come sweep by sweep: most belong to the previous row's sweep.
     const bool same_sweep = current < builders.size() && builders[current].sweep.id == row.id &&
                             builders[current].sweep.direction == row.direction;

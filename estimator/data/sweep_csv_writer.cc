@@ -13,20 +13,11 @@
 
 namespace dwellfit {
 
-namespace {
-
-// The shortest round-trip text of `value` into `buffer`; returns its end.
-char* ToCharsRoundTrip(double value, char (&buffer)[64]) {
-  const std::to_chars_result result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  CHECK(result.ec == std::errc()) << "64 characters hold any double";
-  return result.ptr;
-}
-
-}  // namespace
-
 std::string FormatRoundTrip(double value) {
   char buffer[64];
-  return std::string(buffer, ToCharsRoundTrip(value, buffer));
+  const std::to_chars_result result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  CHECK(result.ec == std::errc()) << "64 characters hold any double";
+  return std::string(buffer, result.ptr);
 }
 
 std::string FormatFrequencyHz(double omega_rad_s) {
@@ -54,13 +45,12 @@ void WriteSweepsCsv(const std::vector<Sweep>& sweeps, std::ostream* out) {
       if (point.phase_rad.has_value()) ++with_phase;
     }
   }
-  if (with_sigma != 0 && with_sigma != points) {
-    throw InputError(std::to_string(with_sigma) + " of " + std::to_string(points) +
-                     " dwells carry a sigma; give every dwell a sigma or none");
-  }
-  if (with_phase != 0 && with_phase != points) {
-    throw InputError(std::to_string(with_phase) + " of " + std::to_string(points) +
-                     " dwells carry a phase; give every dwell a phase or none");
+  for (const auto& [count, what] :
+       {std::pair(with_sigma, "a sigma"), std::pair(with_phase, "a phase")}) {
+    if (count != 0 && count != points) {
+      throw InputError(std::to_string(count) + " of " + std::to_string(points) + " dwells carry " +
+                       what + "; give every dwell " + what + " or none");
+    }
   }
   const bool sigma_column = with_sigma > 0;
   const bool phase_column = with_phase > 0;

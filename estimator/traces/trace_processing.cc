@@ -22,13 +22,25 @@ constexpr double kNoiseSigmas = 5.0;
 // The frequency [Hz] of FFT bin k of n samples at rate fs (negative above n/2).
 double BinFrequencyHz(int k, int n, double fs) { return (2 * k <= n ? k : k - n) * fs / n; }
 
+Spectrum Fft(const std::vector<double>& samples) {
+  Eigen::FFT<double> fft;
+  Spectrum spectrum;
+  fft.fwd(spectrum, samples);
+  return spectrum;
+}
+
+std::vector<double> InverseFft(const Spectrum& spectrum) {
+  Eigen::FFT<double> fft;
+  std::vector<double> samples;
+  fft.inv(samples, spectrum);
+  return samples;
+}
+
 // The spectrum of `samples` with the channel's filter divided out and a
 // sampling delay `delay_s` undone (see the header, step 3).
 Spectrum ChannelSpectrum(const std::vector<double>& samples, double fs, double cutoff_hz,
                          double delay_s) {
-  Eigen::FFT<double> fft;
-  Spectrum spectrum;
-  fft.fwd(spectrum, samples);
+  Spectrum spectrum = Fft(samples);
   const int n = static_cast<int>(samples.size());
   for (int k = 0; k < n; ++k) {
     const double f = BinFrequencyHz(k, n, fs);
@@ -47,13 +59,6 @@ std::vector<Complex> Harmonics(const Spectrum& spectrum, int periods, int count)
   harmonics[0] = spectrum[0] / n;
   for (int h = 1; h <= count; ++h) harmonics[h] = 2.0 / n * spectrum[h * periods];
   return harmonics;
-}
-
-Spectrum Fft(const std::vector<double>& samples) {
-  Eigen::FFT<double> fft;
-  Spectrum spectrum;
-  fft.fwd(spectrum, samples);
-  return spectrum;
 }
 
 // Step 1 of the header: the checks that make a dwell analysable.
@@ -128,9 +133,7 @@ Complex ResponseRatio(const std::vector<double>& u, const std::vector<double>& b
 
 std::vector<double> Displacement(const DwellTrace& dwell, const Spectrum& voltage_spectrum,
                                  const StrainGauge& gauge) {
-  Eigen::FFT<double> fft;
-  std::vector<double> volts;
-  fft.inv(volts, voltage_spectrum);
+  const std::vector<double> volts = InverseFft(voltage_spectrum);
   std::vector<double> u(volts.size());
   for (std::size_t i = 0; i < volts.size(); ++i) {
     if (!gauge.DisplacementFromVoltage(volts[i], &u[i])) {
@@ -178,9 +181,7 @@ DwellResult AnalyzeDwell(const DwellTrace& dwell, const TraceProcessingOptions& 
     const std::size_t n = static_cast<std::size_t>(std::lround(half * per_period));
     // Each half's ratio carries relative noise sqrt(2/n) (u_noise^2 + b_noise^2)^(1/2).
     result.settle_noise = std::sqrt(2.0 * 2.0 / n * (u_noise * u_noise + b_noise * b_noise));
-    std::vector<double> base_corrected;
-    Eigen::FFT<double> fft;
-    fft.inv(base_corrected, base_spectrum);
+    const std::vector<double> base_corrected = InverseFft(base_spectrum);
     const Complex z1 = ResponseRatio(u, base_corrected, 0, n, half);
     const Complex z2 = ResponseRatio(u, base_corrected, u.size() - n, n, half);
     result.settle_change = std::abs(z2 - z1) / std::abs(z2);

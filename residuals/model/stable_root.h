@@ -278,9 +278,7 @@ auto ScalarPart(const J& x) -> decltype(x.a) {
   return x.a;
 }
 
-inline ResponseCoefficients<double> ScalarCoefficients(const ResponseCoefficients<double>& k) {
-  return k;
-}
+// The coefficients' scalar parts (themselves for double).
 template <typename T>
 ResponseCoefficients<double> ScalarCoefficients(const ResponseCoefficients<T>& k) {
   return {ScalarPart(k.k1), ScalarPart(k.k2), ScalarPart(k.k3), ScalarPart(k.k4)};
