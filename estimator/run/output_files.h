@@ -6,10 +6,13 @@
 //   2. The previous run's `manifest.yaml` is removed.
 //   3. Each file is renamed into the output directory (same file system, so
 //      each rename is atomic).
-//   4. `manifest.yaml`, listing every file of the run with its size in bytes,
+//   4. The files the previous manifest listed that this run does not write
+//      (the figures of a run with figures, before one without) are removed.
+//   5. `manifest.yaml`, listing every file of the run with its size in bytes,
 //      is renamed into place last; then the staging folder is removed.
-// So the files a manifest lists are always one run's complete files: a run
-// killed before step 4 leaves no manifest, and one killed before step 2
+// So the files a manifest lists are always one run's complete files, and the
+// directory holds no file of an earlier run beside them: a run killed before
+// step 5 leaves no manifest, and one killed before step 2
 // leaves the previous run's files and manifest untouched. Staging folders
 // (and `*.partial-<pid>` files of earlier versions) left by a killed process
 // are removed by the next run into the same directory.
