@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "dwellfit/config/strict_yaml.h"
+#include "dwellfit/estimator/common/text_file.h"
 #include "yaml-cpp/depthguard.h"
 #include "yaml-cpp/eventhandler.h"
 #include "yaml-cpp/parser.h"
@@ -232,17 +233,7 @@ void CheckNoConflicts(const std::vector<ConfigOverride>& overrides) {
 }  // namespace
 
 ConfigSource ConfigSource::Load(const std::string& path, const std::string& kind) {
-  std::error_code error;
-  if (std::filesystem::is_directory(path, error)) {
-    throw InputError(path, 0, "", "is a directory; give the path of the YAML " + kind);
-  }
-  std::ifstream stream(path);
-  if (!stream) {
-    throw InputError(path, 0, "", "cannot open the " + kind + "; check the path");
-  }
-  std::stringstream text;
-  text << stream.rdbuf();
-  return Parse(path, text.str());
+  return Parse(path, ReadTextFile(path, "give the path of the YAML " + kind));
 }
 
 ConfigSource ConfigSource::Parse(const std::string& file, const std::string& yaml_text) {

@@ -5,21 +5,16 @@
 #include <sstream>
 
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/text_file.h"
 #include "yaml-cpp/yaml.h"
 
 namespace dwellfit {
 
 ParameterVector ReadResultParameters(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
-    throw InputError(path, 0, "",
-                     "cannot open the file; give the result.yaml an identify run wrote");
-  }
-  std::stringstream text;
-  text << in.rdbuf();
+  const std::string text = ReadTextFile(path, "give the result.yaml an identify run wrote");
   YAML::Node document;
   try {
-    document = YAML::Load(text.str());
+    document = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw InputError(path, e.mark.line + 1, "", "not YAML: " + e.msg);
   }

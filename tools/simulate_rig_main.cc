@@ -58,8 +58,13 @@ int main(int argc, char** argv) {
         plan, rig.rig, isatty(STDERR_FILENO) ? dwellfit::RigProgress(DrawProgress) : nullptr);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    dwellfit::WriteTraceSet(run.traces, FLAGS_out);
+    // The trace index is written last: a run stopped before it leaves a set
+    // whose index and samples disagree, which process_traces refuses
+    // (samples_crc32, estimator/traces/trace_file.h).
+    std::error_code error;
+    std::filesystem::create_directories(FLAGS_out, error);
     dwellfit::WriteRigTruthCsv(run, (std::filesystem::path(FLAGS_out) / "truth.csv").string());
+    dwellfit::WriteTraceSet(run.traces, FLAGS_out);
     int unsettled = 0;
     for (const auto& truth : run.dwell_truth) unsettled += truth.settled ? 0 : 1;
     std::cout << dwellfit::StringPrintf(

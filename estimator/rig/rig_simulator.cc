@@ -1,5 +1,7 @@
 #include "dwellfit/estimator/rig/rig_simulator.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -206,6 +208,53 @@ void AddNoise(const RigOptions& options, const StrainGauge& gauge, double a_base
   for (float& y : trace->response) y += static_cast<float>(volt_amplitude * normal(*random));
 }
 
+// Throws InputError unless every dwell's record has enough samples per drive
+// period for the processing's harmonics (kMinSamplesPerPeriod) and all the
+// records fit in kMaxTraceBytes.
+void CheckSampling(const DwellPlan& plan, const RigOptions& options) {
+  constexpr double kMinSamplesPerPeriod = 8.0;  // 3 harmonics and their mirrors
+  constexpr double kMaxTraceBytes = 4.0 * (1u << 30);
+  double max_hz = 0.0;
+  double samples = 0.0;  // both channels, every dwell
+  for (const SweepPlan& sweep : plan.sweeps) {
+    for (SweepDirection direction : sweep.directions) {
+      for (double control : ControlGrid(sweep, direction)) {
+        const double f_hz = sweep.kind == SweepKind::kFrequency ? control : sweep.held_frequency_hz;
+        max_hz = std::max(max_hz, f_hz);
+        samples += 2.0 * options.record_periods * options.sample_rate_hz / f_hz;
+      }
+    }
+  }
+  if (options.sample_rate_hz < kMinSamplesPerPeriod * max_hz) {
+    throw InputError(StringPrintf(
+        "rig: sample_rate_hz %g gives %.3g samples per period at the plan's highest drive "
+        "frequency, %g Hz; give at least %g (sample_rate_hz >= %g)",
+        options.sample_rate_hz, options.sample_rate_hz / max_hz, max_hz, kMinSamplesPerPeriod,
+        kMinSamplesPerPeriod * max_hz));
+  }
+  if (4.0 * samples > kMaxTraceBytes) {
+    throw InputError(StringPrintf(
+        "rig: the records would hold %.3g samples (%.3g GiB as float32), more than 4 GiB; give "
+        "fewer record_periods, a lower sample_rate_hz or fewer dwells",
+        samples, 4.0 * samples / (1u << 30)));
+  }
+}
+
+// Throws InputError when a simulated channel is not finite or is constant:
+// channel settings (gain, filters) that put the signal outside float32's range.
+void CheckRecorded(const DwellTrace& trace) {
+  for (const auto* channel : {&trace.base, &trace.response}) {
+    const auto [low, high] = std::minmax_element(channel->begin(), channel->end());
+    if (!std::isfinite(*low) || !std::isfinite(*high) || *low == *high) {
+      throw InputError(StringPrintf(
+          "rig: dwell %s: the simulated %s channel is %s; check the channel and gauge settings "
+          "(gain, filters) for values that put the signal outside float32's range",
+          trace.Describe().c_str(), channel == &trace.base ? "base" : "response",
+          *low == *high ? "constant" : "not finite"));
+    }
+  }
+}
+
 void CheckPlan(const DwellPlan& plan, const RigOptions& options) {
   std::string error;
   if (!plan.IsValid(&error)) throw InputError("plan: " + error);
@@ -222,6 +271,7 @@ void CheckPlan(const DwellPlan& plan, const RigOptions& options) {
                        "rig starts every sweep from rest (leave `start` out)");
     }
   }
+  CheckSampling(plan, options);
 }
 
 }  // namespace
@@ -236,7 +286,7 @@ bool RigOptions::IsValid(std::string* error) const {
     return fail("sample_rate_hz must be positive and record_periods at least 1");
   }
   if (!(settle_tolerance > 0.0) || settle_window_periods < 1 ||
-      max_settle_periods < 2 * settle_window_periods) {
+      max_settle_periods / 2 < settle_window_periods) {  // 2 W could overflow
     return fail(
         "settle_tolerance must be positive, window_periods >= 1 and max_periods at least "
         "twice window_periods");
@@ -277,6 +327,7 @@ RigRun SimulateRig(const DwellPlan& plan, const RigOptions& options, const RigPr
                          options.sample_rate_hz};
         dwell.Record(&trace);
         AddNoise(options, gauge, a_base, dwell_truth, f_hz, &random, &trace);
+        CheckRecorded(trace);
         DwellPoint point;
         point.drive_frequency_rad_s = HzToRadPerSecond(f_hz);
         point.a_base = a_base;
@@ -307,7 +358,7 @@ void WriteRigTruthCsv(const RigRun& run, const std::string& path) {
            << (truth.settled ? "true" : "false") << ',' << truth.settle_periods << '\n';
     }
   }
-  const std::string staged = path + ".partial";
+  const std::string staged = path + ".partial." + std::to_string(::getpid());
   std::ofstream file(staged, std::ios::binary | std::ios::trunc);
   file << text.str();
   file.close();

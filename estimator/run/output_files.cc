@@ -5,6 +5,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cstring>
@@ -14,6 +15,7 @@
 
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/version.h"
+#include "yaml-cpp/yaml.h"
 
 namespace dwellfit {
 namespace {
@@ -148,9 +150,32 @@ class DirectoryLock {
 };
 
 // Renames the staged files, then the manifest, into `directory`.
+// The files the previous run's manifest in `directory` lists that this run's
+// `files` do not hold (figures of a run with figures, before one without):
+// plain names only, never a path out of the directory. None without a
+// readable manifest.
+std::vector<std::string> PreviousRunsOtherFiles(
+    const fs::path& directory, const std::vector<std::pair<std::string, std::string>>& files) {
+  std::vector<std::string> stale;
+  try {
+    const YAML::Node manifest = YAML::LoadFile((directory / kManifestFileName).string());
+    for (const YAML::Node& entry : manifest["files"]) {
+      const std::string name = entry["name"].as<std::string>();
+      const bool kept = std::any_of(files.begin(), files.end(),
+                                    [&name](const auto& file) { return file.first == name; });
+      if (!kept && fs::path(name) == fs::path(name).filename() && name != ".." && name != ".") {
+        stale.push_back(name);
+      }
+    }
+  } catch (const YAML::Exception&) {
+  }
+  return stale;
+}
+
 void MoveIntoPlace(const fs::path& staging, const fs::path& directory,
                    const std::vector<std::pair<std::string, std::string>>& files) {
   std::error_code error;
+  const std::vector<std::string> stale = PreviousRunsOtherFiles(directory, files);
   fs::remove(directory / kManifestFileName, error);
   if (error)
     ThrowOutputError(directory / kManifestFileName, "cannot replace (" + error.message() + ")");
@@ -162,6 +187,7 @@ void MoveIntoPlace(const fs::path& staging, const fs::path& directory,
     }
   };
   for (const auto& [name, content] : files) move(name, "result");
+  for (const std::string& name : stale) fs::remove(directory / name, error);
   move(kManifestFileName, "manifest");
 }
 

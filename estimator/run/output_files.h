@@ -6,11 +6,14 @@
 //   2. The previous run's `manifest.yaml` is removed.
 //   3. Each file is renamed into the output directory (same file system, so
 //      each rename is atomic).
-//   4. `manifest.yaml`, listing every file of the run with its size in bytes,
+//   4. The files the previous manifest listed that this run does not write
+//      (the figures of a run with figures, before one without) are removed.
+//   5. `manifest.yaml`, listing every file of the run with its size in bytes,
 //      is renamed into place last; then the staging folder is removed.
-// So a manifest always lists one run's complete files. What a killed
-// process leaves (staging folders, `*.partial-<pid>` files) is removed by the
-// next run into the same directory.
+// So a manifest always lists one run's complete files, and the directory
+// holds no file of an earlier run beside them. What a killed process leaves
+// (staging folders, `*.partial-<pid>` files) is removed by the next run into
+// the same directory.
 #ifndef DWELLFIT_ESTIMATOR_RUN_OUTPUT_FILES_H_
 #define DWELLFIT_ESTIMATOR_RUN_OUTPUT_FILES_H_
 

@@ -4,18 +4,22 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <sstream>
 
 #include "boost/algorithm/string/classification.hpp"
 #include "boost/algorithm/string/trim.hpp"
+#include "boost/crc.hpp"
 #include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/analysis/parameter_uncertainty.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/string_printf.h"
+#include "dwellfit/estimator/common/text_file.h"
 #include "dwellfit/estimator/curves/figures.h"
 #include "dwellfit/estimator/data/sweep_csv_writer.h"
 #include "dwellfit/estimator/fit/staged_solve.h"
@@ -183,11 +187,7 @@ void SummarizeCase(const SensitivityStudy& study, int case_index, std::ostringst
 }
 
 std::string ReadText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, 0, "", "cannot open the file; give the folders of the shards");
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
+  return ReadTextFile(path, "give the folders of the shards");
 }
 
 SensitivityStudy ReadStudyYaml(const std::string& path) {
@@ -199,6 +199,7 @@ SensitivityStudy ReadStudyYaml(const std::string& path) {
     study.cases = node["cases"].as<int>();
     study.replicas = node["replicas"].as<int>();
     study.total_fits = node["total_fits"].as<int>();
+    if (node["fingerprint"]) study.fingerprint = node["fingerprint"].as<std::string>();
     study.shard = node["shard"].as<int>();
     study.shards = node["shards"].as<int>();
     if (node["truth"]) {
@@ -241,8 +242,12 @@ std::vector<std::string> SplitCsvLine(const std::string& line) {
 
 double ParseNumber(const std::string& text, const std::string& path, int line) {
   char* end = nullptr;
+  // Decimal notation only: strtod alone would take "0x28", "inf" and "nan".
+  const bool decimal = text.find_first_not_of("0123456789+-.eE") == std::string::npos;
   const double value = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0') throw InputError(path, line, "", "'" + text + "' is no number");
+  if (text.empty() || !decimal || *end != '\0') {
+    throw InputError(path, line, "", "'" + EscapeForMessage(text) + "' is no number");
+  }
   return value;
 }
 
@@ -250,7 +255,7 @@ double ParseNumber(const std::string& text, const std::string& path, int line) {
 int ParseCount(const std::string& text, const std::string& path, int line) {
   const double value = ParseNumber(text, path, line);
   if (!(value >= 0.0 && value <= 2e9) || value != std::floor(value)) {
-    throw InputError(path, line, "", "'" + text + "' is no count");
+    throw InputError(path, line, "", "'" + EscapeForMessage(text) + "' is no count");
   }
   return static_cast<int>(value);
 }
@@ -263,6 +268,7 @@ void ReadFitRows(const std::string& path, const SensitivityStudy& shape,
   const size_t keys = shape.axis_keys.size();
   const size_t columns = 4 + keys + 3 + 2 * kNumParameters;
   for (int number = 2; std::getline(csv, line); ++number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();  // a CRLF file
     const std::vector<std::string> f = SplitCsvLine(line);
     if (f.size() != columns) {
       throw InputError(path, number, "",
@@ -294,7 +300,7 @@ std::string StudyToYaml(const SensitivityStudy& study) {
     yaml << (j > 0 ? ", " : "") << '"' << study.axis_keys[j] << '"';
   yaml << "]\ncases: " << study.cases << "\nreplicas: " << study.replicas
        << "\ntotal_fits: " << study.total_fits << "\nshard: " << study.shard
-       << "\nshards: " << study.shards << "\n";
+       << "\nshards: " << study.shards << "\nfingerprint: \"" << study.fingerprint << "\"\n";
   if (study.truth) {
     yaml << "truth: [";
     for (int i = 0; i < kNumParameters; ++i)
@@ -379,6 +385,39 @@ std::vector<VaryAxis> ParseVaryFlag(const std::string& flag_value, const std::st
   return axes;
 }
 
+namespace {
+
+// StudyFingerprint's text of the plan: truth, sweeps and noise, to the last bit.
+std::string PlanText(const DwellPlan& plan) {
+  std::string text = "plan truth:";
+  for (double value : plan.truth) text += " " + FormatRoundTrip(value);
+  for (const SweepPlan& sweep : plan.sweeps) {
+    text += StringPrintf("\nsweep %s %s %s %s %s %s %s %d", sweep.id.c_str(),
+                         SweepKindName(sweep.kind), FormatRoundTrip(sweep.held_a_base).c_str(),
+                         FormatRoundTrip(sweep.held_frequency_hz).c_str(),
+                         FormatRoundTrip(sweep.from).c_str(), FormatRoundTrip(sweep.to).c_str(),
+                         FormatRoundTrip(sweep.step).c_str(), static_cast<int>(sweep.start_branch));
+    for (SweepDirection direction : sweep.directions) text += SweepDirectionName(direction);
+  }
+  return text + "\nplan noise: " + FormatRoundTrip(plan.noise.relative_sigma);
+}
+
+// SensitivityStudy::fingerprint of a study of `configs` (one per case).
+std::string StudyFingerprint(const SensitivityOptions& options,
+                             const std::vector<IdentifyConfig>& configs) {
+  std::string text = StringPrintf("replicas %d noise %s first_seed %llu standard_errors %d\n",
+                                  options.replicas, FormatRoundTrip(options.noise).c_str(),
+                                  static_cast<unsigned long long>(options.first_seed),
+                                  options.standard_errors ? 1 : 0);
+  for (const IdentifyConfig& config : configs) text += ConfigToYaml(config) + "\n---\n";
+  if (options.plan) text += PlanText(*options.plan);
+  boost::crc_32_type crc;
+  crc.process_bytes(text.data(), text.size());
+  return StringPrintf("%08x", crc.checksum());
+}
+
+}  // namespace
+
 bool SensitivityOptions::IsValid(std::string* why) const {
   auto fail = [why](const std::string& text) {
     *why = text;
@@ -408,9 +447,22 @@ SensitivityStudy RunSensitivityStudy(const SensitivityOptions& options, const Pr
       overrides.push_back({options.vary[j].key, values[j], "--vary"});
     configs.push_back(LoadIdentifyConfig(options.config_path, overrides));
   }
+  // At most kMaxFitsPerRun rows in memory; more is a study to shard.
+  constexpr std::int64_t kMaxFitsPerRun = 1000000;
+  const std::int64_t total = static_cast<std::int64_t>(cases.size()) * options.replicas;
+  if (total > std::numeric_limits<int>::max() || total / options.shards > kMaxFitsPerRun) {
+    throw InputError(
+        "--replicas", 0, "",
+        StringPrintf("%zu cases x %d replicas = %lld fits, %lld in this run; a run "
+                     "holds at most %lld: give fewer, or split the study (--shard k/N)",
+                     cases.size(), options.replicas, static_cast<long long>(total),
+                     static_cast<long long>(total / options.shards),
+                     static_cast<long long>(kMaxFitsPerRun)));
+  }
   study.cases = static_cast<int>(cases.size());
   study.replicas = options.replicas;
-  study.total_fits = study.cases * study.replicas;
+  study.total_fits = static_cast<int>(total);
+  study.fingerprint = StudyFingerprint(options, configs);
   study.shard = options.shard;
   study.shards = options.shards;
   if (options.plan) {
@@ -478,6 +530,13 @@ SensitivityStudy MergeShards(const std::vector<std::string>& folders) {
       throw InputError(folder + "/study.yaml", 0, "",
                        "not a shard of the same study as " + folders[0]);
     }
+    if (shard.fingerprint != merged.fingerprint) {
+      throw InputError(folder + "/study.yaml", 0, "fingerprint",
+                       "'" + shard.fingerprint + "' differs from " + folders[0] + "'s '" +
+                           merged.fingerprint +
+                           "': the shards were run with other settings (config, --set, --vary, "
+                           "plan, --noise, --first_seed or --replicas); merge shards of one study");
+    }
     if (seen[shard.shard]) {
       throw InputError(folder + "/study.yaml", 0, "shard",
                        StringPrintf("shard %d is given twice", shard.shard));
@@ -493,6 +552,11 @@ SensitivityStudy MergeShards(const std::vector<std::string>& folders) {
   std::sort(merged.rows.begin(), merged.rows.end(),
             [](const FitRow& x, const FitRow& y) { return x.fit < y.fit; });
   for (size_t i = 0; i < merged.rows.size(); ++i) {
+    if (i > 0 && merged.rows[i].fit == merged.rows[i - 1].fit) {
+      throw InputError(
+          "--merge", 0, "",
+          StringPrintf("fit %d is given twice in the shards' fits.csv", merged.rows[i].fit));
+    }
     if (merged.rows[i].fit != static_cast<int>(i)) {
       throw InputError("--merge", 0, "",
                        StringPrintf("fit %zu is missing from the shards' fits.csv", i));

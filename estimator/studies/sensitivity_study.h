@@ -70,7 +70,11 @@ struct SensitivityStudy {
   int total_fits = 0;  // of the whole study (all shards)
   int shard = 0, shards = 1;
   std::optional<ParameterVector> truth;  // the plan's (omega in Hz)
-  std::vector<FitRow> rows;              // this shard's, by fit index
+  // CRC-32 (8 hex digits) of everything that decides the fits: each case's
+  // config in effect, the plan, the noise, the seeds, the replicas and the
+  // standard-error switch. Shards merge only with their own study's.
+  std::string fingerprint;
+  std::vector<FitRow> rows;  // this shard's, by fit index
   double seconds = 0.0;
 };
 

@@ -1,13 +1,16 @@
 #include "dwellfit/estimator/traces/trace_file.h"
 
 #include <libfccp/csv.h>
+#include <unistd.h>
 
+#include <boost/crc.hpp>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "dwellfit/estimator/common/input_error.h"
@@ -20,10 +23,38 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr int kIndexColumns = 7;
+constexpr int kIndexColumns = 8;
 using IndexReader =
     io::CSVReader<kIndexColumns, io::trim_chars<' ', '\t'>, io::no_quote_escape<','>,
                   io::throw_on_overflow, io::empty_line_comment>;
+
+// A dwell's index row: the trace without its samples, their counts, and the
+// CRC-32 of its samples' bytes (none in a set written before the column).
+struct IndexRow {
+  DwellTrace trace;
+  std::uint64_t base_samples = 0;
+  std::uint64_t response_samples = 0;
+  std::optional<std::uint32_t> crc32;
+};
+
+// The CRC-32 (boost::crc_32_type) of `size` bytes.
+std::uint32_t Crc32(const void* bytes, std::size_t size) {
+  boost::crc_32_type crc;
+  crc.process_bytes(bytes, size);
+  return crc.checksum();
+}
+
+// Throws InputError unless `path` is a regular file (not a folder, a device
+// such as /dev/zero, or a pipe that would block the read).
+void RequireRegularFile(const std::string& path) {
+  std::error_code error;
+  if (!fs::is_regular_file(path, error)) {
+    throw InputError(path, 0, "",
+                     fs::exists(path, error)
+                         ? "is not a regular file (a folder, device or pipe); give the file itself"
+                         : "cannot open the file; check the path");
+  }
+}
 
 // A little-endian float32 from/to 4 bytes, whatever the host's byte order.
 void PutFloat(float value, std::string* out) {
@@ -43,7 +74,8 @@ float GetFloat(const unsigned char* bytes) {
 
 // Writes `text` to `path` through a temporary file renamed into place.
 void WriteAtomically(const std::string& text, const fs::path& path) {
-  const fs::path staged = path.string() + ".partial";
+  // The process id keeps two runs into one folder from sharing a staged file.
+  const fs::path staged = path.string() + ".partial." + std::to_string(::getpid());
   {
     std::ofstream file(staged, std::ios::binary | std::ios::trunc);
     if (!file) {
@@ -79,9 +111,10 @@ long ParseCount(const std::string& file, int line, const char* field, const char
   return value;
 }
 
-// One index row into `trace` (samples not yet read).
-DwellTrace ReadIndexRow(const std::string& file, int line, char* const* fields) {
-  DwellTrace trace;
+// One index row (samples not yet read).
+IndexRow ReadIndexRow(const std::string& file, int line, char* const* fields) {
+  IndexRow row;
+  DwellTrace& trace = row.trace;
   trace.source_line = line;
   trace.sweep = fields[0];
   if (trace.sweep.empty()) throw InputError(file, line, "sweep", "give the sweep id");
@@ -100,21 +133,37 @@ DwellTrace ReadIndexRow(const std::string& file, int line, char* const* fields) 
   }
   trace.drive_frequency_rad_s = HzToRadPerSecond(ParsePositive(file, line, "freq_hz", fields[3]));
   trace.sample_rate_hz = ParsePositive(file, line, "sample_rate_hz", fields[4]);
-  trace.base.resize(ParseCount(file, line, "base_samples", fields[5]));
-  trace.response.resize(ParseCount(file, line, "response_samples", fields[6]));
-  return trace;
+  row.base_samples = ParseCount(file, line, "base_samples", fields[5]);
+  row.response_samples = ParseCount(file, line, "response_samples", fields[6]);
+  if (fields[7] != nullptr) {
+    char* end = nullptr;
+    const unsigned long long crc = std::strtoull(fields[7], &end, 16);
+    if (end == fields[7] || *end != '\0' || crc > 0xFFFFFFFFull) {
+      throw InputError(file, line, "samples_crc32",
+                       "expected 8 hexadecimal digits, got '" + EscapeForMessage(fields[7]) + "'");
+    }
+    row.crc32 = static_cast<std::uint32_t>(crc);
+  }
+  return row;
 }
 
-std::vector<DwellTrace> ReadIndex(const std::string& path) {
-  std::vector<DwellTrace> dwells;
+std::vector<IndexRow> ReadIndex(const std::string& path) {
+  RequireRegularFile(path);
+  std::vector<IndexRow> dwells;
   try {
     IndexReader reader(path);
-    reader.read_header(io::ignore_no_column, "sweep", "direction", "kind", "freq_hz",
-                       "sample_rate_hz", "base_samples", "response_samples");
+    reader.read_header(io::ignore_missing_column, "sweep", "direction", "kind", "freq_hz",
+                       "sample_rate_hz", "base_samples", "response_samples", "samples_crc32");
     char* fields[kIndexColumns] = {};
     while (reader.read_row(fields[0], fields[1], fields[2], fields[3], fields[4], fields[5],
-                           fields[6])) {
-      // read_header has checked that every column is there: no field is null.
+                           fields[6], fields[7])) {
+      for (int i = 0; i + 1 < kIndexColumns; ++i) {
+        if (fields[i] == nullptr) {
+          throw InputError(path, static_cast<int>(reader.get_file_line()), "",
+                           "the header lacks a column; expected sweep, direction, kind, freq_hz, "
+                           "sample_rate_hz, base_samples, response_samples");
+        }
+      }
       dwells.push_back(ReadIndexRow(path, static_cast<int>(reader.get_file_line()), fields));
     }
   } catch (const io::error::base& e) {
@@ -138,7 +187,8 @@ void WriteTraceSet(const std::vector<DwellTrace>& dwells, const std::string& fol
   fs::create_directories(folder, error);
   if (error) throw InputError(folder, 0, "", "cannot create the folder: " + error.message());
   std::ostringstream index;
-  index << "sweep,direction,kind,freq_hz,sample_rate_hz,base_samples,response_samples\n";
+  index << "sweep,direction,kind,freq_hz,sample_rate_hz,base_samples,response_samples,"
+           "samples_crc32\n";
   std::string samples;
   for (const DwellTrace& dwell : dwells) {
     if (dwell.sweep.empty() || dwell.sweep.find_first_of(",\"\r\n") != std::string::npos) {
@@ -148,9 +198,11 @@ void WriteTraceSet(const std::vector<DwellTrace>& dwells, const std::string& fol
     index << dwell.sweep << ',' << SweepDirectionName(dwell.direction) << ','
           << SweepKindName(dwell.kind) << ',' << FormatFrequencyHz(dwell.drive_frequency_rad_s)
           << ',' << FormatRoundTrip(dwell.sample_rate_hz) << ',' << dwell.base.size() << ','
-          << dwell.response.size() << '\n';
+          << dwell.response.size() << ',';
+    const std::size_t first = samples.size();
     for (float value : dwell.base) PutFloat(value, &samples);
     for (float value : dwell.response) PutFloat(value, &samples);
+    index << StringPrintf("%08x", Crc32(samples.data() + first, samples.size() - first)) << '\n';
   }
   WriteAtomically(samples, fs::path(folder) / kTraceSamplesFile);
   WriteAtomically(index.str(), fs::path(folder) / kTraceIndexFile);
@@ -159,23 +211,41 @@ void WriteTraceSet(const std::vector<DwellTrace>& dwells, const std::string& fol
 std::vector<DwellTrace> ReadTraceSet(const std::string& folder) {
   const std::string index_path = (fs::path(folder) / kTraceIndexFile).string();
   const std::string samples_path = (fs::path(folder) / kTraceSamplesFile).string();
-  std::vector<DwellTrace> dwells = ReadIndex(index_path);
-  std::ifstream file(samples_path, std::ios::binary);
-  if (!file) throw InputError(samples_path, 0, "", "cannot open the samples file");
-  const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  std::size_t expected = 0;
-  for (const DwellTrace& dwell : dwells)
-    expected += 4 * (dwell.base.size() + dwell.response.size());
-  if (bytes.size() != expected) {
+  std::vector<IndexRow> rows = ReadIndex(index_path);
+  // The sizes are checked before anything is allocated for the samples.
+  std::uint64_t expected = 0;
+  for (const IndexRow& row : rows) expected += 4 * (row.base_samples + row.response_samples);
+  RequireRegularFile(samples_path);
+  std::error_code error;
+  const std::uintmax_t size = fs::file_size(samples_path, error);
+  if (error || size != expected) {
     throw InputError(samples_path, 0, "",
-                     StringPrintf("holds %zu bytes, but %s announces %zu (4 per sample); the two "
+                     StringPrintf("holds %ju bytes, but %s announces %ju (4 per sample); the two "
                                   "files do not belong together or one was cut short",
-                                  bytes.size(), kTraceIndexFile, expected));
+                                  static_cast<std::uintmax_t>(size), kTraceIndexFile,
+                                  static_cast<std::uintmax_t>(expected)));
   }
-  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
-  for (DwellTrace& dwell : dwells) {
-    for (float& value : dwell.base) value = GetFloat(data), data += 4;
-    for (float& value : dwell.response) value = GetFloat(data), data += 4;
+  std::ifstream file(samples_path, std::ios::binary);
+  std::vector<DwellTrace> dwells;
+  std::vector<unsigned char> bytes;
+  for (IndexRow& row : rows) {
+    bytes.resize(4 * (row.base_samples + row.response_samples));
+    if (!file.read(reinterpret_cast<char*>(bytes.data()),
+                   static_cast<std::streamsize>(bytes.size()))) {
+      throw InputError(samples_path, 0, "", "cannot read the samples file");
+    }
+    if (row.crc32 && Crc32(bytes.data(), bytes.size()) != *row.crc32) {
+      throw InputError(index_path, row.trace.source_line, "samples_crc32",
+                       row.trace.Describe() + ": the samples in " + kTraceSamplesFile +
+                           " are not the ones this row was written with; the two files come "
+                           "from different runs, or one is damaged");
+    }
+    const unsigned char* sample = bytes.data();
+    for (std::vector<float>* channel : {&row.trace.base, &row.trace.response}) {
+      channel->resize(channel == &row.trace.base ? row.base_samples : row.response_samples);
+      for (float& value : *channel) value = GetFloat(sample), sample += 4;
+    }
+    dwells.push_back(std::move(row.trace));
   }
   return dwells;
 }

@@ -14,13 +14,17 @@
 //       freq_hz           drive frequency [Hz] (the analyzer's source setting)
 //       sample_rate_hz    samples per second of each channel
 //       base_samples, response_samples  the number of samples of each channel
+//       samples_crc32     CRC-32 of the dwell's samples in traces.f32, 8 hex
+//                         digits (optional: sets written before it lack it)
 //   traces.f32  the samples as little-endian IEEE-754 float32, dwell after
 //               dwell in the order of traces.csv, each dwell's base channel
 //               then its response channel (no header, no padding).
 //
 // float32 keeps 7 significant digits, far below any rig's noise, at half the
-// size of double. The reader checks that the binary file holds exactly the
-// samples the index announces.
+// size of double. The reader checks, before it allocates, that both are
+// regular files and that the binary file holds exactly the samples the index
+// announces; then that each dwell's samples match its CRC (so an index and a
+// samples file of two different runs are refused).
 #ifndef DWELLFIT_ESTIMATOR_TRACES_TRACE_FILE_H_
 #define DWELLFIT_ESTIMATOR_TRACES_TRACE_FILE_H_
 

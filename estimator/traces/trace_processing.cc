@@ -73,11 +73,20 @@ void CheckTraces(const DwellTrace& dwell, int harmonics) {
                                           dwell.base.size(), dwell.response.size()));
   }
   for (const auto* channel : {&dwell.base, &dwell.response}) {
+    const char* name = channel == &dwell.base ? "base" : "response";
     for (std::size_t i = 0; i < channel->size(); ++i) {
       if (std::isfinite((*channel)[i])) continue;
       throw InputError(where + StringPrintf("%s sample %zu is not a finite number (NaN or "
                                             "infinite); re-record the dwell",
-                                            channel == &dwell.base ? "base" : "response", i));
+                                            name, i));
+    }
+    // A constant channel (all zero: a cable off, a gain of 0) has no first
+    // harmonic: it would give a = 0 or a_base = 0, not a measurement.
+    const auto [low, high] = std::minmax_element(channel->begin(), channel->end());
+    if (*low == *high) {
+      throw InputError(where + StringPrintf("the %s channel is constant (every sample %g); "
+                                            "check the channel's cabling and gain",
+                                            name, *low));
     }
   }
   const double per_period = dwell.sample_rate_hz / RadPerSecondToHz(dwell.drive_frequency_rad_s);

@@ -530,7 +530,7 @@ TEST(IdentifyConfigErrors, MissingConfigFile) {
   const std::string path = (dir.path() / "absent.yaml").string();
   const InputError error = LoadError(path);
   EXPECT_EQ(error.file(), path);
-  EXPECT_THAT(error.what(), HasSubstr("cannot open the config file"));
+  EXPECT_THAT(error.what(), HasSubstr("no such file; give the path of the YAML config file"));
 }
 
 // Hostile configs (the config rows of the Hardening issue's table).

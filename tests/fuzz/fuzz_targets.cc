@@ -10,6 +10,10 @@ const std::vector<FuzzTarget>& AllFuzzTargets() {
       {"identify_config", &IdentifyConfigBody, ".yaml"},
       {"set_flag", &SetFlagBody, ""},
       {"dwell_plan", &DwellPlanBody, ".yaml"},
+      {"trace_set", &TraceSetBody, ""},
+      {"rig_config", &RigConfigBody, ".yaml"},
+      {"result_parameters", &ResultParametersBody, ""},
+      {"shard_merge", &ShardMergeBody, ""},
   };
   return targets;
 }

@@ -33,6 +33,20 @@ void SetFlagBody(const std::uint8_t* data, std::size_t size);
 // its control grid.
 void DwellPlanBody(const std::uint8_t* data, std::size_t size);
 
+// The input as a trace set: the index (traces.csv) before the first NUL
+// byte, the samples (traces.f32) after it; an accepted set is processed, and
+// every dwell must give a positive, finite amplitude and level and a lag.
+void TraceSetBody(const std::uint8_t* data, std::size_t size);
+// The input as a rig file (ParseRigConfig); accepted options must be valid.
+void RigConfigBody(const std::uint8_t* data, std::size_t size);
+// The input as an identify result.yaml (ReadResultParameters, as `curves
+// --result` reads it); accepted parameters must be finite.
+void ResultParametersBody(const std::uint8_t* data, std::size_t size);
+// The input as one sensitivity shard folder: study.yaml before the first NUL
+// byte, fits.csv after it (MergeShards); a merged study holds each of its
+// fits once, in order.
+void ShardMergeBody(const std::uint8_t* data, std::size_t size);
+
 struct FuzzTarget {
   std::string name;  // tests/fuzz/corpus/<name>, tests/fuzz/regressions/<name>
   FuzzBody body;

@@ -5,7 +5,8 @@
 #   tests/fuzz/run_fuzzers.sh SECONDS [TARGET...]
 #
 # SECONDS per target; 0 only replays the seeds and regression inputs once.
-# TARGETs: sweep_csv identify_config set_flag dwell_plan (default: all).
+# TARGETs: sweep_csv identify_config set_flag dwell_plan trace_set rig_config
+# result_parameters shard_merge (default: all).
 # The fuzzers are taken from $FUZZ_BUILD_DIR (default build-fuzz), a build
 # configured with -DDWELLFIT_BUILD_FUZZERS=ON and built with --target fuzzers.
 # Inputs: tests/fuzz/corpus/<target> and tests/fuzz/regressions/<target>
@@ -24,14 +25,15 @@ fi
 seconds=$1
 shift
 targets=("$@")
-((${#targets[@]} > 0)) || targets=(sweep_csv identify_config set_flag dwell_plan)
+((${#targets[@]} > 0)) || targets=(sweep_csv identify_config set_flag dwell_plan trace_set
+  rig_config result_parameters shard_merge)
 build_dir=${FUZZ_BUILD_DIR:-build-fuzz}
 
 # Files under datasets/ that seed each target.
 dataset_seeds() {
   case "$1" in
     sweep_csv) ls datasets/*/*.csv ;;
-    identify_config | dwell_plan) ls datasets/*/*.yaml ;;
+    identify_config | dwell_plan | rig_config) ls datasets/*/*.yaml ;;
   esac
 }
 
@@ -74,7 +76,7 @@ run_target() {
   done
   local inputs=("${work}" "tests/fuzz/corpus/${name}" "tests/fuzz/regressions/${name}" "${seeds}")
   local dict=tests/fuzz/dict/yaml.dict
-  [[ "${name}" != sweep_csv ]] || dict=tests/fuzz/dict/csv.dict
+  [[ "${name}" != sweep_csv && "${name}" != trace_set ]] || dict=tests/fuzz/dict/csv.dict
   local options=(-timeout=10 -rss_limit_mb=2048 -max_len=8192 -print_final_stats=1
     -dict="${dict}" -artifact_prefix="${findings}/")
   local asan_options status

@@ -190,6 +190,44 @@ TEST(RigSimulator, APlanWithItsOwnNoiseOrAnUpperStartIsRefused) {
   }
 }
 
+// Rig settings that cannot give a usable record are refused before the
+// simulation allocates or integrates anything: too few samples per period,
+// records larger than memory, a settling window whose double overflows an int,
+// and channel settings that push the samples out of float32's range.
+TEST(RigSimulator, SettingsThatGiveNoUsableRecordAreRefused) {
+  DwellPlan plan;
+  plan.truth = kTruth;
+  plan.sweeps = {FrequencySweep("F0.01", 0.01, 40.0, 40.2, 0.1, {SweepDirection::kUp})};
+  const auto refusal = [&plan](const RigOptions& rig) {
+    try {
+      SimulateRig(plan, rig);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  RigOptions rig = ShortRig();
+  rig.sample_rate_hz = 1.0;
+  EXPECT_THAT(refusal(rig), HasSubstr("sample_rate_hz 1 gives 0.0249 samples per period at the "
+                                      "plan's highest drive frequency, 40.2 Hz; give at least 8"));
+  rig = ShortRig();
+  rig.record_periods = 100000000;  // 2 x 1e8 x 25 samples per dwell
+  EXPECT_THAT(refusal(rig), HasSubstr("more than 4 GiB"));
+  rig = ShortRig();
+  rig.sample_rate_hz = 1e12;
+  EXPECT_THAT(refusal(rig), HasSubstr("more than 4 GiB"));
+  rig = ShortRig();
+  rig.settle_window_periods = 1500000000;
+  std::string why;
+  EXPECT_FALSE(rig.IsValid(&why));
+  EXPECT_THAT(why, HasSubstr("max_periods at least twice window_periods"));
+  rig = ShortRig();
+  rig.gauge.gain = 1e300;
+  EXPECT_THAT(refusal(rig), HasSubstr("the simulated response channel is not finite"));
+  rig.gauge.gain = 1e-300;
+  EXPECT_THAT(refusal(rig), HasSubstr("the simulated response channel is constant"));
+}
+
 // Harmonic balance (eqs. 3.12-3.13) on traces of ten dwells with 0.1 % noise
 // recovers eta_e, w and the effective nonlinearity within 1 % (with 0.5 %,
 // ten dwells are too few for the nonlinearity: datasets/virtual-beam has 456).

@@ -82,6 +82,22 @@ TEST(WriteFilesAtomically, RemovesWhatAKilledRunLeftAndKeepsALiveRunsStaging) {
   EXPECT_EQ(ReadFile(dir / "result.yaml"), "a: 2\n");
 }
 
+// A run that writes fewer files (no figures) removes the previous run's
+// others, and only those: the user's own files and paths out of the
+// directory a manifest might name stay.
+TEST(WriteFilesAtomically, RemovesThePreviousRunsFilesItDoesNotWriteAgain) {
+  const fs::path dir = FreshDir("fewer");
+  std::ofstream(dir.parent_path() / "outside.txt") << "not the run's";
+  WriteFilesAtomically(dir.string(), {{"result.yaml", "first\n"}, {"figure_fit_F1.png", "png"}});
+  std::ofstream(dir / "notes.txt") << "the user's own file";
+  std::ofstream(dir / kManifestFileName, std::ios::app)
+      << "  - {name: ../outside.txt, bytes: 13}\n";
+  WriteFilesAtomically(dir.string(), {{"result.yaml", "second\n"}});
+  EXPECT_EQ(Entries(dir), (std::vector<std::string>{".dwellfit-lock", "manifest.yaml", "notes.txt",
+                                                    "result.yaml"}));
+  EXPECT_TRUE(fs::exists(dir.parent_path() / "outside.txt"));
+}
+
 TEST(WriteFilesAtomically, AFailedWriteKeepsThePreviousRunWhole) {
   const fs::path dir = FreshDir("failed");
   WriteFilesAtomically(dir.string(), {{"result.yaml", "first\n"}});

@@ -530,14 +530,14 @@ TEST(DwellPlanReader, AFileThatCannotBeReadIsNamedAsThePlanFile) {
     ReadDwellPlan(missing);
     ADD_FAILURE() << "no error for " << missing;
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()), missing + ": cannot open the plan file; check the path");
+    EXPECT_EQ(std::string(e.what()), missing + ": no such file; give the path of the YAML plan file");
   }
   try {
     ReadDwellPlan(::testing::TempDir());
     ADD_FAILURE() << "no error for a directory";
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(),
-                ::testing::EndsWith("is a directory; give the path of the YAML plan file"));
+                ::testing::EndsWith("is a folder; give the path of the YAML plan file"));
   }
 }
 

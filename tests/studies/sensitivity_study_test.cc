@@ -1,8 +1,13 @@
 #include "dwellfit/estimator/studies/sensitivity_study.h"
 
 #include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "dwellfit/config/dwell_plan_reader.h"
 #include "dwellfit/estimator/common/input_error.h"
@@ -71,6 +76,79 @@ TEST(SensitivityStudy, FourMergedShardsEqualOneRun) {
   EXPECT_EQ(SummaryToYaml(merged), SummaryToYaml(whole));
   folders.pop_back();
   EXPECT_THROW(MergeShards(folders), InputError);  // a shard missing
+}
+
+// Shards of two studies that differ in one setting do not merge; neither do
+// shards with a fit given twice. A CRLF fits.csv merges like its LF original.
+TEST(SensitivityStudy, ShardsOfAnotherStudyOrWithAFitTwiceAreRefused) {
+  const auto write_shard = [](SensitivityOptions options, int k, const std::string& name) {
+    options.shard = k;
+    options.shards = 2;
+    const fs::path folder = fs::path(::testing::TempDir()) / name;
+    fs::remove_all(folder);
+    std::ostringstream warnings;
+    WriteFilesAtomically(folder.string(),
+                         StudyFiles(RunSensitivityStudy(options), false, warnings));
+    return folder.string();
+  };
+  const auto refusal = [](const std::vector<std::string>& folders) {
+    try {
+      MergeShards(folders);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const SensitivityOptions base = NoiseStudy(2);
+  const std::string first = write_shard(base, 0, "fingerprint_shard0");
+  for (const auto& [name, change] :
+       std::vector<std::pair<std::string, std::function<void(SensitivityOptions*)>>>{
+           {"noise", [](SensitivityOptions* o) { o->noise = 0.02; }},
+           {"seed", [](SensitivityOptions* o) { o->first_seed = 12; }},
+           {"set",
+            [](SensitivityOptions* o) {
+              o->overrides = {{"solver.max_iterations", "77", "--set"}};
+            }},
+           {"plan", [](SensitivityOptions* o) { o->plan->truth[kMu1] *= 1.01; }}}) {
+    SensitivityOptions other = base;
+    change(&other);
+    EXPECT_THAT(refusal({first, write_shard(other, 1, "fingerprint_" + name)}),
+                ::testing::HasSubstr("the shards were run with other settings"))
+        << name;
+  }
+  const std::string second = write_shard(base, 1, "fingerprint_shard1");
+  EXPECT_EQ(MergeShards({first, second}).rows.size(), 2u);
+  // The second shard's fits.csv with a CRLF line end merges the same.
+  std::string text;
+  {
+    std::ifstream in(fs::path(second) / "fits.csv");
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  std::string crlf;
+  for (char c : text) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  std::ofstream(fs::path(second) / "fits.csv", std::ios::binary | std::ios::trunc) << crlf;
+  EXPECT_EQ(FitsToCsv(MergeShards({first, second})), FitsToCsv(RunSensitivityStudy(base)));
+  // The first shard's fit row again in the second's file.
+  const std::string first_rows = [&] {
+    std::ifstream in(fs::path(first) / "fits.csv");
+    std::string header, row;
+    std::getline(in, header);
+    std::getline(in, row);
+    return row;
+  }();
+  std::ofstream(fs::path(second) / "fits.csv", std::ios::app) << first_rows << "\n";
+  EXPECT_THAT(refusal({first, second}), ::testing::HasSubstr("fit 0 is given twice"));
+}
+
+TEST(SensitivityStudy, AStudyTooLargeForOneRunIsRefusedBeforeItStarts) {
+  SensitivityOptions options = NoiseStudy(2147483647);
+  options.vary = ParseVaryFlag("residual.error=relative|absolute", "--vary");
+  try {
+    RunSensitivityStudy(options);
+    ADD_FAILURE() << "2 x (2^31 - 1) fits were accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("2 cases x 2147483647 replicas = 4294967294 fits"));
+  }
 }
 
 // A profile: delta fixed on a grid; the cost is lowest at the truth.

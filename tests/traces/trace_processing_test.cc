@@ -1,6 +1,7 @@
 // Dwell points from time traces: amplitudes, the lag, and bad traces.
 #include "dwellfit/estimator/traces/trace_processing.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -99,6 +100,12 @@ TEST(TraceProcessing, BadTracesAreClearErrors) {
   DwellTrace empty = good;
   empty.base.clear();
   EXPECT_THAT(message(empty), HasSubstr("a channel has no samples"));
+  DwellTrace silent = good;
+  std::fill(silent.response.begin(), silent.response.end(), 0.0f);
+  EXPECT_THAT(message(silent), HasSubstr("the response channel is constant (every sample 0)"));
+  DwellTrace no_base = good;
+  std::fill(no_base.base.begin(), no_base.base.end(), 0.0f);
+  EXPECT_THAT(message(no_base), HasSubstr("the base channel is constant (every sample 0)"));
   DwellTrace slow = good;
   slow.sample_rate_hz = 200.0;  // 5 samples per period cannot hold 3 harmonics
   EXPECT_THAT(message(slow), HasSubstr("cannot resolve 3 harmonics"));
@@ -131,6 +138,75 @@ TEST(TraceFile, WrittenTracesReadBackAndAShortSamplesFileIsAnError) {
     EXPECT_THAT(e.what(), HasSubstr("holds 100 bytes, but traces.csv announces 3648"));
   }
   std::filesystem::remove_all(folder);
+}
+
+// The failures a real test bench produces: an index and a samples file of two
+// different runs (a run killed between its two writes), an index that
+// announces more samples than memory holds, and a samples "file" that is a
+// folder or a device.
+class TraceSetOnDisk : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::filesystem::remove_all(folder_);
+    const StrainGauge gauge(TraceProcessingOptions().gauge);
+    dwell_ = SteadyDwell(gauge, 40.0, 2048.0, 256, 0.01, 1e-3, 0.5);
+    WriteTraceSet({dwell_}, folder_.string());
+  }
+  void TearDown() override { std::filesystem::remove_all(folder_); }
+  std::string Refusal() {
+    try {
+      ReadTraceSet(folder_.string());
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "no error";
+  }
+  void WriteIndex(const std::string& text) {
+    std::ofstream(folder_ / kTraceIndexFile, std::ios::trunc) << text;
+  }
+
+  // One folder per test: ctest runs the tests of this fixture side by side.
+  const std::filesystem::path folder_ =
+      std::filesystem::temp_directory_path() /
+      (std::string("dwellfit_trace_set_") +
+       ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  DwellTrace dwell_;
+};
+
+TEST_F(TraceSetOnDisk, SamplesOfAnotherRunAreRefused) {
+  const std::filesystem::path other = folder_ / "other";
+  DwellTrace louder = dwell_;  // the same sizes, other samples
+  for (float& value : louder.response) value *= 2.0f;
+  WriteTraceSet({louder}, other.string());
+  std::filesystem::copy_file(other / kTraceSamplesFile, folder_ / kTraceSamplesFile,
+                             std::filesystem::copy_options::overwrite_existing);
+  EXPECT_THAT(Refusal(), HasSubstr("traces.csv:2: field 'samples_crc32': F0.01/up @ 40 Hz "
+                                   "(traces.csv:2): the samples in traces.f32 are not the ones"));
+}
+
+TEST_F(TraceSetOnDisk, AnIndexWithoutChecksumsStillReads) {
+  WriteIndex(
+      "sweep,direction,kind,freq_hz,sample_rate_hz,base_samples,response_samples\n"
+      "F0.01,up,frequency,40,2048,256,256\n");
+  const std::vector<DwellTrace> back = ReadTraceSet(folder_.string());
+  ASSERT_EQ(back.size(), 1u);
+  EXPECT_EQ(back[0].response, dwell_.response);
+}
+
+TEST_F(TraceSetOnDisk, HugeAnnouncedCountsAreRefusedBeforeAllocating) {
+  std::string index = "sweep,direction,kind,freq_hz,sample_rate_hz,base_samples,response_samples\n";
+  for (int row = 0; row < 64; ++row) index += "F0.01,up,frequency,40,2048,1073741824,1073741824\n";
+  WriteIndex(index);  // 512 GiB of samples announced
+  EXPECT_THAT(Refusal(), HasSubstr("holds 2048 bytes, but traces.csv announces 549755813888"));
+}
+
+TEST_F(TraceSetOnDisk, ASamplesFileThatIsNoRegularFileIsRefused) {
+  std::filesystem::remove(folder_ / kTraceSamplesFile);
+  std::filesystem::create_directory(folder_ / kTraceSamplesFile);
+  EXPECT_THAT(Refusal(), HasSubstr("traces.f32: is not a regular file"));
+  std::filesystem::remove(folder_ / kTraceSamplesFile);
+  std::filesystem::create_symlink("/dev/zero", folder_ / kTraceSamplesFile);
+  EXPECT_THAT(Refusal(), HasSubstr("traces.f32: is not a regular file"));
 }
 
 }  // namespace
