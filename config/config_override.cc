@@ -1,6 +1,5 @@
 #include "dwellfit/config/config_override.h"
 
-#include <set>
 #include <sstream>
 
 #include "dwellfit/estimator/common/input_error.h"
@@ -140,29 +139,6 @@ std::string DescribeOverride(const ConfigOverride& override_value) {
                    : override_value.action == OverrideAction::kAddToList ? "+="
                                                                          : "-=";
   return override_value.origin + " " + override_value.key_path + op + override_value.yaml_value;
-}
-
-std::optional<std::string> RepeatedFlag(const std::vector<std::string>& args,
-                                        const std::function<FlagKind(const std::string&)>& kind) {
-  std::set<std::string> seen;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    if (arg == "--") break;
-    if (arg.size() < 2 || arg[0] != '-') continue;
-    const std::string body = arg.substr(arg[1] == '-' ? 2 : 1);
-    const std::string::size_type equals = body.find('=');
-    std::string name = body.substr(0, equals);
-    FlagKind flag = kind(name);
-    if (flag == FlagKind::kUnknown && name.rfind("no", 0) == 0 &&
-        kind(name.substr(2)) == FlagKind::kBool) {
-      name = name.substr(2);
-      flag = FlagKind::kBool;
-    }
-    if (flag == FlagKind::kUnknown) continue;
-    if (flag == FlagKind::kValue && equals == std::string::npos) ++i;  // its value
-    if (!seen.insert(name).second) return name;
-  }
-  return std::nullopt;
 }
 
 }  // namespace dwellfit

@@ -6,8 +6,6 @@
 #ifndef DWELLFIT_CONFIG_CONFIG_OVERRIDE_H_
 #define DWELLFIT_CONFIG_CONFIG_OVERRIDE_H_
 
-#include <functional>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,23 +29,6 @@ struct ConfigOverride {
   std::string origin;      // the flag that asked for it, named in errors: "--set"
   OverrideAction action = OverrideAction::kReplace;
 };
-
-// What a command-line flag is, for RepeatedFlag.
-enum class FlagKind {
-  kUnknown,  // not a flag of the tool
-  kBool,     // `--name`, `--noname` or `--name=value`
-  kValue,    // `--name=value` or `--name value`
-};
-
-// The first flag that a tool's arguments `args` (argv without the program)
-// give more than once, by name ("set"); none when each is given once.
-// gflags keeps the last value of a repeated flag without a word, so that
-// `identify --set a=1 --set b=2` would drop a=1: the tools refuse a repeated
-// flag instead. A flag is `-name` or `--name`, with `=value` or, for a
-// kValue flag, the value as the next argument; `--noname` of a kBool flag is
-// `name`; nothing after `--` is a flag.
-std::optional<std::string> RepeatedFlag(const std::vector<std::string>& args,
-                                        const std::function<FlagKind(const std::string&)>& kind);
 
 // Splits a `--set` value "a.b=1,c=[x, y]" into {a.b, 1} and {c, [x, y]}.
 // Commas inside [], {} or quotes do not split; space around keys and values is
