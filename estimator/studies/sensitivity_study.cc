@@ -485,8 +485,12 @@ std::vector<std::string> SplitCsvLine(const std::string& line) {
 
 double ParseNumber(const std::string& text, const std::string& path, int line) {
   char* end = nullptr;
+  // Decimal notation only: strtod alone would take "0x28", "inf" and "nan".
+  const bool decimal = text.find_first_not_of("0123456789+-.eE") == std::string::npos;
   const double value = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0') throw InputError(path, line, "", "'" + text + "' is no number");
+  if (text.empty() || !decimal || *end != '\0') {
+    throw InputError(path, line, "", "'" + EscapeForMessage(text) + "' is no number");
+  }
   return value;
 }
 
@@ -494,7 +498,7 @@ double ParseNumber(const std::string& text, const std::string& path, int line) {
 int ParseCount(const std::string& text, const std::string& path, int line) {
   const double value = ParseNumber(text, path, line);
   if (!(value >= 0.0 && value <= 2e9) || value != std::floor(value)) {
-    throw InputError(path, line, "", "'" + text + "' is no count");
+    throw InputError(path, line, "", "'" + EscapeForMessage(text) + "' is no count");
   }
   return static_cast<int>(value);
 }
