@@ -135,6 +135,11 @@ std::vector<SweepSelection> ReadPool(const ConfigValue& value, const ConfigSourc
     }
     pool.push_back(selection);
   }
+  if (pool.empty()) {
+    throw source.Error(value.path, value.mark,
+                       "the pool is empty; list the sweeps to cross-validate over, or leave "
+                       "`pool` out for the config's fitted and validation sweeps");
+  }
   return pool;
 }
 

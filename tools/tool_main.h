@@ -33,6 +33,7 @@
 #include <system_error>
 #include <vector>
 
+#include "dwellfit/config/strict_yaml.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/common/version.h"
@@ -55,23 +56,6 @@ struct ToolSpec {
   const char* file;   // __FILE__ of its main: --help lists the flags defined there
 };
 
-// The number of single-character edits between a and b (Levenshtein), for
-// the did-you-mean of a misspelt flag.
-inline std::size_t EditDistance(const std::string& a, const std::string& b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
-
 // True for the flags a tool lists in --help: those of its main file and of
 // tool_flags.h.
 inline bool OwnFlag(const gflags::CommandLineFlagInfo& flag, const ToolSpec& tool) {
@@ -82,21 +66,16 @@ inline bool OwnFlag(const gflags::CommandLineFlagInfo& flag, const ToolSpec& too
   return file == base(tool.file) || file == "tool_flags.h";
 }
 
-// "--figures" for a misspelt "figure": the tool's own flag nearest to
-// `name`, within a third of its length in edits; empty when none is.
+// " (did you mean 'figures'?)" for a misspelt "figure": the tool's own flag
+// nearest to `name` (DidYouMean); empty when none is near.
 inline std::string NearestFlag(const std::string& name, const ToolSpec& tool) {
   std::vector<gflags::CommandLineFlagInfo> flags;
   gflags::GetAllFlags(&flags);
-  std::string nearest;
-  std::size_t best = std::max<std::size_t>(2, name.size() / 3) + 1;
+  std::vector<std::string> names;
   for (const gflags::CommandLineFlagInfo& flag : flags) {
-    const std::size_t distance = EditDistance(name, flag.name);
-    if (OwnFlag(flag, tool) && distance < best) {
-      best = distance;
-      nearest = flag.name;
-    }
+    if (OwnFlag(flag, tool)) names.push_back(flag.name);
   }
-  return nearest;
+  return DidYouMean(name, names);
 }
 
 // What is wrong with the command line `args` (argv without the program), in
@@ -123,11 +102,7 @@ inline std::optional<std::string> CommandLineProblem(const std::vector<std::stri
       name = name.substr(2);
       value = "false";
     }
-    if (info.name != name) {
-      const std::string nearest = NearestFlag(name, tool);
-      return "unknown flag --" + name +
-             (nearest.empty() ? "" : "; did you mean --" + nearest + "?");
-    }
+    if (info.name != name) return "unknown flag --" + name + NearestFlag(name, tool);
     if (std::find(seen.begin(), seen.end(), name) != seen.end()) {
       return "--" + name + " is given more than once, and only its last value would count; " +
              "give it once" +

@@ -382,8 +382,9 @@ std::string DatasetName(const IdentifyConfig& config) {
 }  // namespace
 
 bool MethodComparisonOptions::IsValid(std::string* error) const {
-  if (noise_seeds < 1) {
-    *error = StringPrintf("noise_seeds must be at least 1, got %d", noise_seeds);
+  // Each seed is a noisy copy of the whole plan and its fits: 10^4 is hours.
+  if (noise_seeds < 1 || noise_seeds > 10000) {
+    *error = StringPrintf("noise_seeds must be 1 to 10000, got %d", noise_seeds);
     return false;
   }
   if (!(relative_noise > 0.0 && relative_noise < 1.0)) {

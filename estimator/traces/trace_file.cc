@@ -92,9 +92,11 @@ void WriteAtomically(const std::string& text, const fs::path& path) {
 }
 
 double ParsePositive(const std::string& file, int line, const char* field, const char* text) {
+  // Decimal notation only: strtod alone would take "0x28" as 40.
+  const bool decimal = std::strspn(text, "0123456789+-.eE") == std::strlen(text);
   char* end = nullptr;
   const double value = std::strtod(text, &end);
-  if (end == text || *end != '\0' || !std::isfinite(value) || !(value > 0.0)) {
+  if (!decimal || end == text || *end != '\0' || !std::isfinite(value) || !(value > 0.0)) {
     throw InputError(file, line, field,
                      "expected a positive number, got '" + EscapeForMessage(text) + "'");
   }

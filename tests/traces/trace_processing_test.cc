@@ -193,6 +193,13 @@ TEST_F(TraceSetOnDisk, AnIndexWithoutChecksumsStillReads) {
   EXPECT_EQ(back[0].response, dwell_.response);
 }
 
+TEST_F(TraceSetOnDisk, AHexadecimalFrequencyIsRefused) {
+  WriteIndex("sweep,direction,kind,freq_hz,sample_rate_hz,base_samples,response_samples\n"
+             "F0.01,up,frequency,0x28,2048,256,256\n");
+  EXPECT_THAT(Refusal(), HasSubstr("traces.csv:2: field 'freq_hz': expected a positive number, "
+                                   "got '0x28'"));
+}
+
 TEST_F(TraceSetOnDisk, HugeAnnouncedCountsAreRefusedBeforeAllocating) {
   std::string index = "sweep,direction,kind,freq_hz,sample_rate_hz,base_samples,response_samples\n";
   for (int row = 0; row < 64; ++row) index += "F0.01,up,frequency,40,2048,1073741824,1073741824\n";
