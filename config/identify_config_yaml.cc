@@ -183,7 +183,8 @@ void EmitModelSelection(YAML::Emitter& out, const ModelSelectionConfig& selectio
   EmitChoices(out, "omega_hz", selection.omega, true);
   Put(out, "cross_validation", CrossValidationSchemeName(selection.scheme));
   Put(out, "training", CrossValidationTrainingName(selection.training));
-  EmitSelections(out, "pool", selection.pool);
+  // No pool: the fitted and validation sweeps (an empty list is refused).
+  if (!selection.pool.empty()) EmitSelections(out, "pool", selection.pool);
   Put(out, "threads", selection.threads);
   out << YAML::EndMap;
 }

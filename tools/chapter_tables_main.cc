@@ -30,6 +30,8 @@ int main(int argc, char** argv) {
       "--output FILE]",
       __FILE__};
   return dwellfit::RunTool(argc, argv, tool, [] {
+    dwellfit::CheckOutputFile(FLAGS_output, "--output",
+                              {FLAGS_numerical, FLAGS_truth_plan, FLAGS_measured});
     const std::string markdown =
         dwellfit::ChapterTablesMarkdown(dwellfit::LoadIdentifyConfig(FLAGS_numerical),
                                         dwellfit::ReadDwellPlan(FLAGS_truth_plan).truth,

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
       "  convergence_family [--base CFG --output FILE]",
       __FILE__};
   return dwellfit::RunTool(argc, argv, tool, [] {
+    dwellfit::CheckOutputFile(FLAGS_output, "--output", {FLAGS_base});
     const dwellfit::IdentifyConfig base = dwellfit::LoadIdentifyConfig(FLAGS_base);
     std::vector<dwellfit::FamilyOutcome> outcomes;
     for (const dwellfit::FamilyMember& member : dwellfit::ConvergenceFamily()) {

@@ -11,8 +11,6 @@
 // --kind with --a_base or --freq_hz and --from/--to (Hz or a_base), else the
 // plan's sweeps.
 #include <cmath>
-#include <cstdio>
-#include <fstream>
 #include <iostream>
 
 #include "dwellfit/config/dwell_plan_reader.h"
@@ -20,6 +18,7 @@
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/curves/sweep_curves.h"
+#include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/tools/tool_main.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
@@ -120,6 +119,9 @@ int main(int argc, char** argv) {
       "--kind amplitude --freq_hz HZ --from A --to A] [--output curves.csv]",
       __FILE__};
   return dwellfit::RunTool(argc, argv, tool, [] {
+    if (!FLAGS_output.empty()) {
+      dwellfit::CheckOutputFile(FLAGS_output, "--output", {FLAGS_result, FLAGS_plan});
+    }
     std::optional<dwellfit::DwellPlan> plan;
     if (!FLAGS_plan.empty()) plan = dwellfit::ReadDwellPlan(FLAGS_plan);
     const dwellfit::DwellPlan* plan_ptr = plan ? &*plan : nullptr;
@@ -139,14 +141,7 @@ int main(int argc, char** argv) {
     if (FLAGS_output.empty()) {
       std::cout << csv;
     } else {
-      // Written beside and renamed into place: never a half-written file.
-      const std::string partial = FLAGS_output + ".partial";
-      std::ofstream out(partial, std::ios::binary);
-      if (!(out << csv) || !out.flush() ||
-          (out.close(), std::rename(partial.c_str(), FLAGS_output.c_str()) != 0)) {
-        std::remove(partial.c_str());
-        throw dwellfit::InputError(FLAGS_output, 0, "--output", "cannot write the file");
-      }
+      dwellfit::WriteReportAtomically(FLAGS_output, csv);  // never a half-written file
     }
     return 0;
   });

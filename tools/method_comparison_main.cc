@@ -33,6 +33,8 @@ int main(int argc, char** argv) {
       "--noise_seeds N --phase_bias_deg D --wall_time]",
       __FILE__};
   return dwellfit::RunTool(argc, argv, tool, [] {
+    dwellfit::CheckOutputFile(FLAGS_output, "--output",
+                              {FLAGS_numerical, FLAGS_truth_plan, FLAGS_measured});
     dwellfit::MethodComparisonOptions options;
     options.noise_seeds = FLAGS_noise_seeds;
     options.phase_bias_deg = FLAGS_phase_bias_deg;

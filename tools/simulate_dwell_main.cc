@@ -6,11 +6,13 @@
 // The plan (config/dwell_plan_reader.h) gives the true parameters, the
 // sweeps and the noise; the plan in effect and each sweep's jumps are printed.
 #include <iostream>
+#include <sstream>
 
 #include "dwellfit/config/dwell_plan_reader.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/data/sweep_csv_writer.h"
+#include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/simulation/dwell_simulator.h"
 #include "dwellfit/tools/tool_main.h"
 #include "gflags/gflags.h"
@@ -29,9 +31,12 @@ int main(int argc, char** argv) {
       std::cerr << "simulate_dwell: give both --plan and --out; see --help\n";
       return dwellfit::kToolExitUsage;
     }
+    dwellfit::CheckOutputFile(FLAGS_out, "--out", {FLAGS_plan});
     const dwellfit::DwellPlan plan = dwellfit::ReadDwellPlan(FLAGS_plan);
     const std::vector<dwellfit::Sweep> sweeps = dwellfit::SimulateDwells(plan);
-    dwellfit::WriteSweepsCsvFile(sweeps, FLAGS_out);
+    std::ostringstream csv;
+    dwellfit::WriteSweepsCsv(sweeps, &csv);
+    dwellfit::WriteReportAtomically(FLAGS_out, csv.str(), "--out");  // never half-written
     dwellfit::DescribeSimulation(plan, sweeps, &std::cout);
     std::cout << "wrote " << FLAGS_out << "\n";
     return 0;

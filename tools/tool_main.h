@@ -119,6 +119,22 @@ inline std::optional<std::string> CommandLineProblem(const std::vector<std::stri
   return std::nullopt;
 }
 
+// Throws InputError (naming `flag`) before a run's work when the output file
+// `path` is a folder or one of the run's `inputs`.
+inline void CheckOutputFile(const std::string& path, const std::string& flag,
+                            const std::vector<std::string>& inputs) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (fs::is_directory(path, error)) {
+    throw InputError(path, 0, flag, "is a folder; give a file name");
+  }
+  for (const std::string& input : inputs) {
+    if (!input.empty() && fs::weakly_canonical(input, error) == fs::weakly_canonical(path, error)) {
+      throw InputError(path, 0, flag, "is an input of this run; give another file");
+    }
+  }
+}
+
 // --help: the usage, then the tool's own flags with their defaults.
 inline void PrintToolHelp(const ToolSpec& tool) {
   std::cout << tool.name << ": " << tool.usage << "\n\nFlags:\n";

@@ -26,8 +26,11 @@ constexpr char kStagingPrefix[] = ".dwellfit-staging-";
 constexpr char kLegacyPartialMarker[] = ".partial-";
 constexpr char kLockFileName[] = ".dwellfit-lock";
 
-[[noreturn]] void ThrowOutputError(const fs::path& path, const std::string& what) {
-  throw InputError(path.string(), 0, "output_dir", what + "; choose a writable output_dir");
+// `field`: the config key or flag that named the path.
+[[noreturn]] void ThrowOutputError(const fs::path& path, const std::string& what,
+                                   const std::string& field = "output_dir") {
+  throw InputError(path.string(), 0, field,
+                   what + "; give " + field + " a path that can be written");
 }
 
 // The process id that ends `name` after `marker`, or 0 when there is none.
@@ -61,10 +64,9 @@ void RemoveStaleStaging(const fs::path& directory) {
 // disk in one journal commit rather than one each.
 class DurableFile {
  public:
-  explicit DurableFile(fs::path path) : path_(std::move(path)) {
+  DurableFile(fs::path path, std::string field) : path_(std::move(path)), field_(std::move(field)) {
     fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd_ < 0)
-      ThrowOutputError(path_, std::string("cannot write (") + std::strerror(errno) + ")");
+    if (fd_ < 0) Fail();
   }
   ~DurableFile() {
     if (fd_ >= 0) ::close(fd_);
@@ -95,10 +97,11 @@ class DurableFile {
 
  private:
   [[noreturn]] void Fail() {
-    ThrowOutputError(path_, std::string("cannot write (") + std::strerror(errno) + ")");
+    ThrowOutputError(path_, std::string("cannot write (") + std::strerror(errno) + ")", field_);
   }
 
   fs::path path_;
+  std::string field_;
   int fd_ = -1;
 };
 
@@ -110,7 +113,7 @@ void WriteDurably(const fs::path& directory,
   std::vector<std::unique_ptr<DurableFile>> written;
   written.reserve(files.size() + 1);
   const auto write = [&](const std::string& name, const std::string& content) {
-    written.push_back(std::make_unique<DurableFile>(directory / name));
+    written.push_back(std::make_unique<DurableFile>(directory / name, "output_dir"));
     written.back()->Write(content);
   };
   for (const auto& [name, content] : files) write(name, content);
@@ -235,11 +238,12 @@ void WriteFilesAtomically(const std::string& directory,
   fs::remove_all(staging, error);
 }
 
-void WriteReportAtomically(const std::string& path, const std::string& text) {
+void WriteReportAtomically(const std::string& path, const std::string& text,
+                           const std::string& field) {
   const fs::path target(path);
   const fs::path staged = target.string() + kLegacyPartialMarker + std::to_string(::getpid());
   {
-    DurableFile file(staged);
+    DurableFile file(staged, field);
     file.Write(text);
     file.Flush();
   }
@@ -247,7 +251,7 @@ void WriteReportAtomically(const std::string& path, const std::string& text) {
   fs::rename(staged, target, error);
   if (error) {
     fs::remove(staged, error);
-    ThrowOutputError(target, "cannot move the report into place");
+    ThrowOutputError(target, "cannot move the report into place", field);
   }
 }
 

@@ -43,7 +43,9 @@ void WriteFilesAtomically(const std::string& directory,
 // One report file (docs/chapter-tables.md, say): written beside `path` under
 // a name of this process, flushed, then renamed onto it, so `path` holds the
 // old text or the whole new one. No manifest: a report is one file.
-void WriteReportAtomically(const std::string& path, const std::string& text);
+// Errors name `field`, the flag or key that gave the path.
+void WriteReportAtomically(const std::string& path, const std::string& text,
+                           const std::string& field = "--output");
 
 }  // namespace dwellfit
 

@@ -18,6 +18,8 @@ namespace dwellfit {
 namespace {
 
 constexpr int kMaxGridSteps = 1000000;
+// More dwells than a plan may hold: 1e7 (some 1 GB of simulated sweeps).
+constexpr double kMaxPlanDwells = 1e7;
 // A grid must close on `to` to this fraction of the span: (to - from) / step
 // is an integer up to rounding of the decimal inputs.
 constexpr double kGridClosureTolerance = 1e-9;
@@ -134,12 +136,19 @@ bool DwellPlan::IsValid(std::string* error) const {
   }
   if (sweeps.empty()) return fail("the plan has no sweeps");
   std::set<std::string> ids;
+  double dwells = 0.0;  // of the whole plan, every direction
   for (const SweepPlan& sweep : sweeps) {
     std::string why;
     if (!sweep.IsValid(&why)) return fail("sweep '" + sweep.id + "': " + why);
     if (!ids.insert(sweep.id).second) {
       return fail("sweep id '" + sweep.id + "' is used twice; ids must be unique");
     }
+    dwells += (sweep.NumSteps() + 1.0) * static_cast<double>(sweep.directions.size());
+  }
+  if (dwells > kMaxPlanDwells) {
+    return fail("the plan has " + G12(dwells) + " dwells, more than " + G12(kMaxPlanDwells) +
+                " (a test of years, and more memory than a run has); give larger steps or "
+                "fewer sweeps");
   }
   if (!(noise.relative_sigma >= 0.0 && noise.relative_sigma < 1.0)) {
     return fail("noise relative_sigma must be in [0, 1), got " + G12(noise.relative_sigma));
