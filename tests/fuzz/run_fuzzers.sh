@@ -37,7 +37,7 @@ dataset_seeds() {
   esac
 }
 
-# ASAN_OPTIONS while a target fuzzes. sweep_csv: libfccp's CSVReader
+# ASAN_OPTIONS while a target fuzzes. sweep_csv and trace_set: libfccp's CSVReader
 # allocates a fixed 48 MB buffer (3 << 24 bytes) for every file it reads, and
 # AddressSanitizer poisons and unpoisons its 6 MB of shadow memory each time:
 # about 40 ms per load (25 runs/s). It fuzzes without heap poisoning (stack
@@ -46,7 +46,7 @@ dataset_seeds() {
 # with all checks.
 fuzzing_asan_options() {
   case "$1" in
-    sweep_csv) echo "poison_heap=0" ;;
+    sweep_csv | trace_set) echo "poison_heap=0" ;;
   esac
 }
 
