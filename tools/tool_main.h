@@ -112,6 +112,11 @@ inline std::optional<std::string> CommandLineProblem(const std::vector<std::stri
     if (!value && info.type == "bool") value = "true";
     if (!value && ++i == args.size()) return "--" + name + " needs a value";
     if (!value) value = args[i];
+    // gflags reads numbers with strtod/strtol, which take "0x28" and "inf".
+    const bool numeric = info.type == "double" || info.type.find("int") != std::string::npos;
+    if (numeric && value->find_first_not_of("0123456789+-.eE") != std::string::npos) {
+      return "--" + name + " '" + EscapeForMessage(*value) + "' is not a decimal number";
+    }
     if (gflags::SetCommandLineOption(name.c_str(), value->c_str()).empty()) {
       return "--" + name + " '" + *value + "' is not a valid " + info.type + " value";
     }
