@@ -1,6 +1,8 @@
 // Dwell points from time traces: amplitudes, the lag, and bad traces.
 #include "dwellfit/estimator/traces/trace_processing.h"
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -194,8 +196,9 @@ TEST_F(TraceSetOnDisk, AnIndexWithoutChecksumsStillReads) {
 }
 
 TEST_F(TraceSetOnDisk, AHexadecimalFrequencyIsRefused) {
-  WriteIndex("sweep,direction,kind,freq_hz,sample_rate_hz,base_samples,response_samples\n"
-             "F0.01,up,frequency,0x28,2048,256,256\n");
+  WriteIndex(
+      "sweep,direction,kind,freq_hz,sample_rate_hz,base_samples,response_samples\n"
+      "F0.01,up,frequency,0x28,2048,256,256\n");
   EXPECT_THAT(Refusal(), HasSubstr("traces.csv:2: field 'freq_hz': expected a positive number, "
                                    "got '0x28'"));
 }
@@ -213,6 +216,9 @@ TEST_F(TraceSetOnDisk, ASamplesFileThatIsNoRegularFileIsRefused) {
   EXPECT_THAT(Refusal(), HasSubstr("traces.f32: is not a regular file"));
   std::filesystem::remove(folder_ / kTraceSamplesFile);
   std::filesystem::create_symlink("/dev/zero", folder_ / kTraceSamplesFile);
+  EXPECT_THAT(Refusal(), HasSubstr("traces.f32: is not a regular file"));
+  std::filesystem::remove(folder_ / kTraceSamplesFile);
+  ASSERT_EQ(::mkfifo((folder_ / kTraceSamplesFile).c_str(), 0600), 0);  // a read would block
   EXPECT_THAT(Refusal(), HasSubstr("traces.f32: is not a regular file"));
 }
 
