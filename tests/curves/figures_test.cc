@@ -59,6 +59,16 @@ TEST(Figures, IdentifyDrawsAValidPngAndSvgPerSweep) {
   }
   EXPECT_THAT(ReadFile(dir / "curves.csv"),
               HasSubstr("sweep,kind,curve,segment,freq_hz,a_base,a,stable,fold,phase_deg\n"));
+
+  // A run without figures into the same folder leaves none of the old ones.
+  IdentifyRunOptions no_figures;
+  no_figures.render_figures = false;
+  RunIdentify(config, printed, no_figures);
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
+    EXPECT_EQ(entry.path().filename().string().rfind("figure_", 0), std::string::npos)
+        << entry.path();
+  }
+  EXPECT_TRUE(fs::exists(dir / "figures.gp"));
 }
 
 TEST(Figures, AFailingScriptIsAWarningNotAnError) {
