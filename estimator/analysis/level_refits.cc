@@ -117,7 +117,8 @@ LevelRefits RefitLeavingOneLevelOut(const std::vector<const Sweep*>& fitted,
   IdentificationOptions refit_options = options;
   refit_options.solve.solver.num_threads = 1;
   result.refits.resize(count);
-  tbb::task_arena arena(std::max(1, std::min(threads, count)));
+  tbb::task_arena arena(
+      std::max(1, std::min({threads, count, tbb::this_task_arena::max_concurrency()})));
   arena.execute([&] {
     tbb::parallel_for(0, count, [&](int i) {
       result.refits[i] = Refit(fitted, refit_options, result.levels[i], omega_ref_rad_s);

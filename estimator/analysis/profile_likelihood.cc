@@ -383,7 +383,8 @@ ProfileLikelihood ProfileCost(const ProfileProblem& problem, const ParameterVect
     const Side side = MakeSide(problem, q, i % 3 == 0 ? -1.0 : 1.0, estimate, covariance, quantile);
     sides[i] = SearchSide(problem, side, profile.minimum_cost);
   };
-  tbb::task_arena arena(std::max(problem.threads, 1));
+  tbb::task_arena arena(
+      std::max(1, std::min(problem.threads, tbb::this_task_arena::max_concurrency())));
   arena.execute([&] { tbb::parallel_for(size_t{0}, sides.size(), search); });
   for (size_t i = 0; i < sides.size(); i += 3) {
     const int q = quantities[i / 3];

@@ -363,6 +363,7 @@ void WriteRigTruthCsv(const RigRun& run, const std::string& path) {
   file << text.str();
   file.close();
   if (!file || std::rename(staged.c_str(), path.c_str()) != 0) {
+    std::remove(staged.c_str());  // no half-written file is left behind
     throw InputError(path, 0, "", "cannot write the truth file; check that its folder is writable");
   }
 }

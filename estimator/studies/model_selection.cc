@@ -300,12 +300,15 @@ std::vector<TaskResult> RunTasks(const IdentifyConfig& config,
   const int sets = static_cast<int>(plan.training.size());
   const int count = static_cast<int>(variants.size()) * sets;
   std::vector<TaskResult> results(count);
-  tbb::task_arena(std::max(1, std::min(threads, count))).execute([&] {
-    tbb::parallel_for(
-        0, count,
-        [&](int i) { results[i] = RunTask(config, variants[i / sets], sweeps, plan, i % sets); },
-        tbb::simple_partitioner());
-  });
+  tbb::task_arena(std::max(1, std::min({threads, count, tbb::this_task_arena::max_concurrency()})))
+      .execute([&] {
+        tbb::parallel_for(
+            0, count,
+            [&](int i) {
+              results[i] = RunTask(config, variants[i / sets], sweeps, plan, i % sets);
+            },
+            tbb::simple_partitioner());
+      });
   for (const TaskResult& result : results) {
     if (result.error) std::rethrow_exception(result.error);
   }

@@ -480,9 +480,9 @@ SensitivityStudy RunSensitivityStudy(const SensitivityOptions& options, const Pr
     const int finished = ++done;
     if (progress) progress(finished, count);
   };
-  tbb::task_arena(options.threads).execute([&] {
-    tbb::parallel_for(0, count, run_fit, tbb::simple_partitioner());
-  });
+  // Threads beyond the machine's would only make TBB warn.
+  tbb::task_arena(std::min({options.threads, count, tbb::this_task_arena::max_concurrency()}))
+      .execute([&] { tbb::parallel_for(0, count, run_fit, tbb::simple_partitioner()); });
   study.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return study;
 }

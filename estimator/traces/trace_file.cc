@@ -76,19 +76,20 @@ float GetFloat(const unsigned char* bytes) {
 void WriteAtomically(const std::string& text, const fs::path& path) {
   // The process id keeps two runs into one folder from sharing a staged file.
   const fs::path staged = path.string() + ".partial." + std::to_string(::getpid());
-  {
-    std::ofstream file(staged, std::ios::binary | std::ios::trunc);
-    if (!file) {
-      throw InputError(staged.string(), 0, "",
-                       "cannot open the file for writing; check that the folder is writable");
-    }
-    file << text;
-    file.close();
-    if (!file) throw InputError(staged.string(), 0, "", "writing the file failed (disk full?)");
+  std::ofstream file(staged, std::ios::binary | std::ios::trunc);
+  if (!file) {
+    throw InputError(staged.string(), 0, "",
+                     "cannot open the file for writing; check that the folder is writable");
   }
+  file << text;
+  file.close();
   std::error_code error;
-  fs::rename(staged, path, error);
-  if (error) throw InputError(path.string(), 0, "", "cannot rename into place: " + error.message());
+  if (file) fs::rename(staged, path, error);
+  if (!file || error) {
+    fs::remove(staged, error);  // no half-written file is left behind
+    throw InputError(path.string(), 0, "",
+                     "cannot write the file (disk full, a size limit, or the folder?)");
+  }
 }
 
 double ParsePositive(const std::string& file, int line, const char* field, const char* text) {

@@ -226,6 +226,9 @@ TEST(RigSimulator, SettingsThatGiveNoUsableRecordAreRefused) {
   EXPECT_THAT(refusal(rig), HasSubstr("the simulated response channel is not finite"));
   rig.gauge.gain = 1e-300;
   EXPECT_THAT(refusal(rig), HasSubstr("the simulated response channel is constant"));
+  rig = ShortRig();
+  rig.channels.response_filter_cutoff_hz = 1e300;
+  EXPECT_THAT(refusal(rig), HasSubstr("the simulated response channel is not finite"));
 }
 
 // Harmonic balance (eqs. 3.12-3.13) on traces of ten dwells with 0.1 % noise
