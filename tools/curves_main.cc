@@ -63,10 +63,6 @@ dwellfit::ParameterVector Parameters(const dwellfit::DwellPlan* plan) {
       }
       continue;
     }
-    if (!std::isfinite(flags[i])) {
-      throw InputError("--" + std::string(i == kNaturalFrequency ? "omega_hz" : ParameterName(i)),
-                       0, "", "is not a finite number; give a finite value");
-    }
     p[i] = i == kNaturalFrequency ? HzToRadPerSecond(flags[i]) : flags[i];
   }
   return p;
