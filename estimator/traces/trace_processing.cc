@@ -155,6 +155,23 @@ std::vector<double> Displacement(const DwellTrace& dwell, const Spectrum& voltag
   return u;
 }
 
+// Throws InputError when a channel holds (next to) nothing at the drive
+// frequency: a first harmonic below 1e-6 of the channel's RMS (a recording
+// at another frequency than freq_hz says, or no response), which would give
+// an amplitude of 0 rather than a measurement.
+void CheckDriveComponent(const DwellTrace& dwell, const char* channel,
+                         const std::vector<double>& samples, Complex first_harmonic) {
+  double square_sum = 0.0;
+  for (double value : samples) square_sum += value * value;
+  const double rms = std::sqrt(square_sum / static_cast<double>(samples.size()));
+  // A sine of amplitude A has an RMS of A / sqrt(2).
+  if (!(std::abs(first_harmonic) > 1e-6 * std::sqrt(2.0) * rms)) {
+    throw InputError("dwell " + dwell.Describe() + ": the " + channel +
+                     " channel has no component at the drive frequency; check freq_hz "
+                     "against the recording");
+  }
+}
+
 DwellResult AnalyzeDwell(const DwellTrace& dwell, const TraceProcessingOptions& options,
                          const StrainGauge& gauge) {
   CheckTraces(dwell, options.harmonics);
@@ -175,6 +192,8 @@ DwellResult AnalyzeDwell(const DwellTrace& dwell, const TraceProcessingOptions& 
   const Spectrum u_spectrum = Fft(u);
   result.harmonics.u = Harmonics(u_spectrum, periods, options.harmonics);
   result.harmonics.base = Harmonics(base_spectrum, periods, options.harmonics);
+  CheckDriveComponent(dwell, "response", u, result.harmonics.u[1]);
+  CheckDriveComponent(dwell, "base", base, result.harmonics.base[1]);
   const double first = std::abs(result.harmonics.u[1]);
   for (int h = 2; h <= options.harmonics; ++h) {
     result.harmonic_ratio =

@@ -108,6 +108,12 @@ TEST(TraceProcessing, BadTracesAreClearErrors) {
   DwellTrace no_base = good;
   std::fill(no_base.base.begin(), no_base.base.end(), 0.0f);
   EXPECT_THAT(message(no_base), HasSubstr("the base channel is constant (every sample 0)"));
+  // Recorded at 64 Hz, announced at 32 Hz: the record holds 4 whole periods of
+  // 32 Hz and nothing at that frequency.
+  DwellTrace elsewhere = SteadyDwell(gauge, 64.0, 2048.0, 256, 0.01, 1e-3, 0.5);
+  elsewhere.drive_frequency_rad_s /= 2.0;
+  EXPECT_THAT(message(elsewhere), HasSubstr("the response channel has no component at the drive "
+                                            "frequency; check freq_hz"));
   DwellTrace slow = good;
   slow.sample_rate_hz = 200.0;  // 5 samples per period cannot hold 3 harmonics
   EXPECT_THAT(message(slow), HasSubstr("cannot resolve 3 harmonics"));
