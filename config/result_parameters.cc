@@ -26,15 +26,14 @@ ParameterVector ReadResultParameters(const std::string& path) {
   ParameterVector p{};
   for (int i = 0; i < kNumParameters; ++i) {
     const std::string field = std::string("parameters.") + ParameterName(i) + ".value";
-    const YAML::Node entry = parameters[ParameterName(i)];
-    const YAML::Node value = entry.IsMap() ? entry["value"] : YAML::Node();
     double number = NAN;
-    const int line = entry.IsDefined() ? entry.Mark().line + 1 : parameters.Mark().line + 1;
-    if (value.IsScalar()) {
-      try {
-        number = value.as<double>();
-      } catch (const YAML::Exception&) {
-      }
+    int line = parameters.Mark().line + 1;
+    try {  // yaml-cpp throws for a key of a node it could not build (InvalidNode)
+      const YAML::Node entry = parameters[ParameterName(i)];
+      if (entry.IsDefined()) line = entry.Mark().line + 1;
+      const YAML::Node value = entry.IsMap() ? entry["value"] : YAML::Node();
+      if (value.IsScalar()) number = value.as<double>();
+    } catch (const YAML::Exception&) {
     }
     if (!std::isfinite(number)) {
       throw InputError(path, line, field,
