@@ -62,33 +62,20 @@ void Commit(const std::string& staged, const std::string& path) {
 }
 
 // Throws InputError, before anything is read or written, when an output
-// flag names a folder, both outputs name one file, or an output is an input;
-// or when --reference_hz is negative or not finite.
+// flag names a folder or an input, or both outputs name one file; or when
+// --reference_hz is negative or not finite.
 void CheckFlags() {
-  namespace fs = std::filesystem;
   if (!(FLAGS_reference_hz >= 0.0 && std::isfinite(FLAGS_reference_hz))) {
     throw dwellfit::InputError("--reference_hz", 0, "",
                                "give a frequency >= 0 in Hz (0: the identified omega)");
   }
-  const auto same = [](const std::string& a, const std::string& b) {
-    return fs::weakly_canonical(a) == fs::weakly_canonical(b);
-  };
-  const fs::path traces(FLAGS_traces);
+  const std::filesystem::path traces(FLAGS_traces);
   const std::vector<std::string> inputs = {FLAGS_rig, (traces / "traces.csv").string(),
                                            (traces / "traces.f32").string()};
-  for (const auto& [flag, path] :
-       {std::pair{"--out", FLAGS_out}, std::pair{"--harmonic_balance", FLAGS_harmonic_balance}}) {
-    if (path.empty()) continue;
-    if (fs::is_directory(path)) {
-      throw dwellfit::InputError(path, 0, flag, "is a folder; give a file name");
-    }
-    for (const std::string& input : inputs) {
-      if (same(path, input)) {
-        throw dwellfit::InputError(path, 0, flag, "is an input of this run; give another file");
-      }
-    }
-  }
-  if (!FLAGS_harmonic_balance.empty() && same(FLAGS_out, FLAGS_harmonic_balance)) {
+  dwellfit::CheckOutputFile(FLAGS_out, "--out", inputs);
+  if (FLAGS_harmonic_balance.empty()) return;
+  dwellfit::CheckOutputFile(FLAGS_harmonic_balance, "--harmonic_balance", inputs);
+  if (dwellfit::SameFile(FLAGS_out, FLAGS_harmonic_balance)) {
     throw dwellfit::InputError(FLAGS_out, 0, "--harmonic_balance",
                                "names the same file as --out; give two files");
   }

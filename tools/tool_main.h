@@ -89,7 +89,9 @@ inline std::optional<std::string> CommandLineProblem(const std::vector<std::stri
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& arg = args[i];
     if (arg == "--") break;
-    if (arg.size() < 2 || arg[0] != '-') return "unexpected argument '" + arg + "'";
+    if (arg.size() < 2 || arg[0] != '-') {
+      return "unexpected argument '" + EscapeForMessage(arg) + "'";
+    }
     const std::string body = arg.substr(arg[1] == '-' ? 2 : 1);
     const std::string::size_type equals = body.find('=');
     std::string name = body.substr(0, equals);
@@ -118,23 +120,32 @@ inline std::optional<std::string> CommandLineProblem(const std::vector<std::stri
       return "--" + name + " '" + EscapeForMessage(*value) + "' is not a decimal number";
     }
     if (gflags::SetCommandLineOption(name.c_str(), value->c_str()).empty()) {
-      return "--" + name + " '" + *value + "' is not a valid " + info.type + " value";
+      return "--" + name + " '" + EscapeForMessage(*value) + "' is not a valid " + info.type +
+             " value";
     }
   }
   return std::nullopt;
+}
+
+// True when the paths `a` and `b` name one file (whether it exists or not);
+// false when either cannot be resolved.
+inline bool SameFile(const std::string& a, const std::string& b) {
+  std::error_code error_a, error_b;
+  const std::filesystem::path resolved_a = std::filesystem::weakly_canonical(a, error_a);
+  const std::filesystem::path resolved_b = std::filesystem::weakly_canonical(b, error_b);
+  return !error_a && !error_b && resolved_a == resolved_b;
 }
 
 // Throws InputError (naming `flag`) before a run's work when the output file
 // `path` is a folder or one of the run's `inputs`.
 inline void CheckOutputFile(const std::string& path, const std::string& flag,
                             const std::vector<std::string>& inputs) {
-  namespace fs = std::filesystem;
   std::error_code error;
-  if (fs::is_directory(path, error)) {
+  if (std::filesystem::is_directory(path, error)) {
     throw InputError(path, 0, flag, "is a folder; give a file name");
   }
   for (const std::string& input : inputs) {
-    if (!input.empty() && fs::weakly_canonical(input, error) == fs::weakly_canonical(path, error)) {
+    if (!input.empty() && SameFile(input, path)) {
       throw InputError(path, 0, flag, "is an input of this run; give another file");
     }
   }
