@@ -19,7 +19,6 @@
 #include <iostream>
 #include <sstream>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "dwellfit/config/rig_config_reader.h"
