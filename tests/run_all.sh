@@ -35,14 +35,17 @@ cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DDWELLFIT_SANITIZE=ON \
   -DDWELLFIT_BUILD_BENCHMARKS=OFF
 cmake --build build-sanitize -j"${jobs}"
-# Four tests repeat, over the whole measured beam or hundreds of replicas, code
+# Tests that repeat, over the whole measured beam or hundreds of replicas, code
 # that lighter tests run under the sanitizers too (the beam fit on one and three
-# threads, the profile of beam-selected.yaml, coverage on a few replicas).
-# Under ASan the two largest took 229 s and 175 s; these run in Release only.
+# threads, the profile of beam-selected.yaml, coverage on a few replicas,
+# select_model's quiet run, the model-selection unit tests), and the packaging
+# tests (outside projects built against the install) run in the Release step
+# only. Under ASan the two largest took 229 s and 175 s, the rest some 300 s.
 heavy='MeasuredBeamFilesAreByteIdenticalOnOneAndTwoThreads|clamped-beam-27C/beam\.yaml|'
-heavy+='UncertaintyCoverage\.|IdentifyOnTheMeasuredBeamReportsProfileIntervals'
+heavy+='UncertaintyCoverage\.|IdentifyOnTheMeasuredBeamReportsProfileIntervals|'
+heavy+='ModelSelectionBeam\.|method_comparison_reproducible|select_model_verbose_shows_ceres'
 UBSAN_OPTIONS=print_stacktrace=1 ctest --test-dir build-sanitize --output-on-failure -j"${jobs}" \
-  -E "${heavy}"
+  -E "${heavy}" -LE packaging
 
 step "fuzzers (Clang, libFuzzer, ASan+UBSan)"
 cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
