@@ -6,7 +6,8 @@
 // simulated datasets sharing eta_e (mapped blocks), and the response curves
 // of an identify run with their curves.csv text. The fits run with the
 // residual blocks evaluated on 1 and on 2 threads (the argument); their
-// results do not depend on it.
+// results do not depend on it. Last, a user's whole identify run with its
+// figures.
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -15,6 +16,7 @@
 #include <filesystem>
 #include <memory>
 #include <ostream>
+#include <sstream>
 #include <streambuf>
 #include <string>
 #include <vector>
@@ -229,7 +231,6 @@ BENCHMARK(BM_ClampedBeamFitBusy)
     ->Iterations(5)
     ->UseRealTime();
 
-
 // Two simulated datasets of the thesis model (w = 2 pi 40 and 2 pi 43 rad/s,
 // 1 % noise), one eta_e, mu1, mu2, delta, alpha block shared and one w block
 // each: the staged solve on mapped blocks (520 dwells) from the thesis start.
@@ -308,6 +309,36 @@ void BM_ClampedBeamRunCurves(benchmark::State& state) {
   TraceCurvesAtEstimate(state, ClampedBeam());
 }
 BENCHMARK(BM_ClampedBeamRunCurves)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// A user's whole `identify` run, as the tool runs it with its defaults: the
+// fit, intervals, model error, predictions, curves, every file written and
+// the figures drawn by gnuplot (PNG and SVG per sweep), into a fresh folder.
+// Targets (two cores): the thesis case under 0.5 s, beam-selected.yaml
+// (twelve levels) under 1.5 s.
+void IdentifyWithFigures(benchmark::State& state, const std::string& config_path) {
+  const std::string out_dir =
+      (std::filesystem::temp_directory_path() / "dwellfit-benchmark-identify").string();
+  const IdentifyConfig config =
+      LoadIdentifyConfig(std::string(DWELLFIT_SOURCE_DIR) + "/datasets/" + config_path,
+                         {{"output_dir", out_dir, "--benchmark"}});
+  for (auto _ : state) {
+    std::ostringstream printed;
+    const std::unique_ptr<IdentifyOutcome> outcome = RunIdentify(config, printed);
+    benchmark::DoNotOptimize(outcome.get());
+  }
+  std::filesystem::remove_all(out_dir);
+}
+void BM_ThesisIdentifyWithFigures(benchmark::State& state) {
+  IdentifyWithFigures(state, "thesis-numerical/beam.yaml");
+}
+BENCHMARK(BM_ThesisIdentifyWithFigures)->Unit(benchmark::kMillisecond)->UseRealTime();
+void BM_ClampedBeamSelectedIdentifyWithFigures(benchmark::State& state) {
+  IdentifyWithFigures(state, "clamped-beam-27C/beam-selected.yaml");
+}
+BENCHMARK(BM_ClampedBeamSelectedIdentifyWithFigures)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3);
 
 }  // namespace
 }  // namespace dwellfit

@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <sstream>
 
 #include "boost/algorithm/string/join.hpp"
@@ -30,8 +32,8 @@ std::string Quoted(const std::string& text) {
 
 std::string Preamble(const FigureSet& figures) {
   std::ostringstream gp;
-  gp << "# Chapter-style figures of a dwellfit run, drawn from curves.csv and predictions.csv\n"
-        "# (docs/outputs.md). PNG: gnuplot figures.gp; SVG: gnuplot -e \"fmt='svg'\" figures.gp\n"
+  gp << "# Chapter-style figures of a dwellfit run; the data are in the datablocks of each\n"
+        "# sweep. PNG: gnuplot figures.gp; SVG: gnuplot -e \"fmt='svg'\" figures.gp\n"
         "set encoding utf8\n"
         "if (!exists(\"fmt\")) fmt = \"png\"\n"
         "if (fmt eq \"svg\") {\n"
@@ -39,83 +41,104 @@ std::string Preamble(const FigureSet& figures) {
         "} else {\n"
         "  set terminal pngcairo size 900,760 noenhanced font \"sans,10\"\n"
         "}\n"
-        "set datafile separator \",\"\n"
-        "set datafile missing \"\"\n"
-        "curves = \"curves.csv\"\n"
-        "dwells = \"predictions.csv\"\n"
         "set grid lc rgb \"#dddddd\"\n"
-        "set key opaque box\n";
+        "set key opaque box\n"
+        "set style textbox opaque noborder\n";
   gp << "estimates = " << Quoted(boost::algorithm::join(figures.corner_lines, "\n")) << "\n";
   gp << "amplitude_unit = " << Quoted(figures.amplitude_unit) << "\n\n";
   return gp.str();
 }
 
-// The `using` expression selecting one sweep's rows of curves.csv.
-std::string CurveRows(const FigureSweep& s, const std::string& condition, const char* x) {
-  return StringPrintf("(strcol('sweep') eq %s && %s ? column('%s') : NaN):'a'",
-                      Quoted(s.id).c_str(), condition.c_str(), x);
+// A datablock of polylines (a blank line between two) named $<name>.
+void AppendBlock(const std::string& name, const std::vector<FigureLine>& lines, std::string* gp) {
+  *gp += "$" + name + " << EOD\n";
+  for (size_t i = 0; i < lines.size(); ++i) {
+    if (i > 0) *gp += "\n";
+    for (const FigurePoint& p : lines[i]) {
+      if (std::isfinite(p.x) && std::isfinite(p.y)) *gp += StringPrintf("%.9g %.9g\n", p.x, p.y);
+    }
+  }
+  *gp += "EOD\n";
 }
 
-std::string DwellRows(const FigureSweep& s, const char* direction, const char* x, const char* y) {
-  return StringPrintf(
-      "(strcol('sweep') eq %s && strcol('direction') eq \"%s\" ? column('%s') : "
-      "NaN):(%s)",
-      Quoted(s.id).c_str(), direction, x, y);
+bool HasPoints(const std::vector<FigureLine>& lines) {
+  return std::any_of(lines.begin(), lines.end(),
+                     [](const FigureLine& line) { return !line.empty(); });
 }
 
-std::string SweepFigure(const FigureSweep& s) {
-  const char* x = s.kind == SweepKind::kFrequency ? "freq_hz" : "a_base";
+// One `plot` of the datablocks that have points: each element is
+// {block name, lines, style and title}.
+struct PlotElement {
+  std::string block;
+  std::vector<FigureLine> lines;
+  std::string style;
+};
+
+std::string Plot(const std::string& prefix, const std::vector<PlotElement>& elements,
+                 const std::string& extra) {
+  std::string gp;
+  std::vector<std::string> parts;
+  for (const PlotElement& element : elements) {
+    if (!HasPoints(element.lines)) continue;
+    AppendBlock(prefix + element.block, element.lines, &gp);
+    parts.push_back("$" + prefix + element.block + " using 1:2 " + element.style);
+  }
+  if (!extra.empty()) parts.push_back(extra);
+  return gp + "plot " + boost::algorithm::join(parts, ", \\\n  ") + "\n";
+}
+
+std::string SweepFigure(const FigureSet& figures, const FigureSweep& s, size_t index) {
+  const std::string prefix = "s" + std::to_string(index) + "_";
+  const std::string title = s.id + " (" + s.role + "): " + SweepKindName(s.kind) + " sweep at " +
+                            s.held + (s.notes.empty() ? "" : "\n") +
+                            boost::algorithm::join(s.notes, "\n");
+  const char* dwell_size = s.up.size() + s.down.size() > 400 ? "0.35" : "1.1";
   std::ostringstream gp;
   gp << "# " << s.id << " (" << s.role << "): " << SweepKindName(s.kind) << " sweep at " << s.held
      << "\n";
   gp << "set output \"" << FigureFileStem(s) << ".\".fmt\n";
-  gp << "dwell_size = " << (s.dwells > 400 ? "0.35" : "1.1") << "\n";
   gp << "set multiplot\n"
         "set origin 0, 0.3\nset size 1, 0.7\nset lmargin 12\nset format x \"\"\nunset xlabel\n";
-  gp << "set title "
-     << Quoted(s.id + " (" + s.role + "): " + SweepKindName(s.kind) + " sweep at " + s.held)
-     << "\n";
+  gp << "set title " << Quoted(title) << "\n";
   gp << "set ylabel \"a [\".amplitude_unit.\"]\"\n";
-  gp << (s.kind == SweepKind::kFrequency ? "set key at graph 0.02, graph 0.72 left top\n"
-                                         : "set key bottom right\n");
-  gp << "set label 1 estimates at graph 0.02, graph 0.96 left front font \",9\"\n";
+  // The key under the corner's lines (about 0.037 of the graph's height each).
+  const double key_top = 0.93 - 0.037 * static_cast<double>(figures.corner_lines.size());
+  gp << (s.kind == SweepKind::kFrequency
+             ? StringPrintf("set key at graph 0.02, graph %.3f left top\n", key_top)
+             : std::string("set key inside bottom right\n"));
+  gp << "set label 1 estimates at graph 0.02, graph 0.96 left front boxed font \",9\"\n";
   for (size_t i = 0; i < s.jump_lines.size(); ++i) {
     gp << StringPrintf(
-        "set arrow %zu from %.17g, graph 0 to %.17g, graph 1 nohead dt 3 lc rgb "
-        "\"#888888\"\n",
+        "set arrow %zu from %.17g, graph 0 to %.17g, graph 1 nohead dt 3 lc rgb \"#888888\"\n",
         i + 1, s.jump_lines[i], s.jump_lines[i]);
   }
-  gp << "plot for [s=0:" << s.segments - 1 << "] curves using "
-     << CurveRows(s,
-                  "strcol('curve') eq \"response\" && column('segment') == s && "
-                  "column('stable') == 1",
-                  x)
-     << " with lines lw 2 lc rgb \"black\" title (s == 0 ? \"stable\" : \"\"), \\\n"
-     << "  for [s=0:" << s.segments - 1 << "] curves using "
-     << CurveRows(s,
-                  "strcol('curve') eq \"response\" && column('segment') == s && "
-                  "column('stable') == 0",
-                  x)
-     << " with lines lw 2 dt 2 lc rgb \"black\" title (s == 0 ? \"unstable\" : \"\"), \\\n"
-     << "  curves using " << CurveRows(s, "strcol('curve') eq \"backbone\"", x)
-     << (s.kind == SweepKind::kFrequency ? " with lines dt 3" : " with points pt 6 ps 1.5")
-     << " lc rgb \"#1f77b4\" title \"backbone\", \\\n"
-     << "  curves using " << CurveRows(s, "strcol('fold') ne \"\"", x)
-     << " with points pt 7 ps 1.3 lc rgb \"#d62728\" title \"folds\", \\\n"
-     << "  dwells using " << DwellRows(s, "up", x, "column('a')")
-     << " with points pt 8 ps dwell_size lc rgb \"#2ca02c\" title \"up dwells\", \\\n"
-     << "  dwells using " << DwellRows(s, "down", x, "column('a')")
-     << " with points pt 10 ps dwell_size lc rgb \"#ff7f0e\" title \"down dwells\"\n";
+  const std::string up_style =
+      std::string("with points pt 8 ps ") + dwell_size + " lc rgb \"#2ca02c\" title \"up dwells\"";
+  const std::string down_style = std::string("with points pt 10 ps ") + dwell_size +
+                                 " lc rgb \"#ff7f0e\" title \"down dwells\"";
+  gp << Plot(prefix,
+             {{"stable", s.stable, "with lines lw 2 lc rgb \"black\" title \"stable\""},
+              {"unstable", s.unstable, "with lines lw 2 dt 2 lc rgb \"black\" title \"unstable\""},
+              {"backbone",
+               {s.backbone},
+               std::string(s.kind == SweepKind::kFrequency ? "with lines dt 3"
+                                                           : "with points pt 6 ps 1.5") +
+                   " lc rgb \"#1f77b4\" title \"backbone\""},
+              {"folds", {s.folds}, "with points pt 7 ps 1.3 lc rgb \"#d62728\" title \"folds\""},
+              {"up", {s.up}, up_style},
+              {"down", {s.down}, down_style}},
+             s.jump_lines.empty()
+                 ? ""
+                 : "NaN with lines dt 3 lc rgb \"#888888\" title \"measured jump bracket\"");
   gp << "unset label 1\nunset arrow\nunset title\n";
   gp << "set origin 0, 0\nset size 1, 0.3\nset format x \"% h\"\n";
   gp << "set xlabel "
-     << Quoted(s.kind == SweepKind::kFrequency ? "drive frequency [Hz]" : "base level a_base")
-     << "\nset ylabel \"a - a_model\"\nunset key\n";
-  gp << "plot dwells using " << DwellRows(s, "up", x, "column('a') - column('a_model')")
-     << " with points pt 8 ps dwell_size lc rgb \"#2ca02c\" notitle, \\\n"
-     << "  dwells using " << DwellRows(s, "down", x, "column('a') - column('a_model')")
-     << " with points pt 10 ps dwell_size lc rgb \"#ff7f0e\" notitle, 0 with lines lc rgb "
-        "\"black\" notitle\n";
+     << Quoted(s.kind == SweepKind::kFrequency ? "drive frequency [Hz]"
+                                               : "base level a_base [" + figures.control_unit + "]")
+     << "\nset ylabel " << Quoted(figures.residual_label) << "\nunset key\n";
+  gp << Plot(prefix + "r",
+             {{"up", {s.up_residual}, up_style}, {"down", {s.down_residual}, down_style}},
+             "0 with lines lc rgb \"black\" notitle");
   gp << "unset multiplot\nset format x \"% h\"\nunset output\n\n";
   return gp.str();
 }
@@ -139,7 +162,9 @@ std::string FigureFileStem(const FigureSweep& sweep) {
 
 std::string GnuplotFigureScript(const FigureSet& figures) {
   std::string script = Preamble(figures);
-  for (const FigureSweep& sweep : figures.sweeps) script += SweepFigure(sweep);
+  for (size_t i = 0; i < figures.sweeps.size(); ++i) {
+    script += SweepFigure(figures, figures.sweeps[i], i);
+  }
   return script;
 }
 
@@ -149,7 +174,7 @@ RenderedFigures RenderFigures(const std::vector<NamedFile>& inputs) {
   if (std::system("command -v gnuplot > /dev/null 2>&1") != 0) {
     out.warning =
         "gnuplot was not found on PATH, so no figures were drawn (install gnuplot-nox; "
-        "figures.gp beside the CSVs draws them later)";
+        "figures.gp draws them later)";
     return out;
   }
   std::string pattern = (fs::temp_directory_path() / "dwellfit-figures-XXXXXX").string();
@@ -162,11 +187,20 @@ RenderedFigures RenderFigures(const std::vector<NamedFile>& inputs) {
   for (const NamedFile& file : inputs) {
     std::ofstream(folder / file.first, std::ios::binary) << file.second;
   }
-  for (const char* format : {"png", "svg"}) {
+  // One gnuplot a format, the two side by side.
+  auto run = [&folder](const std::string& format) {
     const std::string command = "cd '" + folder.string() + "' && gnuplot -e \"fmt='" + format +
-                                "'\" " + kFigureScriptName + " > gnuplot.log 2>&1";
-    if (std::system(command.c_str()) != 0) {
-      out.warning = "gnuplot failed, so no figures were drawn: " + ReadFile(folder / "gnuplot.log");
+                                "'\" " + kFigureScriptName + " > gnuplot-" + format + ".log 2>&1";
+    return std::system(command.c_str());
+  };
+  std::future<int> svg = std::async(std::launch::async, run, "svg");
+  const int png_status = run("png");
+  const int svg_status = svg.get();
+  for (const auto& [status, format] :
+       {std::pair{png_status, "png"}, std::pair{svg_status, "svg"}}) {
+    if (status != 0) {
+      out.warning = "gnuplot failed, so no figures were drawn: " +
+                    ReadFile(folder / ("gnuplot-" + std::string(format) + ".log"));
       fs::remove_all(folder);
       return out;
     }

@@ -1,13 +1,15 @@
-// Chapter-style figures (the chapter's Figures 3.4-3.14) drawn by gnuplot
-// from the files identify writes: per sweep id, the measured up and down
-// dwells with distinct markers over the model's curve (stable branches
-// solid, unstable dashed, folds marked, the backbone dotted), the measured
-// jump brackets as vertical lines, the estimates in a corner, and below it
-// the residual a - a_model of every dwell.
+// Chapter-style figures (the chapter's Figures 3.4-3.14) drawn by gnuplot:
+// per sweep id, the measured up and down dwells with distinct markers over
+// the model's curve (stable branches solid, unstable dashed, folds marked,
+// the backbone dotted), the measured jump brackets as labelled vertical
+// lines, the estimates and the run's status in a corner, the model's jumps
+// against the measured ones under the title, and below it the residual of
+// every dwell in the fit's own error measure.
 //
-// The script (figures.gp) reads curves.csv and predictions.csv from its own
-// folder and writes <stem>.png, or <stem>.svg with `gnuplot -e "fmt='svg'"
-// figures.gp`; a user can restyle it and run it again.
+// The script (figures.gp) carries its data as gnuplot datablocks, one set a
+// sweep, so that each plot reads only its own points; `gnuplot figures.gp`
+// writes <stem>.png, `gnuplot -e "fmt='svg'" figures.gp` <stem>.svg, and a
+// user can restyle it and run it again with nothing beside it.
 #ifndef DWELLFIT_ESTIMATOR_CURVES_FIGURES_H_
 #define DWELLFIT_ESTIMATOR_CURVES_FIGURES_H_
 
@@ -21,20 +23,33 @@ namespace dwellfit {
 
 inline constexpr char kFigureScriptName[] = "figures.gp";
 
+// A point of a figure: x is the swept control (Hz, or a_base in the data's
+// unit), y the amplitude or the residual.
+struct FigurePoint {
+  double x = 0.0;
+  double y = 0.0;
+};
+using FigureLine = std::vector<FigurePoint>;
+
 struct FigureSweep {
   std::string id;  // sweep id, as in curves.csv and predictions.csv
   SweepKind kind = SweepKind::kFrequency;
   std::string role;                // "fitted" or "validation"
-  std::string held;                // the held control in words: "a_base = 0.01", "41.5 Hz"
-  int segments = 1;                // response segments of the sweep in curves.csv
-  int dwells = 0;                  // measured dwells (up and down): sets the marker size
-  std::vector<double> jump_lines;  // measured jump bracket edges [Hz or a_base]
+  std::string held;                // the held control in words: "a_base = 0.01 g", "41.5 Hz"
+  std::vector<std::string> notes;  // under the title: the model's jumps against the measured
+  std::vector<FigureLine> stable, unstable;  // the model's branches, one line per run
+  FigureLine backbone, folds;
+  FigureLine up, down;                    // measured dwells
+  FigureLine up_residual, down_residual;  // their residuals (NaN where the model has none)
+  std::vector<double> jump_lines;         // measured jump bracket edges [Hz or a_base]
 };
 
 struct FigureSet {
   std::vector<FigureSweep> sweeps;
-  std::vector<std::string> corner_lines;  // the estimates, one per line
+  std::vector<std::string> corner_lines;  // the estimates and the status, one per line
   std::string amplitude_unit = "data's unit";
+  std::string control_unit;    // unit of a_base, for an amplitude sweep's x axis
+  std::string residual_label;  // the fit's error measure, for the residual axis
 };
 
 // "figure_<role>_<id>" with characters outside [A-Za-z0-9._-] replaced by '_'.
@@ -52,10 +67,10 @@ struct RenderedFigures {
   std::vector<NamedFile> images;  // <stem>.png and <stem>.svg, by name
 };
 
-// Writes `inputs` (the CSVs and the script named kFigureScriptName) into a
-// fresh temporary folder, runs gnuplot there for PNG and for SVG, and returns
-// the images it made; the folder is removed. Never throws for a missing or
-// failing gnuplot: the result then says why in `warning`.
+// Writes `inputs` (the script named kFigureScriptName and the files it reads)
+// into a fresh temporary folder, runs gnuplot there for PNG and for SVG, the
+// two side by side, and returns the images they made; the folder is removed. Never throws for a
+// missing or failing gnuplot: the result then says why in `warning`.
 RenderedFigures RenderFigures(const std::vector<NamedFile>& inputs);
 
 }  // namespace dwellfit

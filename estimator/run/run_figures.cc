@@ -1,6 +1,7 @@
 #include "dwellfit/estimator/run/run_figures.h"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <utility>
 
@@ -18,33 +19,99 @@ std::string HeldControl(const CurveSpec& spec) {
              : StringPrintf("%.6g Hz", RadPerSecondToHz(spec.omega_rad_s));
 }
 
+// The swept control as the figures show it: Hz, or a_base.
+double FigureX(SweepKind kind, double omega_rad_s, double a_base) {
+  return kind == SweepKind::kFrequency ? RadPerSecondToHz(omega_rad_s) : a_base;
+}
+
+// The model's branches: a line for each run of one stability, joined at the
+// fold where one run ends and the next starts.
+void AddCurveLines(const ResponseCurve& curve, FigureSweep* figure) {
+  const CurvePoint* previous = nullptr;
+  for (const CurvePoint& p : curve.points) {
+    const FigurePoint point{FigureX(curve.spec.kind, p.omega_rad_s, p.a_base), p.a};
+    std::vector<FigureLine>& lines = p.stable ? figure->stable : figure->unstable;
+    const bool joined = previous != nullptr && p.continues;
+    if (!joined || previous->segment != p.segment) {
+      if (joined) (previous->stable ? figure->stable : figure->unstable).back().push_back(point);
+      lines.emplace_back();
+    }
+    lines.back().push_back(point);
+    if (p.fold) figure->folds.push_back(point);
+    previous = &p;
+  }
+  for (const BackbonePoint& p : curve.backbone) {
+    figure->backbone.push_back({FigureX(curve.spec.kind, p.omega_rad_s, p.a_base), p.a});
+  }
+}
+
+// "jump_down: measured 194.2..194.6 Hz, model 196.1 Hz (+1.7 Hz, +0.88 % from the bracket's
+// centre)".
+std::string JumpNote(const Sweep& sweep, const PredictedJump& jump) {
+  const bool hz = sweep.kind == SweepKind::kFrequency;
+  auto shown = [&](double control) { return hz ? RadPerSecondToHz(control) : control; };
+  const char* unit = hz ? " Hz" : "";
+  std::string note =
+      StringPrintf("%s: measured %.5g..%.5g%s, model ", JumpKindName(jump.kind),
+                   shown(jump.bracket.control_before), shown(jump.bracket.control_after), unit);
+  if (!jump.exists) return note + "has no fold";
+  const double centre = shown(jump.bracket.centre());
+  const double error = shown(jump.control) - centre;
+  return note + StringPrintf("%.5g%s (%+.3g%s, %+.3g %% from the bracket centre%s)",
+                             shown(jump.control), unit, error, unit, 100.0 * error / centre,
+                             jump.inside ? ", inside" : "");
+}
+
+// The measured dwells and their residuals in the fit's error measure.
+void AddDwells(const SweepPrediction& prediction, const ResidualOptions& measure,
+               FigureSweep* figure) {
+  const Sweep& sweep = *prediction.sweep;
+  const bool up = sweep.direction == SweepDirection::kUp;
+  for (size_t i = 0; i < sweep.points.size(); ++i) {
+    const DwellPoint& point = sweep.points[i];
+    const double x = FigureX(sweep.kind, point.drive_frequency_rad_s, point.a_base);
+    const double a = point.amplitude;
+    const double model = prediction.model[i].a;
+    const double residual =
+        measure.error == ErrorMeasure::kAbsolute
+            ? a - model
+            : std::log(a + measure.amplitude_floor) - std::log(model + measure.amplitude_floor);
+    (up ? figure->up : figure->down).push_back({x, a});
+    (up ? figure->up_residual : figure->down_residual).push_back({x, residual});
+  }
+}
+
 FigureSweep MakeFigureSweep(const IdentificationReport& report, const ResponseCurve& curve) {
   FigureSweep figure;
   figure.id = curve.spec.name;
   figure.kind = curve.spec.kind;
   figure.held = HeldControl(curve.spec);
-  figure.segments = curve.points.empty() ? 1 : curve.points.back().segment + 1;
   figure.role = "validation";
+  AddCurveLines(curve, &figure);
   for (const SweepPrediction& prediction : report.predictions) {
     if (prediction.sweep->id != figure.id) continue;
     if (prediction.fitted) figure.role = "fitted";
-    figure.dwells += static_cast<int>(prediction.sweep->points.size());
+    AddDwells(prediction, report.options.solve.residual, &figure);
     for (const PredictedJump& jump : prediction.jumps) {
       if (!jump.measured) continue;
+      figure.notes.push_back(prediction.sweep->Name() + " " + JumpNote(*prediction.sweep, jump));
       for (double control : {jump.bracket.control_before, jump.bracket.control_after}) {
-        figure.jump_lines.push_back(figure.kind == SweepKind::kFrequency ? RadPerSecondToHz(control)
-                                                                         : control);
+        figure.jump_lines.push_back(FigureX(figure.kind, control, control));
       }
     }
   }
   return figure;
 }
 
-// The estimates as the figures' corner shows them: "eta_e = 100 ± 0.02",
-// omega in Hz, "(fixed)" for fixed parameters.
+// The figures' corner: the estimates with their 95 % intervals (omega in Hz),
+// fixed parameters and those held at a bound marked, and the run's status.
 std::vector<std::string> EstimateLines(const IdentificationReport& report) {
-  std::vector<std::string> lines;
   const ParameterUncertainty& u = report.uncertainty;
+  std::vector<std::string> lines = {u.available
+                                        ? "estimate [95 % interval, " + u.interval_kind + "]"
+                                        : "estimate (no interval: " + u.message + ")"};
+  std::vector<int> held;
+  if (!report.result.stages.empty()) held = report.result.stages.back().held_at_bound;
   for (int i = 0; i < kNumParameters; ++i) {
     const bool omega = i == kNaturalFrequency;
     const double scale = omega ? 1.0 / kTwoPi : 1.0;
@@ -52,12 +119,23 @@ std::vector<std::string> EstimateLines(const IdentificationReport& report) {
                                     report.result.parameters[i] * scale);
     if (report.options.fixed[i]) {
       line += " (fixed)";
+    } else if (std::find(held.begin(), held.end(), i) != held.end()) {
+      line += " (held at its bound)";
     } else if (u.available) {
-      line += StringPrintf(" ± %.2g", u.standard_error[i] * scale);
+      line += StringPrintf(" [%.4g, %.4g]", u.ci95_low[i] * scale, u.ci95_high[i] * scale);
     }
     lines.push_back(line);
   }
+  lines.push_back(StringPrintf("status: %s, cost %.6g", FitStatusName(report.result.status),
+                               report.result.final_cost));
   return lines;
+}
+
+// The y label of the residual panel: the fit's own error measure.
+std::string ResidualLabel(const ResidualOptions& measure, const std::string& unit) {
+  if (measure.error == ErrorMeasure::kAbsolute) return "a - a_model [" + unit + "]";
+  if (measure.amplitude_floor == 0.0) return "ln a - ln a_model";
+  return StringPrintf("ln(a + f) - ln(a_model + f), f = %.3g", measure.amplitude_floor);
 }
 
 }  // namespace
@@ -87,19 +165,14 @@ void AppendCurvesAndFigures(const IdentificationReport& report, RunCurves traced
   const std::vector<ResponseCurve>& curves = traced.curves;
   FigureSet figures;
   figures.corner_lines = EstimateLines(report);
+  figures.control_unit = figures.amplitude_unit;
+  figures.residual_label = ResidualLabel(report.options.solve.residual, figures.amplitude_unit);
   for (const ResponseCurve& curve : curves)
     figures.sweeps.push_back(MakeFigureSweep(report, curve));
   files->emplace_back("curves.csv", std::move(traced.csv));
   files->emplace_back(kFigureScriptName, GnuplotFigureScript(figures));
   if (!render) return;
-  std::vector<NamedFile> inputs;
-  for (const NamedFile& file : *files) {
-    if (file.first == "curves.csv" || file.first == "predictions.csv" ||
-        file.first == kFigureScriptName) {
-      inputs.push_back(file);
-    }
-  }
-  const RenderedFigures rendered = RenderFigures(inputs);
+  const RenderedFigures rendered = RenderFigures({files->back()});
   if (!rendered.rendered) {
     LOG(WARNING) << rendered.warning;
     out << "warning: " << rendered.warning << "\n";

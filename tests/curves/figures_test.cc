@@ -2,6 +2,7 @@
 
 #include <stdlib.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -50,6 +51,13 @@ TEST(Figures, IdentifyDrawsAValidPngAndSvgPerSweep) {
   EXPECT_THAT(svg, HasSubstr("</svg>"));
   EXPECT_THAT(svg, HasSubstr("A41.8 (validation): amplitude sweep at 41.8 Hz"));
   EXPECT_THAT(svg, HasSubstr("eta_e = 100"));
+  // The corner names its intervals and the run's status; the residual axis
+  // is the fit's error measure (the thesis config fits the relative error).
+  EXPECT_THAT(svg, HasSubstr("estimate [95 % interval, gauss_newton]"));
+  EXPECT_THAT(svg, HasSubstr("status: converged"));
+  EXPECT_THAT(svg, HasSubstr("ln a - ln a_model"));
+  EXPECT_THAT(svg, HasSubstr("measured jump bracket"));
+  EXPECT_THAT(svg, HasSubstr("from the bracket centre"));
 
   // Every file is in the manifest, the script and the curves beside them.
   const std::string manifest = ReadFile(dir / "manifest.yaml");
@@ -87,6 +95,39 @@ TEST(Figures, AMissingGnuplotIsAWarningNotAnError) {
   EXPECT_FALSE(rendered.rendered);
   EXPECT_THAT(rendered.warning, HasSubstr("gnuplot was not found"));
   EXPECT_TRUE(rendered.images.empty());
+}
+
+// The script carries each sweep's points in datablocks of its own: a blank
+// line between two lines of a branch, non-finite points left out, and a set
+// without points neither written nor plotted.
+TEST(Figures, EachSweepsPointsAreInItsOwnDatablocks) {
+  FigureSet figures;
+  figures.residual_label = "a - a_model [mm]";
+  FigureSweep sweep;
+  sweep.id = "F1";
+  sweep.role = "fitted";
+  sweep.held = "a_base = 1";
+  sweep.stable = {{{10, 1}, {11, 2}}, {{13, 0.5}, {14, 0.25}}};
+  sweep.up = {{10, 1.5}, {12, std::nan("")}};
+  sweep.up_residual = {{10, 0.5}};
+  figures.sweeps = {sweep, sweep};
+  figures.sweeps[1].id = "F2";
+  const std::string script = GnuplotFigureScript(figures);
+  EXPECT_THAT(script, HasSubstr("$s0_stable << EOD\n10 1\n11 2\n\n13 0.5\n14 0.25\nEOD\n"));
+  EXPECT_THAT(script, HasSubstr("$s0_up << EOD\n10 1.5\nEOD\n"));
+  EXPECT_THAT(script, HasSubstr("$s0_rup << EOD\n10 0.5\nEOD\n"));
+  EXPECT_THAT(script, HasSubstr("$s1_stable << EOD\n"));
+  EXPECT_THAT(script, HasSubstr("set ylabel \"a - a_model [mm]\""));
+  EXPECT_THAT(script, ::testing::Not(HasSubstr("$s0_unstable")));
+  EXPECT_THAT(script, ::testing::Not(HasSubstr("$s0_down")));
+  EXPECT_THAT(script, ::testing::Not(HasSubstr(".csv")));
+
+  // gnuplot draws it with nothing beside it.
+  const RenderedFigures rendered = RenderFigures({{kFigureScriptName, script}});
+  ASSERT_TRUE(rendered.rendered) << rendered.warning;
+  ASSERT_EQ(rendered.images.size(), 4u);
+  EXPECT_EQ(rendered.images[0].first, "figure_fitted_F1.png");
+  EXPECT_EQ(rendered.images[3].first, "figure_fitted_F2.svg");
 }
 
 TEST(Figures, FileStemsAreSafeNames) {
