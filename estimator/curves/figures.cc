@@ -150,6 +150,90 @@ std::string ReadFile(const std::filesystem::path& path) {
   return content.str();
 }
 
+// The number of distinct held values among the jumps of `kind`.
+size_t HeldValues(const std::vector<OverviewJump>& overview, SweepKind kind) {
+  std::vector<double> held;
+  for (const OverviewJump& jump : overview) {
+    if (jump.sweep_kind == kind) held.push_back(jump.held);
+  }
+  std::sort(held.begin(), held.end());
+  return static_cast<size_t>(std::unique(held.begin(), held.end()) - held.begin());
+}
+
+// The rows of the overview's datablocks for one jump kind.
+struct OverviewRows {
+  std::string measured, model, band;
+};
+OverviewRows OverviewData(std::vector<OverviewJump> jumps) {
+  std::sort(jumps.begin(), jumps.end(),
+            [](const OverviewJump& a, const OverviewJump& b) { return a.held < b.held; });
+  OverviewRows rows;
+  for (const OverviewJump& j : jumps) {
+    rows.measured +=
+        StringPrintf("%.9g %.9g %.9g %.9g\n", j.held, 0.5 * (j.measured_low + j.measured_high),
+                     j.measured_low, j.measured_high);
+    if (std::isfinite(j.model)) rows.model += StringPrintf("%.9g %.9g\n", j.held, j.model);
+    if (std::isfinite(j.band_low)) {
+      rows.band += StringPrintf("%.9g %.9g %.9g %.9g\n", j.held, j.model, j.band_low, j.band_high);
+    }
+  }
+  return rows;
+}
+
+// The overview of the jumps of `sweep_kind`: per jump kind, the measured
+// brackets (error bars about their centres), the model's folds (a line over
+// the held values) and the validation sweeps' 95 % prediction intervals.
+std::string OverviewFigure(const FigureSet& figures, SweepKind sweep_kind) {
+  const bool frequency = sweep_kind == SweepKind::kFrequency;
+  const std::string level = "base level a_base [" + figures.control_unit + "]";
+  const bool has_band =
+      std::any_of(figures.overview.begin(), figures.overview.end(), [&](const OverviewJump& j) {
+        return j.sweep_kind == sweep_kind && std::isfinite(j.band_low);
+      });
+  std::string gp =
+      StringPrintf("# Where the sweeps jump\nset output \"%s.\".fmt\n", kOverviewFigureStem);
+  gp += std::string("set title \"") +
+        (frequency ? "Jump frequencies against the base level"
+                   : "Jump levels against the drive frequency") +
+        ": measured brackets and the model's folds" +
+        (has_band ? ", with 95 % prediction intervals\"\n" : "\"\n");
+  gp += "set xlabel " + Quoted(frequency ? level : "drive frequency [Hz]") + "\nset ylabel " +
+        Quoted(frequency ? "jump frequency [Hz]" : "jump " + level) +
+        "\nset key inside top left\nset format x \"% h\"\n"
+        "set origin 0, 0\nset size 1, 1\nset offsets graph 0.03, graph 0.03, 0, 0\n";
+  std::vector<std::string> parts;
+  for (JumpKind kind : {JumpKind::kJumpDown, JumpKind::kJumpUp}) {
+    std::vector<OverviewJump> jumps;
+    for (const OverviewJump& jump : figures.overview) {
+      if (jump.kind == kind && jump.sweep_kind == sweep_kind) jumps.push_back(jump);
+    }
+    const OverviewRows rows = OverviewData(jumps);
+    const std::string name = JumpKindName(kind);
+    const bool down = kind == JumpKind::kJumpDown;
+    struct Element {
+      const char* block;
+      std::string rows, columns, style;
+    };
+    // The bands first, so that the model and the measurements lie on them.
+    for (const Element& e :
+         {Element{"band", rows.band, "1:2:3:4",
+                  StringPrintf("with yerrorbars pt 0 lw 5 lc rgb \"%s\"",
+                               down ? "#f2b8b8" : "#b8d4ee")},
+          Element{"model", rows.model, "1:2",
+                  StringPrintf("with linespoints pt 6 lw 2 lc rgb \"%s\"",
+                               down ? "#d62728" : "#1f77b4")},
+          Element{"measured", rows.measured, "1:2:3:4",
+                  StringPrintf("with yerrorbars pt %d ps 0.8 lc rgb \"black\"", down ? 7 : 5)}}) {
+      if (e.rows.empty()) continue;
+      const std::string id = "$overview_" + name + "_" + e.block;
+      gp += id + " << EOD\n" + e.rows + "EOD\n";
+      parts.push_back(id + " using " + e.columns + " " + e.style + " title \"" + name + ", " +
+                      e.block + "\"");
+    }
+  }
+  return gp + "plot " + boost::algorithm::join(parts, ", \\\n  ") + "\nunset output\nset offsets\n";
+}
+
 }  // namespace
 
 std::string FigureFileStem(const FigureSweep& sweep) {
@@ -164,6 +248,9 @@ std::string GnuplotFigureScript(const FigureSet& figures) {
   std::string script = Preamble(figures);
   for (size_t i = 0; i < figures.sweeps.size(); ++i) {
     script += SweepFigure(figures, figures.sweeps[i], i);
+  }
+  for (SweepKind kind : {SweepKind::kFrequency, SweepKind::kAmplitude}) {
+    if (HeldValues(figures.overview, kind) >= 2) return script + OverviewFigure(figures, kind);
   }
   return script;
 }

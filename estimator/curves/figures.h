@@ -44,13 +44,31 @@ struct FigureSweep {
   std::vector<double> jump_lines;         // measured jump bracket edges [Hz or a_base]
 };
 
+// One measured jump for the overview figure: where the sweeps jump against
+// their held control (the jump frequency against the base level for
+// frequency sweeps, the jump level against the drive frequency for amplitude
+// sweeps). Swept and held values in Hz or a_base; NaN where one is missing.
+struct OverviewJump {
+  SweepKind sweep_kind = SweepKind::kFrequency;
+  double held = 0.0;  // the sweep's a_base, or its drive frequency [Hz]
+  JumpKind kind = JumpKind::kJumpDown;
+  double measured_low = 0.0, measured_high = 0.0;  // the measured bracket
+  double model = 0.0;                              // the model's fold
+  double band_low = 0.0, band_high = 0.0;          // 95 % prediction interval (validation)
+};
+
 struct FigureSet {
   std::vector<FigureSweep> sweeps;
+  // Drawn as figure_overview_jumps when the frequency sweeps' jumps span two
+  // or more levels (else the amplitude sweeps' two or more frequencies).
+  std::vector<OverviewJump> overview;
   std::vector<std::string> corner_lines;  // the estimates and the status, one per line
   std::string amplitude_unit = "data's unit";
   std::string control_unit;    // unit of a_base, for an amplitude sweep's x axis
   std::string residual_label;  // the fit's error measure, for the residual axis
 };
+
+inline constexpr char kOverviewFigureStem[] = "figure_overview_jumps";
 
 // "figure_<role>_<id>" with characters outside [A-Za-z0-9._-] replaced by '_'.
 std::string FigureFileStem(const FigureSweep& sweep);

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
+#include <tuple>
 #include <utility>
 
 #include "dwellfit/estimator/common/input_error.h"
@@ -103,6 +105,55 @@ FigureSweep MakeFigureSweep(const IdentificationReport& report, const ResponseCu
   return figure;
 }
 
+// The prediction interval of `sweep`'s jump of `kind` (frequency sweeps of
+// validation levels), or NaN.
+std::pair<double, double> JumpBand(const ValidationIntervals& intervals, const Sweep& sweep,
+                                   JumpKind kind) {
+  const HeldOutQuantity quantity =
+      kind == JumpKind::kJumpDown ? HeldOutQuantity::kJumpDown : HeldOutQuantity::kJumpUp;
+  for (const ValidationLevel& level : intervals.levels) {
+    for (const HeldOutPrediction& held : level.predictions) {
+      if (held.sweep == sweep.Name() && held.quantity == quantity &&
+          std::isfinite(held.half_width)) {
+        return {held.predicted - held.half_width, held.predicted + held.half_width};
+      }
+    }
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  return {nan, nan};
+}
+
+// Every measured jump with the model's fold beside it, for the overview.
+std::vector<OverviewJump> OverviewJumps(const IdentificationReport& report) {
+  std::vector<OverviewJump> overview;
+  for (const SweepPrediction& prediction : report.predictions) {
+    const Sweep& sweep = *prediction.sweep;
+    if (sweep.points.empty()) continue;
+    const DwellPoint& first = sweep.points.front();
+    for (const PredictedJump& jump : prediction.jumps) {
+      if (!jump.measured) continue;
+      OverviewJump row;
+      row.sweep_kind = sweep.kind;
+      row.kind = jump.kind;
+      row.held = sweep.kind == SweepKind::kFrequency
+                     ? first.a_base
+                     : RadPerSecondToHz(first.drive_frequency_rad_s);
+      const double before =
+          FigureX(sweep.kind, jump.bracket.control_before, jump.bracket.control_before);
+      const double after =
+          FigureX(sweep.kind, jump.bracket.control_after, jump.bracket.control_after);
+      row.measured_low = std::min(before, after);
+      row.measured_high = std::max(before, after);
+      row.model = jump.exists ? FigureX(sweep.kind, jump.control, jump.control)
+                              : std::numeric_limits<double>::quiet_NaN();
+      std::tie(row.band_low, row.band_high) =
+          JumpBand(report.validation_intervals, sweep, jump.kind);
+      overview.push_back(row);
+    }
+  }
+  return overview;
+}
+
 // The figures' corner: the estimates with their 95 % intervals (omega in Hz),
 // fixed parameters and those held at a bound marked, and the run's status.
 std::vector<std::string> EstimateLines(const IdentificationReport& report) {
@@ -165,6 +216,7 @@ void AppendCurvesAndFigures(const IdentificationReport& report, RunCurves traced
   const std::vector<ResponseCurve>& curves = traced.curves;
   FigureSet figures;
   figures.corner_lines = EstimateLines(report);
+  figures.overview = OverviewJumps(report);
   figures.control_unit = figures.amplitude_unit;
   figures.residual_label = ResidualLabel(report.options.solve.residual, figures.amplitude_unit);
   for (const ResponseCurve& curve : curves)

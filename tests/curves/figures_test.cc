@@ -58,6 +58,9 @@ TEST(Figures, IdentifyDrawsAValidPngAndSvgPerSweep) {
   EXPECT_THAT(svg, HasSubstr("ln a - ln a_model"));
   EXPECT_THAT(svg, HasSubstr("measured jump bracket"));
   EXPECT_THAT(svg, HasSubstr("from the bracket centre"));
+  // Three amplitude sweeps at three drive frequencies: the overview.
+  EXPECT_THAT(ReadFile(dir / "figure_overview_jumps.svg"),
+              HasSubstr("Jump levels against the drive frequency"));
 
   // Every file is in the manifest, the script and the curves beside them.
   const std::string manifest = ReadFile(dir / "manifest.yaml");
@@ -128,6 +131,40 @@ TEST(Figures, EachSweepsPointsAreInItsOwnDatablocks) {
   ASSERT_EQ(rendered.images.size(), 4u);
   EXPECT_EQ(rendered.images[0].first, "figure_fitted_F1.png");
   EXPECT_EQ(rendered.images[3].first, "figure_fitted_F2.svg");
+}
+
+// The overview draws the frequency sweeps' jumps against their levels once
+// two levels have them: the measured brackets about their centres, the
+// model's folds and the prediction intervals, each in its own datablock.
+TEST(Figures, TheOverviewDrawsJumpsAgainstTheLevel) {
+  const double nan = std::nan("");
+  FigureSet figures;
+  figures.control_unit = "g";
+  figures.overview = {
+      {SweepKind::kFrequency, 0.08, JumpKind::kJumpDown, 194.0, 195.0, 194.6, nan, nan},
+      {SweepKind::kFrequency, 0.04, JumpKind::kJumpDown, 168.0, 169.0, 170.0, 160.0, 180.0},
+      {SweepKind::kAmplitude, 41.5, JumpKind::kJumpUp, 0.03, 0.04, 0.035, nan, nan}};
+  std::string script = GnuplotFigureScript(figures);
+  EXPECT_THAT(script, HasSubstr("set output \"figure_overview_jumps.\".fmt"));
+  EXPECT_THAT(script, HasSubstr("Jump frequencies against the base level"));
+  EXPECT_THAT(script, HasSubstr("with 95 % prediction intervals"));
+  // Sorted by level; the bracket's centre, low and high.
+  EXPECT_THAT(script, HasSubstr("$overview_jump_down_measured << EOD\n0.04 168.5 168 169\n"
+                                "0.08 194.5 194 195\nEOD\n"));
+  EXPECT_THAT(script, HasSubstr("$overview_jump_down_model << EOD\n0.04 170\n0.08 194.6\nEOD\n"));
+  EXPECT_THAT(script, HasSubstr("$overview_jump_down_band << EOD\n0.04 170 160 180\nEOD\n"));
+  EXPECT_THAT(script, HasSubstr("base level a_base [g]"));
+  EXPECT_THAT(script, ::testing::Not(HasSubstr("jump_up")));  // the amplitude sweep's one level
+  const RenderedFigures rendered = RenderFigures({{kFigureScriptName, script}});
+  ASSERT_TRUE(rendered.rendered) << rendered.warning;
+  ASSERT_EQ(rendered.images.size(), 2u);
+  EXPECT_EQ(rendered.images[0].first, "figure_overview_jumps.png");
+
+  // One level: no overview.
+  figures.overview.pop_back();
+  figures.overview.pop_back();
+  script = GnuplotFigureScript(figures);
+  EXPECT_THAT(script, ::testing::Not(HasSubstr("overview")));
 }
 
 TEST(Figures, FileStemsAreSafeNames) {
