@@ -27,6 +27,8 @@ packages=(
   gnuplot-nox
   # The library-state check (tests/check_library_state.py).
   python3
+  # The browser test of report.html (tests/run/report_in_browser.py).
+  chromium
   # The fuzzers (tests/fuzz): Clang with its libFuzzer and sanitizer runtimes.
   clang-14
   libclang-rt-14-dev

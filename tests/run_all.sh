@@ -39,13 +39,14 @@ cmake --build build-sanitize -j"${jobs}"
 # that lighter tests run under the sanitizers too (the beam fit on one and three
 # threads, the profile of beam-selected.yaml, coverage on a few replicas,
 # select_model's quiet run, the model-selection unit tests), and the packaging
-# tests (outside projects built against the install) run in the Release step
-# only. Under ASan the two largest took 229 s and 175 s, the rest some 300 s.
+# tests (outside projects built against the install) and the browser tests
+# (report.html in Chromium, whose writing the identify tests run) run in the
+# Release step only. Under ASan the two largest took 229 s and 175 s, the rest some 300 s.
 heavy='MeasuredBeamFilesAreByteIdenticalOnOneAndTwoThreads|clamped-beam-27C/beam\.yaml|'
 heavy+='UncertaintyCoverage\.|IdentifyOnTheMeasuredBeamReportsProfileIntervals|'
 heavy+='ModelSelectionBeam\.|method_comparison_reproducible|select_model_verbose_shows_ceres'
 UBSAN_OPTIONS=print_stacktrace=1 ctest --test-dir build-sanitize --output-on-failure -j"${jobs}" \
-  -E "${heavy}" -LE packaging
+  -E "${heavy}" -LE "packaging|browser"
 
 step "fuzzers (Clang, libFuzzer, ASan+UBSan)"
 cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo \

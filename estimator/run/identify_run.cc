@@ -10,6 +10,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
+#include "dwellfit/estimator/run/html_report.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/run/run_figures.h"
 #include "glog/logging.h"
@@ -170,7 +171,9 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
   PrintReport(report, out);
   std::vector<NamedFile> files = {{"result.yaml", ReportToYaml(report)},
                                   {"predictions.csv", std::move(predictions_csv)}};
-  AppendCurvesAndFigures(report, std::move(curves), &files, out, run_options.render_figures);
+  const std::string figures_note =
+      AppendCurvesAndFigures(report, std::move(curves), &files, out, run_options.render_figures);
+  files.emplace_back(kHtmlReportName, ReportToHtml(report, files, figures_note));
   WriteFilesAtomically(config.output_dir, files);
   out << "\nwrote into " << config.output_dir << ":";
   for (const NamedFile& file : files) out << " " << file.first;

@@ -47,23 +47,6 @@ void AddCurveLines(const ResponseCurve& curve, FigureSweep* figure) {
   }
 }
 
-// "jump_down: measured 194.2..194.6 Hz, model 196.1 Hz (+1.7 Hz, +0.88 % from the bracket's
-// centre)".
-std::string JumpNote(const Sweep& sweep, const PredictedJump& jump) {
-  const bool hz = sweep.kind == SweepKind::kFrequency;
-  auto shown = [&](double control) { return hz ? RadPerSecondToHz(control) : control; };
-  const char* unit = hz ? " Hz" : "";
-  std::string note =
-      StringPrintf("%s: measured %.5g..%.5g%s, model ", JumpKindName(jump.kind),
-                   shown(jump.bracket.control_before), shown(jump.bracket.control_after), unit);
-  if (!jump.exists) return note + "has no fold";
-  const double centre = shown(jump.bracket.centre());
-  const double error = shown(jump.control) - centre;
-  return note + StringPrintf("%.5g%s (%+.3g%s, %+.3g %% from the bracket centre%s)",
-                             shown(jump.control), unit, error, unit, 100.0 * error / centre,
-                             jump.inside ? ", inside" : "");
-}
-
 // The measured dwells and their residuals in the fit's error measure.
 void AddDwells(const SweepPrediction& prediction, const ResidualOptions& measure,
                FigureSweep* figure) {
@@ -191,6 +174,23 @@ std::string ResidualLabel(const ResidualOptions& measure, const std::string& uni
 
 }  // namespace
 
+// "jump_down: measured 194.2..194.6 Hz, model 196.1 Hz (+1.7 Hz, +0.88 % from the bracket's
+// centre)".
+std::string JumpNote(const Sweep& sweep, const PredictedJump& jump) {
+  const bool hz = sweep.kind == SweepKind::kFrequency;
+  auto shown = [&](double control) { return hz ? RadPerSecondToHz(control) : control; };
+  const char* unit = hz ? " Hz" : "";
+  std::string note =
+      StringPrintf("%s: measured %.5g..%.5g%s, model ", JumpKindName(jump.kind),
+                   shown(jump.bracket.control_before), shown(jump.bracket.control_after), unit);
+  if (!jump.exists) return note + "has no fold";
+  const double centre = shown(jump.bracket.centre());
+  const double error = shown(jump.control) - centre;
+  return note + StringPrintf("%.5g%s (%+.3g%s, %+.3g %% from the bracket centre%s)",
+                             shown(jump.control), unit, error, unit, 100.0 * error / centre,
+                             jump.inside ? ", inside" : "");
+}
+
 RunCurves TraceRunCurves(const ParameterVector& parameters,
                          const std::vector<const Sweep*>& sweeps) {
   RunCurves traced;
@@ -207,11 +207,11 @@ RunCurves TraceRunCurves(const ParameterVector& parameters,
   return traced;
 }
 
-void AppendCurvesAndFigures(const IdentificationReport& report, RunCurves traced,
-                            std::vector<NamedFile>* files, std::ostream& out, bool render) {
+std::string AppendCurvesAndFigures(const IdentificationReport& report, RunCurves traced,
+                                   std::vector<NamedFile>* files, std::ostream& out, bool render) {
   if (!traced.warning.empty()) {
     out << "warning: " << traced.warning << "\n";
-    return;
+    return traced.warning;
   }
   const std::vector<ResponseCurve>& curves = traced.curves;
   FigureSet figures;
@@ -223,14 +223,15 @@ void AppendCurvesAndFigures(const IdentificationReport& report, RunCurves traced
     figures.sweeps.push_back(MakeFigureSweep(report, curve));
   files->emplace_back("curves.csv", std::move(traced.csv));
   files->emplace_back(kFigureScriptName, GnuplotFigureScript(figures));
-  if (!render) return;
+  if (!render) return "the run was asked for none (--figures=false)";
   const RenderedFigures rendered = RenderFigures({files->back()});
   if (!rendered.rendered) {
     LOG(WARNING) << rendered.warning;
     out << "warning: " << rendered.warning << "\n";
-    return;
+    return rendered.warning;
   }
   files->insert(files->end(), rendered.images.begin(), rendered.images.end());
+  return "";
 }
 
 }  // namespace dwellfit

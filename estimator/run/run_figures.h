@@ -27,11 +27,17 @@ RunCurves TraceRunCurves(const ParameterVector& parameters,
                          const std::vector<const Sweep*>& sweeps);
 
 // Appends curves.csv and figures.gp (`curves`: TraceRunCurves of the
-// report's estimate) to `files`, which must hold predictions.csv, and with
-// `render` gnuplot's images. No curves, or no working gnuplot, is a warning
-// on `out`, never an error.
-void AppendCurvesAndFigures(const IdentificationReport& report, RunCurves curves,
-                            std::vector<NamedFile>* files, std::ostream& out, bool render = true);
+// report's estimate) to `files` and, with `render`, gnuplot's images. No
+// curves, or no working gnuplot, is a warning on `out`, never an error.
+// Returns why no images were drawn (empty when they were).
+std::string AppendCurvesAndFigures(const IdentificationReport& report, RunCurves curves,
+                                   std::vector<NamedFile>* files, std::ostream& out,
+                                   bool render = true);
+
+// One measured jump against the model's: "jump_down: measured
+// 194.59..194.64 Hz, model 194.61 Hz (-0.0074 Hz, -0.0038 % from the bracket
+// centre, inside)"; a_base for an amplitude sweep.
+std::string JumpNote(const Sweep& sweep, const PredictedJump& jump);
 
 }  // namespace dwellfit
 

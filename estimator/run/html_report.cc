@@ -1,0 +1,205 @@
+#include "dwellfit/estimator/run/html_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "dwellfit/estimator/common/string_printf.h"
+#include "dwellfit/estimator/common/version.h"
+#include "dwellfit/estimator/run/run_figures.h"
+
+namespace dwellfit {
+namespace {
+
+constexpr char kStyle[] =
+    "body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}"
+    "table{border-collapse:collapse;margin:0.5em 0 1.5em}"
+    "th,td{border:1px solid #ccc;padding:3px 8px;text-align:left;vertical-align:top}"
+    "th{background:#f2f2f2}td.n{text-align:right;font-variant-numeric:tabular-nums}"
+    ".status{padding:0.6em 1em;border-radius:4px;margin:1em 0}"
+    ".ok{background:#e3f4e1;border:1px solid #7bbf73}.bad{background:#fbe3e1;border:1px solid "
+    "#d9786f}"
+    "figure{margin:1em 0}figure svg{width:100%;max-width:900px;height:auto}pre{background:#f7f7f7;padding:1em;"
+    "overflow-x:auto}";
+
+std::string Cell(const std::string& text, bool number = false) {
+  return std::string(number ? "<td class=\"n\">" : "<td>") + HtmlEscape(text) + "</td>";
+}
+
+std::string Header(const std::vector<std::string>& names) {
+  std::string row = "<tr>";
+  for (const std::string& name : names) row += "<th>" + HtmlEscape(name) + "</th>";
+  return row + "</tr>\n";
+}
+
+std::string StatusSection(const IdentificationReport& report) {
+  const bool ok = report.result.status == FitStatus::kConverged;
+  return StringPrintf("<div class=\"status %s\" id=\"status\"><b>%s</b>: %s</div>\n",
+                      ok ? "ok" : "bad", FitStatusName(report.result.status),
+                      HtmlEscape(report.result.message).c_str());
+}
+
+// The estimates with their intervals; omega also in Hz.
+std::string EstimatesSection(const IdentificationReport& report) {
+  const ParameterUncertainty& u = report.uncertainty;
+  std::string html =
+      "<h2>Estimates</h2>\n<p>95 % intervals: " +
+      HtmlEscape(u.available ? u.interval_kind : "none") + ". " + HtmlEscape(u.message) +
+      "</p>\n<table id=\"estimates\">\n" +
+      Header({"parameter", "estimate", "95 % interval", "linearised standard error", "note"});
+  std::vector<int> held;
+  if (!report.result.stages.empty()) held = report.result.stages.back().held_at_bound;
+  for (int i = 0; i < kNumParameters; ++i) {
+    const double value = report.result.parameters[i];
+    std::string note;
+    if (report.options.fixed[i]) note = "fixed";
+    if (std::find(held.begin(), held.end(), i) != held.end()) note = "held at its bound";
+    const bool interval = u.available && note.empty();
+    html +=
+        "<tr>" + Cell(ParameterName(i)) + Cell(StringPrintf("%.10g", value), true) +
+        Cell(interval ? StringPrintf("[%.6g, %.6g]", u.ci95_low[i], u.ci95_high[i]) : "-", true) +
+        Cell(interval ? StringPrintf("%.3g", u.standard_error[i]) : "-", true) + Cell(note) +
+        "</tr>\n";
+  }
+  html += "</table>\n<p>" +
+          HtmlEscape(StringPrintf(
+              "Natural frequency %.8g Hz (omega in rad/s above). Effective nonlinearity alpha_e "
+              "%.8g at %.6g rad/s, 95 %% interval [%.6g, %.6g]. Final cost %.6g.",
+              RadPerSecondToHz(report.result.parameters[kNaturalFrequency]),
+              u.effective_nonlinearity, u.omega_ref_rad_s, u.effective_nonlinearity_ci95_low,
+              u.effective_nonlinearity_ci95_high, report.result.final_cost)) +
+          "</p>\n";
+  return html;
+}
+
+std::string WarningsSection(const IdentificationReport& report) {
+  std::vector<std::string> warnings = report.uncertainty.warnings;
+  if (!report.validation_intervals.levels.empty() &&
+      !report.validation_intervals.parameter_covariance) {
+    warnings.push_back(report.validation_intervals.note);
+  }
+  warnings.insert(warnings.end(), report.level_refits.warnings.begin(),
+                  report.level_refits.warnings.end());
+  std::string html = "<h2>Warnings</h2>\n<ul id=\"warnings\">\n";
+  for (const std::string& warning : warnings) html += "<li>" + HtmlEscape(warning) + "</li>\n";
+  if (warnings.empty()) html += "<li>none</li>\n";
+  return html + "</ul>\n";
+}
+
+// Per sweep: its errors and each measured jump against the model's.
+std::string SweepsSection(const IdentificationReport& report) {
+  std::string html = "<h2>Fit and validation per sweep</h2>\n<table id=\"sweeps\">\n" +
+                     Header({"sweep", "role", "dwells", "RMS error", "relative RMS error",
+                             "past their branch's end", "jumps: measured against the model"});
+  for (const SweepPrediction& p : report.predictions) {
+    std::string jumps;
+    for (const PredictedJump& jump : p.jumps) {
+      if (!jump.measured) continue;
+      jumps += (jumps.empty() ? "" : "<br>") + HtmlEscape(JumpNote(*p.sweep, jump));
+    }
+    html += "<tr>" + Cell(p.sweep->Name()) + Cell(p.fitted ? "fitted" : "validation") +
+            Cell(std::to_string(p.sweep->points.size()), true) +
+            Cell(StringPrintf("%.4g", p.rms_error), true) +
+            Cell(StringPrintf("%.4g", p.relative_rms_error), true) +
+            Cell(std::to_string(p.points_off_branch), true) + "<td>" +
+            (jumps.empty() ? "none measured" : jumps) + "</td></tr>\n";
+  }
+  return html + "</table>\n";
+}
+
+std::string ValidationSection(const ValidationIntervals& v) {
+  if (v.levels.empty()) return "";
+  std::string html =
+      "<h2>Validation: 95 % prediction intervals</h2>\n<p>" +
+      HtmlEscape(std::string("Rule: ") + kPredictionIntervalRule) +
+      "</p>\n<table id=\"validation\">\n" +
+      Header({"sweep", "quantity", "measured", "predicted", "half-width", "error (%)", "inside"});
+  for (const ValidationLevel& level : v.levels) {
+    for (const HeldOutPrediction& p : level.predictions) {
+      html += "<tr>" + Cell(p.sweep) + Cell(HeldOutQuantityName(p.quantity)) +
+              Cell(StringPrintf("%.6g", p.measured), true) +
+              Cell(StringPrintf("%.6g", p.predicted), true) +
+              Cell(StringPrintf("%.3g", p.half_width), true) +
+              Cell(StringPrintf("%+.2f", p.ErrorPercent()), true) + Cell(p.inside ? "yes" : "no") +
+              "</tr>\n";
+    }
+  }
+  html += "</table>\n<p>Inside their interval: ";
+  const std::pair<const char*, const IntervalCoverage*> quantities[] = {
+      {"jump-down", &v.coverage.jump_down},
+      {"jump-up", &v.coverage.jump_up},
+      {"upper-branch amplitude", &v.coverage.upper_branch}};
+  for (const auto& [name, c] : quantities) {
+    html += StringPrintf("%s %d of %d; ", name, c->inside, c->total);
+  }
+  return html + "</p>\n";
+}
+
+// <figure>s of the SVG images among `files` whose name starts (`overview`)
+// or does not start with kOverviewFigureStem, without their XML declaration.
+std::string InlineFigures(const std::vector<NamedFile>& files, bool overview) {
+  std::string html;
+  for (const auto& [name, svg] : files) {
+    const bool is_svg = name.size() > 4 && name.compare(name.size() - 4, 4, ".svg") == 0;
+    const size_t start = svg.find("<svg");
+    if (!is_svg || (name.rfind(kOverviewFigureStem, 0) == 0) != overview ||
+        start == std::string::npos) {
+      continue;
+    }
+    html += "<figure>\n" + svg.substr(start) + "<figcaption>" + HtmlEscape(name) +
+            "</figcaption>\n</figure>\n";
+  }
+  return html;
+}
+
+}  // namespace
+
+std::string HtmlEscape(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&#39;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+std::string ReportToHtml(const IdentificationReport& report, const std::vector<NamedFile>& figures,
+                         const std::string& figures_note) {
+  std::ostringstream html;
+  html << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>dwellfit "
+          "identify: "
+       << HtmlEscape(report.config_path) << "</title>\n<style>" << kStyle
+       << "</style>\n</head>\n<body>\n<h1>dwellfit identify</h1>\n<p>Config: <code>"
+       << HtmlEscape(report.config_path) << "</code>; dwellfit " << HtmlEscape(DwellfitVersion())
+       << "</p>\n";
+  const std::string overview = InlineFigures(figures, /*overview=*/true);
+  html << StatusSection(report) << EstimatesSection(report)
+       << (overview.empty() ? "" : "<h2>Where the sweeps jump</h2>\n" + overview)
+       << WarningsSection(report) << SweepsSection(report)
+       << ValidationSection(report.validation_intervals) << "<h2>Figures</h2>\n"
+       << (figures_note.empty() ? "" : "<p>" + HtmlEscape("No figures: " + figures_note) + "</p>\n")
+       << InlineFigures(figures, /*overview=*/false);
+  html << "<h2>Configuration in effect</h2>\n<pre id=\"config\">"
+       << HtmlEscape(report.config_in_effect) << "</pre>\n</body>\n</html>\n";
+  return html.str();
+}
+
+}  // namespace dwellfit

@@ -1,0 +1,31 @@
+// report.html: one self-contained page of an identify run to read and pass
+// on: the status and its reason, the estimates with their 95 % intervals and
+// the intervals' kind, the warnings, the fit and validation of every sweep
+// (RMS errors, each measured jump against the model's in Hz and %), the
+// validation prediction intervals, the figures inline as SVG, the
+// configuration in effect and the version. No script, no network.
+#ifndef DWELLFIT_ESTIMATOR_RUN_HTML_REPORT_H_
+#define DWELLFIT_ESTIMATOR_RUN_HTML_REPORT_H_
+
+#include <string>
+#include <vector>
+
+#include "dwellfit/estimator/analysis/identification_report.h"
+#include "dwellfit/estimator/curves/figures.h"
+
+namespace dwellfit {
+
+inline constexpr char kHtmlReportName[] = "report.html";
+
+// The page of `report`; `figures` are the run's files, of which the SVG
+// images are shown (the overview first); `figures_note` says why there are
+// none (empty when they were drawn).
+std::string ReportToHtml(const IdentificationReport& report, const std::vector<NamedFile>& figures,
+                         const std::string& figures_note);
+
+// `text` with &, <, >, " and ' written as HTML entities.
+std::string HtmlEscape(const std::string& text);
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_ESTIMATOR_RUN_HTML_REPORT_H_
