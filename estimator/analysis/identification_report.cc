@@ -411,7 +411,12 @@ void PrintJumps(const IdentificationReport& report, std::ostream& out) {
       const std::string model =
           jump.exists
               ? StringPrintf("%.6g%s%s", ControlInFileUnit(sweep, jump.control), unit,
-                             jump.measured ? (jump.inside ? " (inside)" : " (outside)") : "")
+                             jump.measured
+                                 ? StringPrintf(" (%s, %+.3g %% from the bracket centre)",
+                                                jump.inside ? "inside" : "outside",
+                                                100.0 * (jump.control / jump.bracket.centre() - 1))
+                                       .c_str()
+                                 : "")
               : "no fold";
       out << StringPrintf("%-20s %-10s %-30s %s\n", sweep.Name().c_str(), JumpKindName(jump.kind),
                           measured.c_str(), model.c_str());
@@ -425,8 +430,8 @@ void PrintValidationIntervals(const ValidationIntervals& v, std::ostream& out) {
   if (v.levels.empty()) return;
   out << "validation prediction intervals (95 %)\n  rule: " << kPredictionIntervalRule << "\n";
   if (!v.note.empty()) out << "  " << v.note << "\n";
-  out << StringPrintf("%-20s %-24s %-14s %-30s %s\n", "sweep", "quantity", "measured",
-                      "predicted +/- half-width", "inside");
+  out << StringPrintf("%-20s %-24s %-14s %-30s %-9s %s\n", "sweep", "quantity", "measured",
+                      "predicted +/- half-width", "error %", "inside");
   for (const ValidationLevel& level : v.levels) {
     for (const HeldOutPrediction& p : level.predictions) {
       const char* unit = IsAmplitude(p) ? "" : " Hz";
@@ -434,10 +439,10 @@ void PrintValidationIntervals(const ValidationIntervals& v, std::ostream& out) {
           std::isfinite(p.predicted)
               ? StringPrintf("%.6g +/- %.3g%s", p.predicted, p.half_width, unit)
               : std::string("no fold");
-      out << StringPrintf("%-20s %-24s %-14s %-30s %s\n", p.sweep.c_str(),
+      out << StringPrintf("%-20s %-24s %-14s %-30s %-9s %s\n", p.sweep.c_str(),
                           HeldOutQuantityName(p.quantity),
                           StringPrintf("%.6g%s", p.measured, unit).c_str(), predicted.c_str(),
-                          p.inside ? "yes" : "no");
+                          StringPrintf("%+.2f", p.ErrorPercent()).c_str(), p.inside ? "yes" : "no");
     }
   }
   const struct {
@@ -449,7 +454,16 @@ void PrintValidationIntervals(const ValidationIntervals& v, std::ostream& out) {
               {"upper-branch amplitude", v.coverage.upper_branch, ""}};
   for (const auto& row : rows) {
     if (row.c.total == 0) continue;
-    out << StringPrintf("%s: %d of %d measured inside, ", row.name, row.c.inside, row.c.total)
+    std::vector<double> errors;
+    for (const ValidationLevel& level : v.levels) {
+      for (const HeldOutPrediction& p : level.predictions) {
+        if (HeldOutQuantityName(p.quantity) == std::string(row.name)) {
+          errors.push_back(std::abs(p.ErrorPercent()));
+        }
+      }
+    }
+    out << StringPrintf("%s: median |error| %.3g %%, %d of %d measured inside, ", row.name,
+                        MedianOf(errors), row.c.inside, row.c.total)
         << (std::isfinite(row.c.median_half_width)
                 ? StringPrintf("median half-width %.3g%s (%.3g %%)\n", row.c.median_half_width,
                                row.unit, row.c.median_half_width_percent)

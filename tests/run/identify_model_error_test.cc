@@ -111,8 +111,9 @@ TEST(IdentifyModelError, BeamValidationJumpDownsFallInsideTheirIntervals) {
             << v.coverage.jump_down.median_half_width << " Hz\n";
   std::ostringstream printed;
   PrintReport(report, printed);
-  EXPECT_THAT(printed.str(), HasSubstr("jump-down: " + std::to_string(v.coverage.jump_down.inside) +
-                                       " of 10 measured inside"));
+  EXPECT_THAT(printed.str(), ::testing::ContainsRegex("jump-down: median \\|error\\| [0-9.]+ %, " +
+                                                      std::to_string(v.coverage.jump_down.inside) +
+                                                      " of 10 measured inside"));
   const YAML::Node result = YAML::Load(ReportToYaml(report));
   const YAML::Node coverage = result["validation_intervals"]["coverage"]["jump_down"];
   EXPECT_EQ(coverage["inside"].as<int>(), v.coverage.jump_down.inside);
