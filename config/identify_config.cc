@@ -518,11 +518,26 @@ PenaltyOptions ReadPenalties(const ConfigValue& value, const ConfigSource& sourc
   return penalties;
 }
 
+// `units:` and `plot:`: how figures and reports show the data.
+void ReadPresentation(const StrictMap& top, const ConfigSource& source, IdentifyConfig* config) {
+  if (const auto value = top.Optional("units")) {
+    const StrictMap units(*value, source, {"a", "a_base"});
+    if (const auto a = units.Optional("a")) config->units.a = ReadNonEmptyString(*a, source);
+    if (const auto base = units.Optional("a_base")) {
+      config->units.a_base = ReadNonEmptyString(*base, source);
+    }
+  }
+  if (const auto value = top.Optional("plot")) {
+    StrictMap(*value, source, {"log_amplitude"}).Read("log_amplitude", &config->log_amplitude);
+  }
+}
+
 IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& config_dir) {
-  const StrictMap top(DocumentValue(source), source,
-                      {"data", "fit", "validate", "initial_guess", "fixed", "stages", "residual",
-                       "solver", "penalties", "multi_start", "jump_detection", "jumps",
-                       "effective_nonlinearity_reference_hz", "model_selection", "output_dir"});
+  const StrictMap top(
+      DocumentValue(source), source,
+      {"data", "fit", "validate", "initial_guess", "fixed", "stages", "residual", "solver",
+       "penalties", "multi_start", "jump_detection", "jumps", "effective_nonlinearity_reference_hz",
+       "model_selection", "output_dir", "units", "plot"});
   IdentifyConfig config;
   config.data_files =
       ReadDataFiles(top.Required("data", "give the CSV file with the sweeps (or a list of files)"),
@@ -578,6 +593,7 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
     config.omega_ref_rad_s = RadPerSecond(hz, *value, source);
   }
 
+  ReadPresentation(top, source, &config);
   const ConfigValue output_dir =
       top.Required("output_dir", "give the directory for the results, e.g. output_dir: out");
   config.output_dir =

@@ -21,6 +21,11 @@
 
 namespace dwellfit {
 
+struct DataUnits {
+  std::string a;       // of the response amplitude a (and its sigma)
+  std::string a_base;  // of the base level a_base
+};
+
 struct IdentifyConfig {
   // The config file, absolute.
   std::string config_path;
@@ -50,6 +55,11 @@ struct IdentifyConfig {
   std::optional<double> omega_ref_rad_s;
   // Where results go, absolute (resolved like data_files); may not exist yet.
   std::string output_dir;
+  // The names of the data's units in figures and reports (`units: {a: mm,
+  // a_base: g}`); empty: unstated. They change no number.
+  DataUnits units;
+  // `plot: {log_amplitude: true}`: the figures' amplitude axes logarithmic.
+  bool log_amplitude = false;
   // The model variants to compare and how (`model_selection:`); unset when
   // the config has no such block. `identify` ignores it; `select_model` runs it.
   std::optional<ModelSelectionConfig> model_selection;

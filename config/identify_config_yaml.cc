@@ -217,6 +217,17 @@ std::string ConfigToYaml(const IdentifyConfig& config, ConfigKeys keys) {
         << YAML::Comment(FormatRoundTrip(*config.omega_ref_rad_s) + " rad/s");
   }  // unset: the identified omega (the key's default)
   if (config.model_selection.has_value()) EmitModelSelection(out, *config.model_selection);
+  if (!config.units.a.empty() || !config.units.a_base.empty()) {
+    out << YAML::Key << "units" << YAML::Value << YAML::BeginMap;
+    if (!config.units.a.empty()) Put(out, "a", config.units.a);
+    if (!config.units.a_base.empty()) Put(out, "a_base", config.units.a_base);
+    out << YAML::EndMap;
+  }
+  if (config.log_amplitude) {
+    out << YAML::Key << "plot" << YAML::Value << YAML::BeginMap;
+    Put(out, "log_amplitude", true);
+    out << YAML::EndMap;
+  }
   if (keys == ConfigKeys::kAll) Put(out, "output_dir", config.output_dir);
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";

@@ -100,7 +100,8 @@ std::string SweepFigure(const FigureSet& figures, const FigureSweep& s, size_t i
   gp << "set multiplot\n"
         "set origin 0, 0.3\nset size 1, 0.7\nset lmargin 12\nset format x \"\"\nunset xlabel\n";
   gp << "set title " << Quoted(title) << "\n";
-  gp << "set ylabel \"a [\".amplitude_unit.\"]\"\n";
+  gp << "set ylabel \"a [\".amplitude_unit.\"]\"\n"
+     << (figures.log_amplitude ? "set logscale y\n" : "");
   // The key under the corner's lines (about 0.037 of the graph's height each).
   const double key_top = 0.93 - 0.037 * static_cast<double>(figures.corner_lines.size());
   gp << (s.kind == SweepKind::kFrequency
@@ -130,7 +131,7 @@ std::string SweepFigure(const FigureSet& figures, const FigureSweep& s, size_t i
              s.jump_lines.empty()
                  ? ""
                  : "NaN with lines dt 3 lc rgb \"#888888\" title \"measured jump bracket\"");
-  gp << "unset label 1\nunset arrow\nunset title\n";
+  gp << "unset label 1\nunset arrow\nunset title\nunset logscale y\n";
   gp << "set origin 0, 0\nset size 1, 0.3\nset format x \"% h\"\n";
   gp << "set xlabel "
      << Quoted(s.kind == SweepKind::kFrequency ? "drive frequency [Hz]"

@@ -66,6 +66,7 @@ struct FigureSet {
   std::string amplitude_unit = "data's unit";
   std::string control_unit;    // unit of a_base, for an amplitude sweep's x axis
   std::string residual_label;  // the fit's error measure, for the residual axis
+  bool log_amplitude = false;  // the amplitude axis logarithmic
 };
 
 inline constexpr char kOverviewFigureStem[] = "figure_overview_jumps";

@@ -19,7 +19,8 @@ constexpr char kStyle[] =
     ".status{padding:0.6em 1em;border-radius:4px;margin:1em 0}"
     ".ok{background:#e3f4e1;border:1px solid #7bbf73}.bad{background:#fbe3e1;border:1px solid "
     "#d9786f}"
-    "figure{margin:1em 0}figure svg{width:100%;max-width:900px;height:auto}pre{background:#f7f7f7;padding:1em;"
+    "figure{margin:1em 0}figure "
+    "svg{width:100%;max-width:900px;height:auto}pre{background:#f7f7f7;padding:1em;"
     "overflow-x:auto}";
 
 std::string Cell(const std::string& text, bool number = false) {
@@ -39,14 +40,14 @@ std::string StatusSection(const IdentificationReport& report) {
                       HtmlEscape(report.result.message).c_str());
 }
 
-// The estimates with their intervals; omega also in Hz.
-std::string EstimatesSection(const IdentificationReport& report) {
+// The estimates with their intervals and units; omega also in Hz.
+std::string EstimatesSection(const IdentificationReport& report, const DataUnits& units) {
   const ParameterUncertainty& u = report.uncertainty;
-  std::string html =
-      "<h2>Estimates</h2>\n<p>95 % intervals: " +
-      HtmlEscape(u.available ? u.interval_kind : "none") + ". " + HtmlEscape(u.message) +
-      "</p>\n<table id=\"estimates\">\n" +
-      Header({"parameter", "estimate", "95 % interval", "linearised standard error", "note"});
+  std::string html = "<h2>Estimates</h2>\n<p>95 % intervals: " +
+                     HtmlEscape(u.available ? u.interval_kind : "none") + ". " +
+                     HtmlEscape(u.message) + "</p>\n<table id=\"estimates\">\n" +
+                     Header({"parameter", "unit", "estimate", "95 % interval",
+                             "linearised standard error", "note"});
   std::vector<int> held;
   if (!report.result.stages.empty()) held = report.result.stages.back().held_at_bound;
   for (int i = 0; i < kNumParameters; ++i) {
@@ -56,7 +57,8 @@ std::string EstimatesSection(const IdentificationReport& report) {
     if (std::find(held.begin(), held.end(), i) != held.end()) note = "held at its bound";
     const bool interval = u.available && note.empty();
     html +=
-        "<tr>" + Cell(ParameterName(i)) + Cell(StringPrintf("%.10g", value), true) +
+        "<tr>" + Cell(ParameterName(i)) + Cell(ParameterUnit(i, units)) +
+        Cell(StringPrintf("%.10g", value), true) +
         Cell(interval ? StringPrintf("[%.6g, %.6g]", u.ci95_low[i], u.ci95_high[i]) : "-", true) +
         Cell(interval ? StringPrintf("%.3g", u.standard_error[i]) : "-", true) + Cell(note) +
         "</tr>\n";
@@ -181,8 +183,27 @@ std::string HtmlEscape(const std::string& text) {
   return out;
 }
 
+std::string ParameterUnit(int index, const DataUnits& units) {
+  const std::string a = units.a.empty() ? "[A]" : units.a;
+  const std::string b = units.a_base.empty() ? "[B]" : units.a_base;
+  switch (index) {
+    case kEtaE:
+      return a + "/(" + b + " s^2)";
+    case kMu1:
+      return "1/s";
+    case kMu2:
+      return "1/(" + a + " s)";
+    case kDelta:
+      return "1/" + a + "^2";
+    case kAlpha:
+      return "1/(" + a + "^2 s^2)";
+    default:
+      return "rad/s";
+  }
+}
+
 std::string ReportToHtml(const IdentificationReport& report, const std::vector<NamedFile>& figures,
-                         const std::string& figures_note) {
+                         const std::string& figures_note, const DataUnits& units) {
   std::ostringstream html;
   html << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>dwellfit "
           "identify: "
@@ -191,7 +212,7 @@ std::string ReportToHtml(const IdentificationReport& report, const std::vector<N
        << HtmlEscape(report.config_path) << "</code>; dwellfit " << HtmlEscape(DwellfitVersion())
        << "</p>\n";
   const std::string overview = InlineFigures(figures, /*overview=*/true);
-  html << StatusSection(report) << EstimatesSection(report)
+  html << StatusSection(report) << EstimatesSection(report, units)
        << (overview.empty() ? "" : "<h2>Where the sweeps jump</h2>\n" + overview)
        << WarningsSection(report) << SweepsSection(report)
        << ValidationSection(report.validation_intervals) << "<h2>Figures</h2>\n"

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/analysis/identification_report.h"
 #include "dwellfit/estimator/curves/figures.h"
 
@@ -19,9 +20,13 @@ inline constexpr char kHtmlReportName[] = "report.html";
 
 // The page of `report`; `figures` are the run's files, of which the SVG
 // images are shown (the overview first); `figures_note` says why there are
-// none (empty when they were drawn).
+// none (empty when they were drawn); `units` name the data's units.
 std::string ReportToHtml(const IdentificationReport& report, const std::vector<NamedFile>& figures,
-                         const std::string& figures_note);
+                         const std::string& figures_note, const DataUnits& units = {});
+
+// The unit of parameter `index` (docs/model.md, Units) in the data's units
+// ("[A]" and "[B]" where unstated): eta_e "mm/(g s^2)", mu2 "1/(mm s)".
+std::string ParameterUnit(int index, const DataUnits& units);
 
 // `text` with &, <, >, " and ' written as HTML entities.
 std::string HtmlEscape(const std::string& text);

@@ -171,9 +171,9 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
   PrintReport(report, out);
   std::vector<NamedFile> files = {{"result.yaml", ReportToYaml(report)},
                                   {"predictions.csv", std::move(predictions_csv)}};
-  const std::string figures_note =
-      AppendCurvesAndFigures(report, std::move(curves), &files, out, run_options.render_figures);
-  files.emplace_back(kHtmlReportName, ReportToHtml(report, files, figures_note));
+  const std::string figures_note = AppendCurvesAndFigures(report, config, std::move(curves), &files,
+                                                          out, run_options.render_figures);
+  files.emplace_back(kHtmlReportName, ReportToHtml(report, files, figures_note, config.units));
   WriteFilesAtomically(config.output_dir, files);
   out << "\nwrote into " << config.output_dir << ":";
   for (const NamedFile& file : files) out << " " << file.first;

@@ -15,9 +15,10 @@
 namespace dwellfit {
 namespace {
 
-std::string HeldControl(const CurveSpec& spec) {
+std::string HeldControl(const CurveSpec& spec, const std::string& base_unit) {
   return spec.kind == SweepKind::kFrequency
-             ? StringPrintf("a_base = %.6g", spec.a_base)
+             ? StringPrintf("a_base = %.6g%s", spec.a_base,
+                            base_unit.empty() ? "" : (" " + base_unit).c_str())
              : StringPrintf("%.6g Hz", RadPerSecondToHz(spec.omega_rad_s));
 }
 
@@ -66,11 +67,12 @@ void AddDwells(const SweepPrediction& prediction, const ResidualOptions& measure
   }
 }
 
-FigureSweep MakeFigureSweep(const IdentificationReport& report, const ResponseCurve& curve) {
+FigureSweep MakeFigureSweep(const IdentificationReport& report, const ResponseCurve& curve,
+                            const std::string& base_unit) {
   FigureSweep figure;
   figure.id = curve.spec.name;
   figure.kind = curve.spec.kind;
-  figure.held = HeldControl(curve.spec);
+  figure.held = HeldControl(curve.spec, base_unit);
   figure.role = "validation";
   AddCurveLines(curve, &figure);
   for (const SweepPrediction& prediction : report.predictions) {
@@ -207,8 +209,9 @@ RunCurves TraceRunCurves(const ParameterVector& parameters,
   return traced;
 }
 
-std::string AppendCurvesAndFigures(const IdentificationReport& report, RunCurves traced,
-                                   std::vector<NamedFile>* files, std::ostream& out, bool render) {
+std::string AppendCurvesAndFigures(const IdentificationReport& report, const IdentifyConfig& config,
+                                   RunCurves traced, std::vector<NamedFile>* files,
+                                   std::ostream& out, bool render) {
   if (!traced.warning.empty()) {
     out << "warning: " << traced.warning << "\n";
     return traced.warning;
@@ -217,10 +220,12 @@ std::string AppendCurvesAndFigures(const IdentificationReport& report, RunCurves
   FigureSet figures;
   figures.corner_lines = EstimateLines(report);
   figures.overview = OverviewJumps(report);
-  figures.control_unit = figures.amplitude_unit;
+  figures.amplitude_unit = config.units.a.empty() ? "data's unit" : config.units.a;
+  figures.control_unit = config.units.a_base.empty() ? "data's unit" : config.units.a_base;
+  figures.log_amplitude = config.log_amplitude;
   figures.residual_label = ResidualLabel(report.options.solve.residual, figures.amplitude_unit);
   for (const ResponseCurve& curve : curves)
-    figures.sweeps.push_back(MakeFigureSweep(report, curve));
+    figures.sweeps.push_back(MakeFigureSweep(report, curve, config.units.a_base));
   files->emplace_back("curves.csv", std::move(traced.csv));
   files->emplace_back(kFigureScriptName, GnuplotFigureScript(figures));
   if (!render) return "the run was asked for none (--figures=false)";

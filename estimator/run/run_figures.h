@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/analysis/identification_report.h"
 #include "dwellfit/estimator/curves/figures.h"
 #include "dwellfit/estimator/curves/response_curve.h"
@@ -27,12 +28,13 @@ RunCurves TraceRunCurves(const ParameterVector& parameters,
                          const std::vector<const Sweep*>& sweeps);
 
 // Appends curves.csv and figures.gp (`curves`: TraceRunCurves of the
-// report's estimate) to `files` and, with `render`, gnuplot's images. No
+// report's estimate; `config`: its units and plot style) to `files` and, with
+// `render`, gnuplot's images. No
 // curves, or no working gnuplot, is a warning on `out`, never an error.
 // Returns why no images were drawn (empty when they were).
-std::string AppendCurvesAndFigures(const IdentificationReport& report, RunCurves curves,
-                                   std::vector<NamedFile>* files, std::ostream& out,
-                                   bool render = true);
+std::string AppendCurvesAndFigures(const IdentificationReport& report, const IdentifyConfig& config,
+                                   RunCurves curves, std::vector<NamedFile>* files,
+                                   std::ostream& out, bool render = true);
 
 // One measured jump against the model's: "jump_down: measured
 // 194.59..194.64 Hz, model 194.61 Hz (-0.0074 Hz, -0.0038 % from the bracket

@@ -16,6 +16,7 @@ namespace {
 
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
+using ::testing::Not;
 namespace fs = std::filesystem;
 
 std::vector<std::string> Names(const std::vector<SweepSelection>& selections) {
@@ -186,6 +187,32 @@ TEST(LoadIdentifyConfig, StartFunctionToleranceIsReadAndShown) {
   const IdentifyConfig config = LoadIdentifyConfig(dir.WriteConfig(text));
   EXPECT_EQ(config.identification.solve.solver.start_function_tolerance, 1e-3);
   EXPECT_THAT(ConfigToYaml(config), HasSubstr("start_function_tolerance: 0.001"));
+}
+
+// units: and plot: name the data's units and the figures' amplitude axis;
+// unstated they are empty and off, and neither is shown; a bad entry names
+// its key and line.
+TEST(LoadIdentifyConfig, UnitsAndPlotAreReadAndShown) {
+  const ConfigDirectory dir;
+  const IdentifyConfig by_default = LoadIdentifyConfig(dir.WriteConfig(kValidConfig));
+  EXPECT_TRUE(by_default.units.a.empty());
+  EXPECT_FALSE(by_default.log_amplitude);
+  EXPECT_THAT(ConfigToYaml(by_default), Not(HasSubstr("units")));
+  const IdentifyConfig stated = LoadIdentifyConfig(dir.WriteConfig(
+      std::string(kValidConfig) + "units: {a: mm, a_base: g}\nplot: {log_amplitude: true}\n"));
+  EXPECT_EQ(stated.units.a, "mm");
+  EXPECT_EQ(stated.units.a_base, "g");
+  EXPECT_TRUE(stated.log_amplitude);
+  const IdentifyConfig reloaded = LoadIdentifyConfig(dir.WriteConfig(ConfigToYaml(stated)));
+  EXPECT_EQ(reloaded.units.a, "mm");
+  EXPECT_TRUE(reloaded.log_amplitude);
+  std::string path;
+  const InputError unknown =
+      LoadError(dir, std::string(kValidConfig) + "units: {amplitude: mm}\n", &path);
+  EXPECT_THAT(unknown.what(), HasSubstr("amplitude"));
+  const InputError not_bool =
+      LoadError(dir, std::string(kValidConfig) + "plot: {log_amplitude: maybe}\n", &path);
+  EXPECT_THAT(not_bool.what(), HasSubstr("log_amplitude"));
 }
 
 // The valley polish: on by default, off when the config says so, shown in

@@ -124,6 +124,12 @@ TEST(Figures, EachSweepsPointsAreInItsOwnDatablocks) {
   EXPECT_THAT(script, ::testing::Not(HasSubstr("$s0_unstable")));
   EXPECT_THAT(script, ::testing::Not(HasSubstr("$s0_down")));
   EXPECT_THAT(script, ::testing::Not(HasSubstr(".csv")));
+  EXPECT_THAT(script, ::testing::Not(HasSubstr("\nset logscale y")));
+  figures.log_amplitude = true;  // the amplitude panels only
+  const std::string log_script = GnuplotFigureScript(figures);
+  EXPECT_THAT(log_script, HasSubstr("set logscale y\n"));
+  EXPECT_LT(log_script.find("set logscale y"), log_script.find("$s0_rup"));
+  EXPECT_LT(log_script.find("unset logscale y"), log_script.find("$s0_rup"));
 
   // gnuplot draws it with nothing beside it.
   const RenderedFigures rendered = RenderFigures({{kFigureScriptName, script}});

@@ -18,6 +18,18 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
+// docs/model.md, Units: each parameter's unit from those of a and a_base.
+TEST(HtmlReport, ParameterUnitsFollowTheDataUnits) {
+  const DataUnits units{"mm", "g"};
+  EXPECT_EQ(ParameterUnit(kEtaE, units), "mm/(g s^2)");
+  EXPECT_EQ(ParameterUnit(kMu1, units), "1/s");
+  EXPECT_EQ(ParameterUnit(kMu2, units), "1/(mm s)");
+  EXPECT_EQ(ParameterUnit(kDelta, units), "1/mm^2");
+  EXPECT_EQ(ParameterUnit(kAlpha, units), "1/(mm^2 s^2)");
+  EXPECT_EQ(ParameterUnit(kNaturalFrequency, units), "rad/s");
+  EXPECT_EQ(ParameterUnit(kMu2, DataUnits{}), "1/([A] s)");
+}
+
 TEST(HtmlReport, EscapesEveryMarkupCharacter) {
   EXPECT_EQ(HtmlEscape("<a href=\"x\">Tom & 'Jerry'</a>"),
             "&lt;a href=&quot;x&quot;&gt;Tom &amp; &#39;Jerry&#39;&lt;/a&gt;");
@@ -37,8 +49,8 @@ TEST(HtmlReport, ShowsUserTextAsTextAndSaysWhyThereAreNoFigures) {
   EXPECT_THAT(html, HasSubstr("<div class=\"status bad\" id=\"status\"><b>no_convergence</b>: "
                               "stopped after 200 iterations &amp; the cost &lt; 1</div>"));
   EXPECT_THAT(html, HasSubstr("No figures: gnuplot was not found"));
-  EXPECT_THAT(html, HasSubstr("<td>mu2</td><td class=\"n\">0</td><td class=\"n\">-</td><td "
-                              "class=\"n\">-</td><td>fixed</td>"));
+  EXPECT_THAT(html, HasSubstr("<td>mu2</td><td>1/([A] s)</td><td class=\"n\">0</td><td "
+                              "class=\"n\">-</td><td class=\"n\">-</td><td>fixed</td>"));
 }
 
 // identify writes report.html beside result.yaml, listed in the manifest, with
@@ -61,7 +73,8 @@ TEST(HtmlReport, IdentifyWritesTheReportWithItsFiguresInline) {
   EXPECT_THAT(listed.str(), HasSubstr(kHtmlReportName));
   const IdentificationReport& report = outcome->report;
   EXPECT_THAT(html, HasSubstr("<b>converged</b>"));
-  EXPECT_THAT(html, HasSubstr(StringPrintf("<td>eta_e</td><td class=\"n\">%.10g</td>",
+  EXPECT_THAT(html, HasSubstr(StringPrintf("<td>eta_e</td><td>[A]/([B] s^2)</td><td "
+                                           "class=\"n\">%.10g</td>",
                                            report.result.parameters[kEtaE])));
   EXPECT_THAT(html, HasSubstr(StringPrintf("[%.6g, %.6g]", report.uncertainty.ci95_low[kMu1],
                                            report.uncertainty.ci95_high[kMu1])));
