@@ -2,10 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <memory>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "Eigen/SVD"
@@ -17,7 +15,6 @@
 #include "dwellfit/estimator/fit/jacobian_factor.h"
 #include "dwellfit/estimator/fit/scaled_subset_manifold.h"
 #include "dwellfit/estimator/fit/stage_problem.h"
-#include "glog/logging.h"
 
 namespace dwellfit {
 namespace {

@@ -1,7 +1,6 @@
 #include "dwellfit/estimator/analysis/identification_report.h"
 
 #include <cmath>
-#include <sstream>
 #include <utility>
 
 #include "dwellfit/estimator/common/string_printf.h"
@@ -10,22 +9,6 @@
 #include "yaml-cpp/yaml.h"
 
 namespace dwellfit {
-
-IdentificationReport MakeIdentificationReport(const std::string& config_path,
-                                              const IdentificationOptions& options,
-                                              const IdentificationResult& result,
-                                              double omega_ref_rad_s,
-                                              const std::vector<const Sweep*>& fitted,
-                                              const std::vector<const Sweep*>& validation) {
-  IdentificationReport report;
-  report.config_path = config_path;
-  report.options = options;
-  report.result = result;
-  report.omega_ref_rad_s =
-      omega_ref_rad_s > 0.0 ? omega_ref_rad_s : result.parameters[kNaturalFrequency];
-  report.predictions = PredictSweeps(result.parameters, fitted, validation);
-  return report;
-}
 
 void AddModelError(const std::vector<const Sweep*>& fitted,
                    const std::vector<const Sweep*>& validation, int threads,
@@ -185,6 +168,16 @@ void EmitStage(const StageSummary& stage, YAML::Emitter* out) {
   *out << YAML::EndMap;
 }
 
+// `key`: a number, or null when it is not finite (a missing prediction).
+void EmitNumber(const char* key, double value, YAML::Emitter* out) {
+  *out << YAML::Key << key << YAML::Value;
+  if (std::isfinite(value)) {
+    *out << value;
+  } else {
+    *out << YAML::Null;
+  }
+}
+
 // One measured or predicted jump: the measured bracket beside the model's
 // fold, in the file's unit (Hz or a_base).
 void EmitJump(const Sweep& sweep, const PredictedJump& jump, YAML::Emitter* out) {
@@ -196,12 +189,8 @@ void EmitJump(const Sweep& sweep, const PredictedJump& jump, YAML::Emitter* out)
              ControlInFileUnit(sweep, jump.bracket.control_before),
              ControlInFileUnit(sweep, jump.bracket.control_after), out);
   }
-  *out << YAML::Key << (frequency ? "model_hz" : "model_a_base") << YAML::Value;
-  if (jump.exists) {
-    *out << ControlInFileUnit(sweep, jump.control);
-  } else {
-    *out << YAML::Null;
-  }
+  EmitNumber(frequency ? "model_hz" : "model_a_base",
+             jump.exists ? ControlInFileUnit(sweep, jump.control) : NAN, out);
   if (jump.measured) *out << YAML::Key << "inside" << YAML::Value << jump.inside;
   if (jump.measured && jump.bracket.into_missing_data) {
     *out << YAML::Key << "into_missing_data" << YAML::Value << true;
@@ -223,16 +212,6 @@ void EmitSweep(const SweepPrediction& prediction, YAML::Emitter* out) {
   for (const PredictedJump& jump : prediction.jumps) EmitJump(sweep, jump, out);
   *out << YAML::EndSeq;
   *out << YAML::EndMap;
-}
-
-// `key`: a number, or null when it is not finite (a missing prediction).
-void EmitNumber(const char* key, double value, YAML::Emitter* out) {
-  *out << YAML::Key << key << YAML::Value;
-  if (std::isfinite(value)) {
-    *out << value;
-  } else {
-    *out << YAML::Null;
-  }
 }
 
 bool IsAmplitude(const HeldOutPrediction& p) {

@@ -1,14 +1,11 @@
 #include "dwellfit/estimator/analysis/parameter_uncertainty.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "Eigen/Cholesky"
 #include "dwellfit/estimator/analysis/profile_likelihood.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/fit/fit_description.h"

@@ -1,6 +1,5 @@
 #include "dwellfit/estimator/run/run_figures.h"
 
-#include <algorithm>
 #include <string>
 #include <utility>
 
@@ -12,17 +11,13 @@
 namespace dwellfit {
 namespace {
 
-std::string HeldControl(const CurveSpec& spec) {
-  return spec.kind == SweepKind::kFrequency
-             ? StringPrintf("a_base = %.6g", spec.a_base)
-             : StringPrintf("%.6g Hz", RadPerSecondToHz(spec.omega_rad_s));
-}
-
 FigureSweep MakeFigureSweep(const IdentificationReport& report, const ResponseCurve& curve) {
   FigureSweep figure;
   figure.id = curve.spec.name;
   figure.kind = curve.spec.kind;
-  figure.held = HeldControl(curve.spec);
+  figure.held = figure.kind == SweepKind::kFrequency
+                    ? StringPrintf("a_base = %.6g", curve.spec.a_base)
+                    : StringPrintf("%.6g Hz", RadPerSecondToHz(curve.spec.omega_rad_s));
   figure.segments = curve.points.empty() ? 1 : curve.points.back().segment + 1;
   figure.role = "validation";
   for (const SweepPrediction& prediction : report.predictions) {
@@ -70,7 +65,6 @@ RunCurves TraceRunCurves(const ParameterVector& parameters,
   } catch (const InputError& error) {
     // The run's status says what happened; the files it can write are
     // still written.
-    traced.curves.clear();
     traced.warning = std::string("no curves or figures: ") + error.what();
     return traced;
   }
@@ -84,11 +78,11 @@ void AppendCurvesAndFigures(const IdentificationReport& report, RunCurves traced
     out << "warning: " << traced.warning << "\n";
     return;
   }
-  const std::vector<ResponseCurve>& curves = traced.curves;
   FigureSet figures;
   figures.corner_lines = EstimateLines(report);
-  for (const ResponseCurve& curve : curves)
+  for (const ResponseCurve& curve : traced.curves) {
     figures.sweeps.push_back(MakeFigureSweep(report, curve));
+  }
   files->emplace_back("curves.csv", std::move(traced.csv));
   files->emplace_back(kFigureScriptName, GnuplotFigureScript(figures));
   if (!render) return;

@@ -106,8 +106,6 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
 
   double sum_noise_sigma = 0.0;
   for (int r = 0; r < options.replicas; ++r) {
-    // The simulated sweeps go the way of measured ones: labelled, the
-    // config's jumps applied, selected, the start found from them.
     const ResolvedRun run = ResolveReplicaRun(config, plan, options.relative_noise,
                                               options.first_seed + static_cast<std::uint64_t>(r));
     IdentificationResult result = FitRun(run).best;

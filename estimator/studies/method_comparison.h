@@ -23,9 +23,7 @@ struct MethodComparisonOptions {
   std::uint64_t first_seed = 1;
   // The phase error the phase-lag fit is shown with [degrees].
   double phase_bias_deg = 2.0;
-  // Add each fit's wall-clock time to the tables. Off for the committed
-  // report: times differ from run to run and machine to machine.
-  bool wall_time = false;
+  bool wall_time = false;  // add wall-clock times (they vary: off for the committed report)
   bool IsValid(std::string* error) const;
 };
 

@@ -6,7 +6,6 @@
 #include <limits>
 #include <map>
 #include <set>
-#include <utility>
 
 #include "dwellfit/estimator/analysis/sweep_prediction.h"
 #include "dwellfit/estimator/common/input_error.h"
@@ -39,11 +38,6 @@ IdentifyConfig VariantConfig(const IdentifyConfig& config, const ModelVariant& v
   copy.identification.solve.solver.num_threads = 1;
   copy.multi_start.threads = 1;
   return copy;
-}
-
-bool SelectedByAny(const Sweep& sweep, const std::vector<SweepSelection>& selections) {
-  return std::any_of(selections.begin(), selections.end(),
-                     [&](const SweepSelection& s) { return s.Selects(sweep); });
 }
 
 // Every combination of the block's choices, delta slowest, omega fastest.
@@ -79,18 +73,12 @@ SweepResult PredictHeldOutSweep(const Sweep& sweep, const ParameterVector& param
     const bool known = std::isfinite(p.predicted);
     const double percent = known ? std::abs(p.ErrorPercent()) : 100.0;
     const double hz = known ? std::abs(p.predicted - p.measured) : p.measured;
-    switch (p.quantity) {
-      case HeldOutQuantity::kJumpDown:
-        errors.jump_down_percent.push_back(percent);
-        errors.jump_down_hz.push_back(hz);
-        break;
-      case HeldOutQuantity::kJumpUp:
-        errors.jump_up_percent.push_back(percent);
-        errors.jump_up_hz.push_back(hz);
-        break;
-      case HeldOutQuantity::kUpperBranchAmplitude:
-        errors.upper_branch_percent.push_back(percent);
-        break;
+    const bool down = p.quantity == HeldOutQuantity::kJumpDown;
+    if (p.quantity == HeldOutQuantity::kUpperBranchAmplitude) {
+      errors.upper_branch_percent.push_back(percent);
+    } else {
+      (down ? errors.jump_down_percent : errors.jump_up_percent).push_back(percent);
+      (down ? errors.jump_down_hz : errors.jump_up_hz).push_back(hz);
     }
   }
   const double relative_rms =
@@ -155,19 +143,11 @@ std::vector<const Sweep*> PoolSweeps(const IdentifyConfig& config,
                                      const std::vector<SweepSelection>& pool,
                                      const std::vector<Sweep>& sweeps,
                                      std::vector<std::string>* levels) {
-  for (const SweepSelection& selection : pool) {
-    if (std::none_of(sweeps.begin(), sweeps.end(),
-                     [&](const Sweep& sweep) { return selection.Selects(sweep); })) {
-      throw InputError(config.config_path, 0, "model_selection.pool",
-                       "sweep '" + selection.Name() + "' is not in the data");
-    }
-  }
-  std::vector<const Sweep*> selected;
-  for (const Sweep& sweep : sweeps) {
-    if (!SelectedByAny(sweep, pool)) continue;
-    selected.push_back(&sweep);
-    if (std::find(levels->begin(), levels->end(), sweep.id) == levels->end()) {
-      levels->push_back(sweep.id);
+  const std::vector<const Sweep*> selected =
+      SelectSweeps(sweeps, pool, config.config_path, "model_selection.pool");
+  for (const Sweep* sweep : selected) {
+    if (std::find(levels->begin(), levels->end(), sweep->id) == levels->end()) {
+      levels->push_back(sweep->id);
     }
   }
   return selected;
@@ -183,8 +163,9 @@ Plan MakePlan(const IdentifyConfig& config, const ModelSelectionConfig& selectio
   Plan plan;
   const std::vector<const Sweep*> pool_sweeps = PoolSweeps(config, pool, sweeps, &plan.levels);
   TrainingIndex(config.fit_sweeps, &plan);
-  for (const Sweep& sweep : sweeps) {
-    if (SelectedByAny(sweep, config.validate_sweeps)) plan.validation.push_back(sweep.Name());
+  for (const Sweep* sweep :
+       SelectSweeps(sweeps, config.validate_sweeps, config.config_path, "validate")) {
+    plan.validation.push_back(sweep->Name());
   }
   plan.predicts[0] = plan.validation;
   if (selection.scheme == CrossValidationScheme::kNone) return plan;
