@@ -68,8 +68,7 @@ struct BlockCovariance {
   double noise_sigma = 0.0;           // s
   double reduced_chi_square = 0.0;    // 2 F_d / (n - k)
   double interval_quantile = 0.0;     // q
-  // sigma_max / sigma_min of the column-normalised J (0: not computed).
-  double collinearity = 0.0;
+  double collinearity = 0.0;  // sigma_max / sigma_min of the column-normalised J (0: not computed)
   // Per ambient entry (FitDescription::AmbientIndex); fixed entries have
   // standard error 0 and interval [value, value]. Empty for an invalid
   // description.

@@ -22,8 +22,7 @@ void AddModelError(const std::vector<const Sweep*>& fitted,
 
 namespace {
 
-// About the length of one predictions.csv row (four round-trip numbers and
-// the labels), to reserve the text at once.
+// About the length of one predictions.csv row, to reserve the text at once.
 constexpr size_t kPredictionRowBytes = 96;
 
 const char* Role(const SweepPrediction& prediction) {
@@ -52,9 +51,8 @@ void EmitPair(const char* key, const T& first, const T& second, YAML::Emitter* o
        << YAML::EndSeq;
 }
 
-// Of parameter i (kNumParameters: alpha_e): ci95, the reported interval
-// (its kind in uncertainty.interval_kind); with the profile's, ci95_ends
-// (crossed, bound, open) and linearised_ci95 (estimate -/+ q standard_error).
+// Of parameter i (kNumParameters: alpha_e): ci95, the reported interval; with
+// the profile's, ci95_ends (crossed, bound, open) and linearised_ci95.
 void EmitInterval(const ParameterUncertainty& u, int i, YAML::Emitter* out) {
   const bool p = i < kNumParameters;
   EmitPair("ci95", p ? u.ci95_low[i] : u.effective_nonlinearity_ci95_low,
@@ -67,8 +65,7 @@ void EmitInterval(const ParameterUncertainty& u, int i, YAML::Emitter* out) {
            p ? u.linearised_ci95_high[i] : u.effective_nonlinearity_linearised_ci95_high, out);
 }
 
-// parameters: value, start, fixed and interval of each; the natural frequency
-// in Hz and the effective nonlinearity with its interval.
+// parameters, the natural frequency in Hz and alpha_e with its interval.
 void EmitParameters(const IdentificationReport& report, YAML::Emitter* out) {
   const ParameterVector& p = report.result.parameters;
   const ParameterUncertainty& u = report.uncertainty;
@@ -227,9 +224,7 @@ void EmitCoverage(const char* key, const IntervalCoverage& c, YAML::Emitter* out
   *out << YAML::EndMap;
 }
 
-// validation_intervals: the rule, the coverage of each quantity (half-widths
-// in Hz for the jumps, the data's unit for the amplitude) and every
-// prediction.
+// validation_intervals: the rule, each quantity's coverage, every prediction.
 void EmitValidationIntervals(const ValidationIntervals& v, YAML::Emitter* out) {
   *out << YAML::Key << "validation_intervals" << YAML::Value << YAML::BeginMap;
   *out << YAML::Key << "rule" << YAML::Value << kPredictionIntervalRule;
@@ -260,8 +255,7 @@ void EmitValidationIntervals(const ValidationIntervals& v, YAML::Emitter* out) {
   *out << YAML::EndMap;
 }
 
-// leave_one_level_out: whether the refits ran, each refit, and the spread
-// of every free parameter and alpha_e (omega in rad/s).
+// leave_one_level_out: the refits and their spread (omega in rad/s).
 void EmitLevelRefits(const LevelRefits& r, YAML::Emitter* out) {
   *out << YAML::Key << "leave_one_level_out" << YAML::Value << YAML::BeginMap;
   *out << YAML::Key << "computed" << YAML::Value << r.computed;
@@ -398,8 +392,7 @@ void PrintJumps(const IdentificationReport& report, std::ostream& out) {
   }
 }
 
-// The validation sweeps' prediction intervals, one line each, and the
-// coverage of each quantity.
+// The validation sweeps' prediction intervals and each quantity's coverage.
 void PrintValidationIntervals(const ValidationIntervals& v, std::ostream& out) {
   if (v.levels.empty()) return;
   out << "validation prediction intervals (95 %)\n  rule: " << kPredictionIntervalRule << "\n";

@@ -88,8 +88,7 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
   study.penalty = config.identification.solve.penalties.bifurcation_range.enabled;
   study.omega_ref_rad_s = config.omega_ref_rad_s.value_or(plan.truth[kNaturalFrequency]);
 
-  // Rows: the free parameters, then alpha_e (index kNumParameters).
-  std::vector<int> rows;
+  std::vector<int> rows;  // the free parameters, then alpha_e (index kNumParameters)
   for (int i = 0; i < kNumParameters; ++i) {
     if (!config.identification.fixed[i]) rows.push_back(i);
   }

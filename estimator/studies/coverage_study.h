@@ -43,8 +43,8 @@ struct CoverageRow {
   double empirical_std = 0.0;        // sample standard deviation of the estimates
   double mean_standard_error = 0.0;  // over replicas with an interval
   int on_bound = 0;  // replicas whose estimate sits on its bound 0 (eta_e, mu1, mu2)
-  // The same count over the replicas whose fit left fewer than
-  // kKinkedFitDwells dwells past their branch end (a smooth minimum).
+  // The same over the replicas with fewer than kKinkedFitDwells dwells past
+  // their branch end (a smooth minimum).
   int smooth_covered = 0;
   int smooth_replicas = 0;
 
@@ -65,15 +65,13 @@ struct CoverageStudy {
   int refitted = 0;            // replicas fitted again from a lower point their profile found
   int kinked = 0;              // replicas with a fitted dwell past its branch end
   double omega_ref_rad_s = 0.0;
-  double mean_noise_sigma = 0.0;      // mean estimated residual sigma
-  int degrees_of_freedom = 0;         // of the first replica
-  std::vector<CoverageRow> rows;      // free parameters in index order, then alpha_e
-  std::vector<std::string> messages;  // distinct unavailability messages, if any
-  // Whether some initial guess came from each replica's data.
-  bool start_from_data = false;
-  // Replica 0's fitted sweeps with their jumps (DescribeJumps).
-  std::vector<std::string> first_replica_jumps;
-  double seconds = 0.0;  // wall time of all replicas
+  double mean_noise_sigma = 0.0;                 // mean estimated residual sigma
+  int degrees_of_freedom = 0;                    // of the first replica
+  std::vector<CoverageRow> rows;                 // free parameters in index order, then alpha_e
+  std::vector<std::string> messages;             // distinct unavailability messages, if any
+  bool start_from_data = false;                  // some initial guess from each replica's data
+  std::vector<std::string> first_replica_jumps;  // replica 0's fitted sweeps (DescribeJumps)
+  double seconds = 0.0;                          // wall time of all replicas
 };
 
 // Runs the study on the config's fitted sweeps of `plan` (its noise is

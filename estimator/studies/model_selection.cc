@@ -53,11 +53,9 @@ std::vector<ModelVariant> ModelVariants(const ModelSelectionConfig& selection) {
   return variants;
 }
 
-// One held-out sweep predicted: its predictions (with their parameter
-// uncertainty when `covariance` is given) and their errors (a missing
-// prediction counts 100 %, in Hz the measured frequency); with no usable
-// fit, every measured jump and upper branch counts 100 % and the relative
-// RMS is left out.
+// One held-out sweep's predictions (with s_p when `covariance` is given) and
+// their errors: a missing prediction counts 100 % (in Hz the measured
+// frequency); without a usable fit the relative RMS is left out.
 struct SweepResult {
   PredictionErrors errors;
   std::vector<HeldOutPrediction> predictions;
@@ -96,8 +94,7 @@ struct Plan {
   std::vector<int> fold_training;                     // per level
   std::vector<std::vector<std::string>> fold_sweeps;  // per level: its pool sweeps' names
   std::vector<std::string> validation;                // the config's validate sweeps' names
-  // Per training set: the sweeps (names) it predicts.
-  std::vector<std::vector<std::string>> predicts;
+  std::vector<std::vector<std::string>> predicts;     // per training set: the sweeps it predicts
 };
 
 std::string Key(const std::vector<SweepSelection>& selections) {
@@ -205,10 +202,8 @@ struct TaskResult {
   std::exception_ptr error;  // an InputError of the config's own fit
 };
 
-// A fit the solver calls usable, but whose parameters are not finite or
-// not physical (eta_e or w not positive), is counted as failed, with the
-// reason. (A fit that ends without an enforced fold or dominated by the
-// penalties already has FitStatus::kFailure.)
+// A fit the solver calls usable whose parameters are not finite or not
+// physical (eta_e or w not positive) is counted as failed, with the reason.
 void DemoteImplausibleFit(IdentificationResult* result) {
   if (!result->IsSolutionUsable()) return;
   const ParameterVector& p = result->parameters;
