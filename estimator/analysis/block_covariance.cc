@@ -2,10 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <memory>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "Eigen/SVD"
@@ -17,7 +15,6 @@
 #include "dwellfit/estimator/fit/jacobian_factor.h"
 #include "dwellfit/estimator/fit/scaled_subset_manifold.h"
 #include "dwellfit/estimator/fit/stage_problem.h"
-#include "glog/logging.h"
 
 namespace dwellfit {
 namespace {
@@ -81,9 +78,8 @@ BlockCovariance Unavailable(BlockCovariance c, const std::string& message) {
   return c;
 }
 
-// A valid description, counts, free entries, zeroed results, the
-// point-sigma flag and its warning; false when there is nothing to estimate
-// (`c->message` says why).
+// Counts, free entries, zeroed results and the point-sigma flag; false
+// (`c->message` says why) when there is nothing to estimate.
 bool Prepare(const FitDescription& fit, const ResidualOptions& residual, BlockCovariance* c) {
   if (!fit.IsValid(&c->message) || !residual.IsValid(&c->message)) return false;
   c->values = fit.Values();
@@ -164,9 +160,8 @@ bool NormaliseColumns(const FitDescription& fit, const std::vector<double>& tang
   return true;
 }
 
-// The collinearity of J_n from R_n (same singular values and right singular
-// vectors); false above kMaxCollinearity, with the null directions and a
-// message naming their entries.
+// The collinearity of J_n from R_n (same singular values); false above
+// kMaxCollinearity, with the null directions and their entries named.
 bool CheckCollinearity(const FitDescription& fit, const Eigen::MatrixXd& r_normalised,
                        BlockCovariance* c) {
   const int k = c->num_free;

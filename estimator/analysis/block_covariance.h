@@ -43,8 +43,7 @@ namespace dwellfit {
 // reciprocal condition number above ~1e-16 and its inverse is not rounding
 // noise.
 inline constexpr double kMaxCollinearity = 1e8;
-// An entry whose share of a (unit) null direction is below this is not
-// implicated in it.
+// An entry's share of a (unit) null direction below which it is not implicated.
 inline constexpr double kNullDirectionShare = 0.1;
 
 struct BlockCovarianceOptions {
@@ -56,42 +55,33 @@ struct BlockCovarianceOptions {
 };
 
 struct BlockCovariance {
-  // False: no covariance (standard errors and covariance 0); `message` says
-  // why.
-  bool available = false;
-  std::string message;  // plain words, always set
-  // Mixed point sigmas (some dwells standardised, some raw).
-  std::vector<std::string> warnings;
-  int num_points = 0;               // n: dwells of every dataset
-  int num_free = 0;                 // k: free entries of the described blocks
-  int degrees_of_freedom = 0;       // n - k
-  int caller_residuals = 0;         // rows of the caller's residual blocks
-  bool evaluated = false;           // the residuals and J were evaluated at the estimate
-  bool all_standardised = false;    // every dwell divided by its point sigma (s = 1)
-  double data_cost = 0.0;           // F_d
-  double noise_sigma = 0.0;         // s
-  double reduced_chi_square = 0.0;  // 2 F_d / (n - k)
-  double interval_quantile = 0.0;   // q
-  // sigma_max / sigma_min of the column-normalised J (0: not computed).
-  double collinearity = 0.0;
+  bool available = false;             // false: no covariance (all 0); `message` says why
+  std::string message;                // plain words, always set
+  std::vector<std::string> warnings;  // mixed point sigmas (some dwells standardised)
+  int num_points = 0;                 // n: dwells of every dataset
+  int num_free = 0;                   // k: free entries of the described blocks
+  int degrees_of_freedom = 0;         // n - k
+  int caller_residuals = 0;           // rows of the caller's residual blocks
+  bool evaluated = false;             // the residuals and J were evaluated at the estimate
+  bool all_standardised = false;      // every dwell divided by its point sigma (s = 1)
+  double data_cost = 0.0;             // F_d
+  double noise_sigma = 0.0;           // s
+  double reduced_chi_square = 0.0;    // 2 F_d / (n - k)
+  double interval_quantile = 0.0;     // q
+  double collinearity = 0.0;  // sigma_max / sigma_min of the column-normalised J (0: not computed)
   // Per ambient entry (FitDescription::AmbientIndex); fixed entries have
   // standard error 0 and interval [value, value]. Empty for an invalid
   // description.
   std::vector<double> values, standard_error, ci95_low, ci95_high;
-  Eigen::MatrixXd covariance;  // ambient x ambient, physical units
-  std::vector<int> free;       // ambient index of each free entry, in order
-  // When the data cannot tell entries apart: orthonormal null directions
-  // (k x r) of J_n.
-  Eigen::MatrixXd null_space;
-  // J_n^T J_n (k x k): the cosines between J_n's columns, +-1 for entries
-  // that change the residuals along one direction.
-  Eigen::MatrixXd column_cosines;
-  // The physical change per unit of each free entry's normalised coordinate.
-  Eigen::VectorXd unit_scale;
+  Eigen::MatrixXd covariance;      // ambient x ambient, physical units
+  std::vector<int> free;           // ambient index of each free entry, in order
+  Eigen::MatrixXd null_space;      // entries not told apart: J_n's null directions (k x r)
+  Eigen::MatrixXd column_cosines;  // J_n^T J_n (k x k): cosines between J_n's columns
+  Eigen::VectorXd unit_scale;      // physical change per unit of each free normalised coordinate
 };
 
-// The covariance of every described entry at the blocks' current values,
-// the dwells measured as `residual` says. Never throws or aborts.
+// The covariance of every described entry at the blocks' current values.
+// Never throws or aborts.
 BlockCovariance EstimateBlockCovariance(const FitDescription& fit, const ResidualOptions& residual,
                                         const BlockCovarianceOptions& options = {});
 

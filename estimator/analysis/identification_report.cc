@@ -1,7 +1,6 @@
 #include "dwellfit/estimator/analysis/identification_report.h"
 
 #include <cmath>
-#include <sstream>
 #include <utility>
 
 #include "dwellfit/estimator/common/string_printf.h"
@@ -10,22 +9,6 @@
 #include "yaml-cpp/yaml.h"
 
 namespace dwellfit {
-
-IdentificationReport MakeIdentificationReport(const std::string& config_path,
-                                              const IdentificationOptions& options,
-                                              const IdentificationResult& result,
-                                              double omega_ref_rad_s,
-                                              const std::vector<const Sweep*>& fitted,
-                                              const std::vector<const Sweep*>& validation) {
-  IdentificationReport report;
-  report.config_path = config_path;
-  report.options = options;
-  report.result = result;
-  report.omega_ref_rad_s =
-      omega_ref_rad_s > 0.0 ? omega_ref_rad_s : result.parameters[kNaturalFrequency];
-  report.predictions = PredictSweeps(result.parameters, fitted, validation);
-  return report;
-}
 
 void AddModelError(const std::vector<const Sweep*>& fitted,
                    const std::vector<const Sweep*>& validation, int threads,
@@ -39,8 +22,7 @@ void AddModelError(const std::vector<const Sweep*>& fitted,
 
 namespace {
 
-// About the length of one predictions.csv row (four round-trip numbers and
-// the labels), to reserve the text at once.
+// About the length of one predictions.csv row, to reserve the text at once.
 constexpr size_t kPredictionRowBytes = 96;
 
 const char* Role(const SweepPrediction& prediction) {
@@ -69,9 +51,8 @@ void EmitPair(const char* key, const T& first, const T& second, YAML::Emitter* o
        << YAML::EndSeq;
 }
 
-// Of parameter i (kNumParameters: alpha_e): ci95, the reported interval
-// (its kind in uncertainty.interval_kind); with the profile's, ci95_ends
-// (crossed, bound, open) and linearised_ci95 (estimate -/+ q standard_error).
+// Of parameter i (kNumParameters: alpha_e): ci95, the reported interval; with
+// the profile's, ci95_ends (crossed, bound, open) and linearised_ci95.
 void EmitInterval(const ParameterUncertainty& u, int i, YAML::Emitter* out) {
   const bool p = i < kNumParameters;
   EmitPair("ci95", p ? u.ci95_low[i] : u.effective_nonlinearity_ci95_low,
@@ -84,8 +65,7 @@ void EmitInterval(const ParameterUncertainty& u, int i, YAML::Emitter* out) {
            p ? u.linearised_ci95_high[i] : u.effective_nonlinearity_linearised_ci95_high, out);
 }
 
-// parameters: value, start, fixed and interval of each; the natural frequency
-// in Hz and the effective nonlinearity with its interval.
+// parameters, the natural frequency in Hz and alpha_e with its interval.
 void EmitParameters(const IdentificationReport& report, YAML::Emitter* out) {
   const ParameterVector& p = report.result.parameters;
   const ParameterUncertainty& u = report.uncertainty;
@@ -185,6 +165,16 @@ void EmitStage(const StageSummary& stage, YAML::Emitter* out) {
   *out << YAML::EndMap;
 }
 
+// `key`: a number, or null when it is not finite (a missing prediction).
+void EmitNumber(const char* key, double value, YAML::Emitter* out) {
+  *out << YAML::Key << key << YAML::Value;
+  if (std::isfinite(value)) {
+    *out << value;
+  } else {
+    *out << YAML::Null;
+  }
+}
+
 // One measured or predicted jump: the measured bracket beside the model's
 // fold, in the file's unit (Hz or a_base).
 void EmitJump(const Sweep& sweep, const PredictedJump& jump, YAML::Emitter* out) {
@@ -196,12 +186,8 @@ void EmitJump(const Sweep& sweep, const PredictedJump& jump, YAML::Emitter* out)
              ControlInFileUnit(sweep, jump.bracket.control_before),
              ControlInFileUnit(sweep, jump.bracket.control_after), out);
   }
-  *out << YAML::Key << (frequency ? "model_hz" : "model_a_base") << YAML::Value;
-  if (jump.exists) {
-    *out << ControlInFileUnit(sweep, jump.control);
-  } else {
-    *out << YAML::Null;
-  }
+  EmitNumber(frequency ? "model_hz" : "model_a_base",
+             jump.exists ? ControlInFileUnit(sweep, jump.control) : NAN, out);
   if (jump.measured) *out << YAML::Key << "inside" << YAML::Value << jump.inside;
   if (jump.measured && jump.bracket.into_missing_data) {
     *out << YAML::Key << "into_missing_data" << YAML::Value << true;
@@ -225,16 +211,6 @@ void EmitSweep(const SweepPrediction& prediction, YAML::Emitter* out) {
   *out << YAML::EndMap;
 }
 
-// `key`: a number, or null when it is not finite (a missing prediction).
-void EmitNumber(const char* key, double value, YAML::Emitter* out) {
-  *out << YAML::Key << key << YAML::Value;
-  if (std::isfinite(value)) {
-    *out << value;
-  } else {
-    *out << YAML::Null;
-  }
-}
-
 bool IsAmplitude(const HeldOutPrediction& p) {
   return p.quantity == HeldOutQuantity::kUpperBranchAmplitude;
 }
@@ -248,9 +224,7 @@ void EmitCoverage(const char* key, const IntervalCoverage& c, YAML::Emitter* out
   *out << YAML::EndMap;
 }
 
-// validation_intervals: the rule, the coverage of each quantity (half-widths
-// in Hz for the jumps, the data's unit for the amplitude) and every
-// prediction.
+// validation_intervals: the rule, each quantity's coverage, every prediction.
 void EmitValidationIntervals(const ValidationIntervals& v, YAML::Emitter* out) {
   *out << YAML::Key << "validation_intervals" << YAML::Value << YAML::BeginMap;
   *out << YAML::Key << "rule" << YAML::Value << kPredictionIntervalRule;
@@ -281,8 +255,7 @@ void EmitValidationIntervals(const ValidationIntervals& v, YAML::Emitter* out) {
   *out << YAML::EndMap;
 }
 
-// leave_one_level_out: whether the refits ran, each refit, and the spread
-// of every free parameter and alpha_e (omega in rad/s).
+// leave_one_level_out: the refits and their spread (omega in rad/s).
 void EmitLevelRefits(const LevelRefits& r, YAML::Emitter* out) {
   *out << YAML::Key << "leave_one_level_out" << YAML::Value << YAML::BeginMap;
   *out << YAML::Key << "computed" << YAML::Value << r.computed;
@@ -424,8 +397,7 @@ void PrintJumps(const IdentificationReport& report, std::ostream& out) {
   }
 }
 
-// The validation sweeps' prediction intervals, one line each, and the
-// coverage of each quantity.
+// The validation sweeps' prediction intervals and each quantity's coverage.
 void PrintValidationIntervals(const ValidationIntervals& v, std::ostream& out) {
   if (v.levels.empty()) return;
   out << "validation prediction intervals (95 %)\n  rule: " << kPredictionIntervalRule << "\n";

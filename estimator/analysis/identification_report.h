@@ -20,12 +20,10 @@ namespace dwellfit {
 
 struct IdentificationReport {
   std::string config_path;
-  // The configuration in effect as a YAML block mapping, recorded in
-  // result.yaml when set.
-  std::string config_in_effect;
+  std::string config_in_effect;   // a YAML block mapping, in result.yaml when set
   IdentificationOptions options;  // the start and the fixed parameters
   IdentificationResult result;
-  double omega_ref_rad_s = 0.0;              // reference of the effective nonlinearity
+  double omega_ref_rad_s = 0.0;              // Omega_ref of alpha_e
   std::vector<SweepPrediction> predictions;  // fitted sweeps first, then validation
   // How the automatic starting point was found (empty: every guess given).
   std::vector<std::string> initial_guess_steps;
@@ -37,24 +35,12 @@ struct IdentificationReport {
   LevelRefits level_refits;
 };
 
-// Builds the report: predicts every sweep at the identified parameters.
-// `omega_ref_rad_s` <= 0 means: the identified natural frequency.
-IdentificationReport MakeIdentificationReport(const std::string& config_path,
-                                              const IdentificationOptions& options,
-                                              const IdentificationResult& result,
-                                              double omega_ref_rad_s,
-                                              const std::vector<const Sweep*>& fitted,
-                                              const std::vector<const Sweep*>& validation);
-
-// Fills report->validation_intervals and report->level_refits at the
-// report's estimate (report->options.initial: the reported fit's start).
+// Fills report->validation_intervals and report->level_refits.
 void AddModelError(const std::vector<const Sweep*>& fitted,
                    const std::vector<const Sweep*>& validation, int threads,
                    IdentificationReport* report);
 
-// result.yaml: status and reason, version, parameters (omega in rad/s) and
-// their uncertainty, stages, per-sweep errors and jumps, model error (when
-// computed) and the configuration in effect.
+// result.yaml (docs/outputs.md; omega in rad/s).
 std::string ReportToYaml(const IdentificationReport& report);
 
 // predictions.csv: one row per measured dwell with the model's amplitude.

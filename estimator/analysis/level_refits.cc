@@ -67,8 +67,7 @@ std::vector<std::string> Warnings(const LevelRefits& r) {
   return warnings;
 }
 
-}  // namespace
-
+// The fitted sweeps' levels (sweep ids) in data order.
 std::vector<std::string> FittedLevels(const std::vector<const Sweep*>& fitted) {
   std::vector<std::string> levels;
   for (const Sweep* sweep : fitted) {
@@ -78,6 +77,8 @@ std::vector<std::string> FittedLevels(const std::vector<const Sweep*>& fitted) {
   }
   return levels;
 }
+
+}  // namespace
 
 std::vector<RefitSpread> SpreadOverRefits(const std::vector<LevelRefit>& refits,
                                           const std::array<bool, kNumParameters>& fixed,

@@ -27,8 +27,7 @@
 
 namespace dwellfit {
 
-// Fewer fitted levels than this: no refits (two refits of one level each
-// say little about the spread).
+// Fewer fitted levels: no refits (two say little about the spread).
 inline constexpr int kMinLevelsForRefits = 3;
 
 struct LevelRefit {
@@ -41,10 +40,9 @@ struct LevelRefit {
   double effective_nonlinearity = 0.0;
 };
 
-// One quantity's spread over the usable refits (index kNumParameters:
-// alpha_e; omega in rad/s).
+// One quantity's spread over the usable refits (omega in rad/s).
 struct RefitSpread {
-  int index = 0;
+  int index = 0;          // kNumParameters: alpha_e
   std::string name;       // ParameterName, or "alpha_e"
   double estimate = 0.0;  // the all-level fit's
   double min = 0.0, max = 0.0;
@@ -61,12 +59,8 @@ struct LevelRefits {
   std::vector<std::string> warnings;
 };
 
-// The fitted sweeps' levels (sweep ids) in data order.
-std::vector<std::string> FittedLevels(const std::vector<const Sweep*>& fitted);
-
-// Runs the refits (see above) of the fit of `fitted` with `options`
-// (options.initial: the reported fit's start) whose estimate is `estimate`.
-// Never throws for a failed refit: its status says it.
+// The refits of the fit of `fitted` with `options` (options.initial: its
+// start) at `estimate`. A failed refit does not throw: its status says it.
 LevelRefits RefitLeavingOneLevelOut(const std::vector<const Sweep*>& fitted,
                                     const IdentificationOptions& options,
                                     const ParameterVector& estimate, double omega_ref_rad_s,

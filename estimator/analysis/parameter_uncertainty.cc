@@ -1,14 +1,11 @@
 #include "dwellfit/estimator/analysis/parameter_uncertainty.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "Eigen/Cholesky"
 #include "dwellfit/estimator/analysis/profile_likelihood.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/fit/fit_description.h"
@@ -45,10 +42,9 @@ std::string PairAdvice(int a, int b) {
          "one of them";
 }
 
-// The plain-words account of what the sweeps cannot see (BlockCovariance's
-// null_space, unit_scale, free and column_cosines). A parameter is
-// implicated when its row of `null_space` has a norm of at least
-// kNullDirectionShare (independent of the basis the SVD returned).
+// What the sweeps cannot see, in plain words. A parameter is implicated when
+// its row of `null_space` has a norm of at least kNullDirectionShare
+// (independent of the basis the SVD returned).
 std::string DescribeNullSpace(const Eigen::MatrixXd& null_space, const Eigen::VectorXd& unit_scale,
                               const std::vector<int>& free, const Eigen::MatrixXd& column_cosines) {
   std::vector<int> involved;
@@ -91,10 +87,9 @@ std::string DescribeNullSpace(const Eigen::MatrixXd& null_space, const Eigen::Ve
   return text + "; " + PairAdvice(involved[0], involved[1]);
 }
 
-// The fitted dwells whose measured branch does not reach their a_base at
-// `estimate` (RootStatus::kBranchEnd): the vertical error then measures them
-// from the fold where that branch ends, and the cost has a kink as the fold
-// passes a dwell. Counts them and warns, naming up to three.
+// Counts the fitted dwells past the end of their branch at `estimate`
+// (RootStatus::kBranchEnd: the cost has a kink where the fold passes a
+// dwell) and warns, naming up to three.
 void WarnAboutDwellsPastTheirBranchEnd(const std::vector<const Sweep*>& fitted,
                                        const ParameterVector& estimate, ParameterUncertainty* u) {
   int count = 0;
@@ -193,8 +188,7 @@ std::vector<PenaltyCurvature> EnforcedJumps(const std::vector<const Sweep*>& fit
   return terms;
 }
 
-// The covariance's counts, noise and collinearity in `u`; its warnings
-// before those of `u`.
+// The covariance's counts, noise, collinearity and warnings into `u`.
 void CopyCounts(const BlockCovariance& c, ParameterUncertainty* u) {
   u->num_points = c.num_points;
   u->num_free = c.num_free;
@@ -286,8 +280,7 @@ BlockCovariance PenalisedCovariance(const std::vector<const Sweep*>& fitted,
 }
 
 // The dwells' covariance, with the penalty's curvature at each enforced jump
-// when the fit had the penalty (C = s^2 H^-1); `u` gets the kind and the
-// penalty terms.
+// when the fit had the penalty (C = s^2 H^-1).
 BlockCovariance PenaltyCovariance(const std::vector<const Sweep*>& fitted,
                                   const IdentificationOptions& options,
                                   const ParameterVector& estimate, const FitSummary* summary,
@@ -352,9 +345,8 @@ bool MakeProfileProblem(const std::vector<const Sweep*>& fitted,
   return problem->threshold > 0.0;
 }
 
-// Replaces the linearised intervals in `u` (kept in linearised_*) by the
-// profile's, and warns where the two differ by more than
-// kIntervalDisagreement or an end is open.
+// Replaces the intervals in `u` by the profile's; warns where an end is open
+// or the two differ by more than kIntervalDisagreement.
 void UseProfile(const ProfileLikelihood& profile, ParameterUncertainty* u) {
   u->profile = profile;
   u->interval_kind = "profile_likelihood";
@@ -383,9 +375,8 @@ void UseProfile(const ProfileLikelihood& profile, ParameterUncertainty* u) {
   }
 }
 
-// Whether every linearised interval is narrower than kRoundOffShare of its
-// parameter: the data are exact to round-off, and a rise of the cost of
-// q^2 s^2 / 2 is below what its evaluation resolves.
+// Every linearised interval narrower than kRoundOffShare of its parameter:
+// exact data, where a rise of q^2 s^2 / 2 is below the cost's resolution.
 bool AtRoundOff(const ParameterUncertainty& u, const ParameterVector& estimate) {
   for (int i = 0; i < kNumParameters; ++i) {
     const double half_width = u.linearised_ci95_high[i] - estimate[i];
@@ -410,10 +401,8 @@ void ProfileIntervals(const std::vector<const Sweep*>& fitted, const Identificat
   UseProfile(ProfileCost(problem, estimate, c.covariance, c.interval_quantile), u);
 }
 
-// Fits the last stage again from `start` with the profile's solve; where
-// that ends below the result's cost, the result moves there (parameters,
-// cost, its last stage's values) and its message says `why`. Returns
-// whether it moved.
+// Fits the last stage again from `start`; where that ends below the result's
+// cost, the result moves there and its message says `why`. Whether it moved.
 bool MoveToLower(const ProfileProblem& problem, const ParameterVector& start,
                  const std::string& why, IdentificationResult* result) {
   ParameterVector p = start;

@@ -42,8 +42,7 @@
 
 namespace dwellfit {
 
-// |correlation| above which a pair of free parameters is reported as weakly
-// separated.
+// |correlation| above which a pair of free parameters is warned about.
 inline constexpr double kCorrelationWarning = 0.99;
 
 using ParameterMatrix = Eigen::Matrix<double, kNumParameters, kNumParameters>;
@@ -55,8 +54,7 @@ enum class IntervalMethod {
   kProfile,     // profile likelihood of the fitted cost (the default)
 };
 
-// |width ratio| beyond which the linearised and the profile interval of a
-// quantity are said to disagree (a warning).
+// Width ratio of the linearised and the profile interval beyond which they disagree.
 inline constexpr double kIntervalDisagreement = 1.5;
 // See EstimateUncertaintyAtMinimum.
 inline constexpr int kMaxRefits = 3;
@@ -65,14 +63,12 @@ inline constexpr double kReprofileShare = 0.05;
 // data exact to round-off: the profile is not run.
 inline constexpr double kRoundOffShare = 1e-9;
 
-// "data_only", "linearised", "profile".
-const char* IntervalMethodName(IntervalMethod method);
-// False for an unknown name.
+const char* IntervalMethodName(IntervalMethod method);  // "data_only", "linearised", "profile"
 bool ParseIntervalMethod(const std::string& name, IntervalMethod* method);
 
 struct ParameterUncertainty {
-  // False: no covariance; `message` (plain words, always set) says why.
-  // Standard errors, intervals, covariance and correlation are then 0.
+  // False: no covariance (errors, intervals and correlations 0); `message`
+  // (always set) says why.
   bool available = false;
   std::string message;
   // "profile_likelihood", "gauss_newton" or "linearised_with_penalty".
@@ -103,21 +99,17 @@ struct ParameterUncertainty {
   double effective_nonlinearity_ci95_high = 0.0;
   double effective_nonlinearity_linearised_ci95_low = 0.0;
   double effective_nonlinearity_linearised_ci95_high = 0.0;
-  // Fitted dwells whose measured branch ends before their control value at
-  // the estimate (the model's fold falls short of them). The cost has a kink
-  // there and the linearisation is poor: over 600 noisy replicas of the
-  // thesis case, alpha_e's interval covered the truth in 82 % of the fits
-  // with two or more such dwells and in 94 % of the others (coverage_study).
+  // Fitted dwells past the end of their measured branch at the estimate: the
+  // cost has a kink there and the linearisation is poor (coverage_study: 82 %
+  // coverage of alpha_e with two or more such dwells, 94 % without).
   int dwells_past_branch_end = 0;
   std::vector<std::string> warnings;
 };
 
 // The uncertainty of the vertical-error fit of `fitted` at `estimate`
-// (residual, point sigmas, fixed parameters and penalties from `options`).
-// `omega_ref_rad_s` <= 0 means the estimate's omega. Never throws for
-// degenerate data: `available` and `message` say what went wrong. kProfile
-// needs the fit's `summary` (its last stage's penalty weights; may be null
-// without penalties) and runs the profiles on `threads`.
+// (`omega_ref_rad_s` <= 0: the estimate's omega). Never throws: `available`
+// and `message` say what went wrong. kProfile needs the fit's `summary` (its
+// penalty weights; may be null without penalties).
 ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted,
                                          const IdentificationOptions& options,
                                          const ParameterVector& estimate, double omega_ref_rad_s,

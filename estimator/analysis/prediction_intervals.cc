@@ -64,6 +64,95 @@ std::vector<double> Derivatives(const ParameterVector& p, int j, const Sweep& sw
   return up;
 }
 
+// The pseudo-inverse of a symmetric positive semi-definite matrix.
+Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& m) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(m);
+  const Eigen::VectorXd& values = eigen.eigenvalues();
+  const double cutoff = 1e-12 * values.cwiseAbs().maxCoeff();
+  Eigen::VectorXd inverse = Eigen::VectorXd::Zero(values.size());
+  for (int i = 0; i < values.size(); ++i) {
+    if (values[i] > cutoff) inverse[i] = 1.0 / values[i];
+  }
+  return eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
+}
+
+// FitPredictionCovariance from C_d = `data_only`.
+ParameterMatrix PredictionCovariance(const ParameterMatrix& data_only,
+                                     const std::vector<const Sweep*>& fitted,
+                                     const IdentificationOptions& options,
+                                     const ParameterVector& parameters) {
+  std::vector<int> free;
+  for (int j = 0; j < kNumParameters; ++j) {
+    if (data_only(j, j) > 0.0) free.push_back(j);
+  }
+  const int k = static_cast<int>(free.size());
+  if (k == 0) return data_only;
+  // Scaled coordinates: q_j = p_j / d_j, d_j = sqrt(C_d,jj).
+  const Eigen::VectorXd d = data_only.diagonal()(free).cwiseSqrt();
+  const Eigen::MatrixXd scaled = data_only(free, free).cwiseQuotient(d * d.transpose());
+  Eigen::MatrixXd information = PseudoInverse(scaled);
+  int observations = 0;
+  for (const Sweep* sweep : fitted) {
+    if (sweep->kind != SweepKind::kFrequency) continue;
+    for (std::size_t q = 0; q < sweep->jumps.size(); ++q) {
+      const JumpBracket& jump = sweep->jumps[q];
+      if (!IsEnforced(options.solve.penalties.bifurcation_range, *sweep, jump)) continue;
+      const double h_k = RadPerSecondToHz(jump.half_width());
+      Eigen::VectorXd g(k);
+      bool finite = h_k > 0.0;
+      for (int a = 0; a < k && finite; ++a) {
+        // d f_k / d q_a = d_a d f_k / d p_j.
+        g[a] = Derivatives(parameters, free[a], *sweep, {}, d[a])[q];
+        finite = std::isfinite(g[a]);
+      }
+      if (!finite) continue;
+      information += g * g.transpose() / (h_k * h_k);
+      ++observations;
+    }
+  }
+  if (observations == 0) return data_only;
+  ParameterMatrix covariance = ParameterMatrix::Zero();
+  covariance(free, free) = d.asDiagonal() * PseudoInverse(information) * d.asDiagonal();
+  return covariance;
+}
+
+// The model error of one prediction: |q_model| x the RMS relative error of
+// the same quantity over every level but `level`.
+double ModelSd(const HeldOutPrediction& p, std::size_t level,
+               const std::vector<std::vector<HeldOutPrediction>*>& levels) {
+  double sum = 0.0;
+  int count = 0;
+  for (std::size_t other = 0; other < levels.size(); ++other) {
+    if (other == level) continue;
+    for (const HeldOutPrediction& q : *levels[other]) {
+      if (q.quantity != p.quantity || !std::isfinite(q.predicted)) continue;
+      const double relative = (q.predicted - q.measured) / q.measured;
+      sum += relative * relative;
+      ++count;
+    }
+  }
+  return count > 0 ? std::abs(p.predicted) * std::sqrt(sum / count) : 0.0;
+}
+
+IntervalCoverage CoverageOf(HeldOutQuantity quantity,
+                            const std::vector<std::vector<HeldOutPrediction>*>& levels) {
+  IntervalCoverage coverage;
+  std::vector<double> widths, percents;
+  for (const std::vector<HeldOutPrediction>* level : levels) {
+    for (const HeldOutPrediction& p : *level) {
+      if (p.quantity != quantity) continue;
+      ++coverage.total;
+      coverage.inside += p.inside;
+      if (!std::isfinite(p.half_width)) continue;
+      widths.push_back(p.half_width);
+      percents.push_back(100.0 * p.half_width / std::abs(p.predicted));
+    }
+  }
+  coverage.median_half_width = MedianOf(widths);
+  coverage.median_half_width_percent = MedianOf(percents);
+  return coverage;
+}
+
 }  // namespace
 
 std::vector<int> UpperBranchDwells(const Sweep& sweep) {
@@ -133,61 +222,6 @@ std::vector<HeldOutPrediction> PredictHeldOut(const Sweep& sweep, const Paramete
   return predictions;
 }
 
-namespace {
-
-// The pseudo-inverse of a symmetric positive semi-definite matrix.
-Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& m) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(m);
-  const Eigen::VectorXd& values = eigen.eigenvalues();
-  const double cutoff = 1e-12 * values.cwiseAbs().maxCoeff();
-  Eigen::VectorXd inverse = Eigen::VectorXd::Zero(values.size());
-  for (int i = 0; i < values.size(); ++i) {
-    if (values[i] > cutoff) inverse[i] = 1.0 / values[i];
-  }
-  return eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
-}
-
-}  // namespace
-
-ParameterMatrix PredictionCovariance(const ParameterMatrix& data_only,
-                                     const std::vector<const Sweep*>& fitted,
-                                     const IdentificationOptions& options,
-                                     const ParameterVector& parameters) {
-  std::vector<int> free;
-  for (int j = 0; j < kNumParameters; ++j) {
-    if (data_only(j, j) > 0.0) free.push_back(j);
-  }
-  const int k = static_cast<int>(free.size());
-  if (k == 0) return data_only;
-  // Scaled coordinates: q_j = p_j / d_j, d_j = sqrt(C_d,jj).
-  const Eigen::VectorXd d = data_only.diagonal()(free).cwiseSqrt();
-  const Eigen::MatrixXd scaled = data_only(free, free).cwiseQuotient(d * d.transpose());
-  Eigen::MatrixXd information = PseudoInverse(scaled);
-  int observations = 0;
-  for (const Sweep* sweep : fitted) {
-    if (sweep->kind != SweepKind::kFrequency) continue;
-    for (std::size_t q = 0; q < sweep->jumps.size(); ++q) {
-      const JumpBracket& jump = sweep->jumps[q];
-      if (!IsEnforced(options.solve.penalties.bifurcation_range, *sweep, jump)) continue;
-      const double h_k = RadPerSecondToHz(jump.half_width());
-      Eigen::VectorXd g(k);
-      bool finite = h_k > 0.0;
-      for (int a = 0; a < k && finite; ++a) {
-        // d f_k / d q_a = d_a d f_k / d p_j.
-        g[a] = Derivatives(parameters, free[a], *sweep, {}, d[a])[q];
-        finite = std::isfinite(g[a]);
-      }
-      if (!finite) continue;
-      information += g * g.transpose() / (h_k * h_k);
-      ++observations;
-    }
-  }
-  if (observations == 0) return data_only;
-  ParameterMatrix covariance = ParameterMatrix::Zero();
-  covariance(free, free) = d.asDiagonal() * PseudoInverse(information) * d.asDiagonal();
-  return covariance;
-}
-
 double HeldOutPrediction::ErrorPercent() const {
   return std::isfinite(predicted) ? 100.0 * (predicted - measured) / measured : kNaN;
 }
@@ -221,47 +255,6 @@ std::optional<ParameterMatrix> FitPredictionCovariance(const std::vector<const S
   }
   return PredictionCovariance(uncertainty.covariance, fitted, options, parameters);
 }
-
-namespace {
-
-// The model error of one prediction: |q_model| x the RMS relative error of
-// the same quantity over every level but `level`.
-double ModelSd(const HeldOutPrediction& p, std::size_t level,
-               const std::vector<std::vector<HeldOutPrediction>*>& levels) {
-  double sum = 0.0;
-  int count = 0;
-  for (std::size_t other = 0; other < levels.size(); ++other) {
-    if (other == level) continue;
-    for (const HeldOutPrediction& q : *levels[other]) {
-      if (q.quantity != p.quantity || !std::isfinite(q.predicted)) continue;
-      const double relative = (q.predicted - q.measured) / q.measured;
-      sum += relative * relative;
-      ++count;
-    }
-  }
-  return count > 0 ? std::abs(p.predicted) * std::sqrt(sum / count) : 0.0;
-}
-
-IntervalCoverage CoverageOf(HeldOutQuantity quantity,
-                            const std::vector<std::vector<HeldOutPrediction>*>& levels) {
-  IntervalCoverage coverage;
-  std::vector<double> widths, percents;
-  for (const std::vector<HeldOutPrediction>* level : levels) {
-    for (const HeldOutPrediction& p : *level) {
-      if (p.quantity != quantity) continue;
-      ++coverage.total;
-      coverage.inside += p.inside;
-      if (!std::isfinite(p.half_width)) continue;
-      widths.push_back(p.half_width);
-      percents.push_back(100.0 * p.half_width / std::abs(p.predicted));
-    }
-  }
-  coverage.median_half_width = MedianOf(widths);
-  coverage.median_half_width_percent = MedianOf(percents);
-  return coverage;
-}
-
-}  // namespace
 
 PredictionCoverage AddPredictionIntervals(
     const std::vector<std::vector<HeldOutPrediction>*>& levels) {

@@ -13,7 +13,7 @@
 //
 //   - s_p^2 = g^T C g, the parameters' uncertainty by the delta method,
 //     g = dq/dp by central differences (relative step 1e-5; 1e-6 absolute
-//     at 0), C the fit's prediction covariance (PredictionCovariance): its
+//     at 0), C the fit's prediction covariance (FitPredictionCovariance): its
 //     dwells-alone covariance with each enforced jump as one observation;
 //   - s_m = |q_model| x the RMS of the relative errors (q_model - q) / q of
 //     the same quantity at every *other* level (0 without one).
@@ -45,19 +45,17 @@ const char* HeldOutQuantityName(HeldOutQuantity quantity);  // "jump-down", ...
 // "jump_down", "jump_up", "upper_branch_amplitude" (file keys).
 const char* HeldOutQuantityKey(HeldOutQuantity quantity);
 
-// One predicted quantity of a sweep the fit did not see, with its 95 %
-// prediction interval.
+// One predicted quantity of a sweep the fit did not see, with its 95 % interval.
 struct HeldOutPrediction {
   std::string sweep;  // its name, "L0.070g/up"
   HeldOutQuantity quantity = HeldOutQuantity::kJumpDown;
-  double measured = 0.0;      // Hz (the bracket's centre), or the amplitude (data's unit)
-  double predicted = 0.0;     // the same; NaN: no usable fit, or the model lacks the fold
-  double parameter_sd = 0.0;  // s_p, the same unit; 0 when the fit has no covariance
-  double model_sd = 0.0;      // s_m, the same unit
-  double half_width = 0.0;    // z sqrt(s_p^2 + s_m^2); NaN without a prediction
-  bool inside = false;        // measured within predicted +/- half_width
-  // 100 (predicted - measured) / measured; NaN without a prediction.
-  double ErrorPercent() const;
+  double measured = 0.0;        // Hz (the bracket's centre), or the amplitude (data's unit)
+  double predicted = 0.0;       // the same; NaN: no usable fit, or the model lacks the fold
+  double parameter_sd = 0.0;    // s_p, the same unit; 0 when the fit has no covariance
+  double model_sd = 0.0;        // s_m, the same unit
+  double half_width = 0.0;      // z sqrt(s_p^2 + s_m^2); NaN without a prediction
+  bool inside = false;          // measured within predicted +/- half_width
+  double ErrorPercent() const;  // 100 (predicted - measured) / measured; NaN without one
 };
 
 // How often the measurements of one quantity fall inside their intervals.
@@ -93,21 +91,13 @@ std::vector<HeldOutPrediction> PredictHeldOut(const Sweep& sweep, const Paramete
 //   C = (C_d^+ + sum_k g_k g_k^T / h_k^2)^+,   g_k = d f_k / d p,
 // on the free parameters, computed in the scale of C_d's diagonal (^+: the
 // pseudo-inverse, eigenvalues below 1e-12 of the largest dropped). Without
-// the penalty, C_d.
-ParameterMatrix PredictionCovariance(const ParameterMatrix& data_only,
-                                     const std::vector<const Sweep*>& fitted,
-                                     const IdentificationOptions& options,
-                                     const ParameterVector& parameters);
-
-// PredictionCovariance with C_d estimated here; none (`why` says why) when
-// it is not available.
+// the penalty, C_d. None (`why` says why) when C_d is not available.
 std::optional<ParameterMatrix> FitPredictionCovariance(const std::vector<const Sweep*>& fitted,
                                                        const IdentificationOptions& options,
                                                        const ParameterVector& parameters,
                                                        std::string* why = nullptr);
 
-// Fills model_sd, half_width and inside of every prediction of every level
-// and returns the coverage of each quantity.
+// Fills model_sd, half_width and inside of every prediction; the coverage.
 PredictionCoverage AddPredictionIntervals(
     const std::vector<std::vector<HeldOutPrediction>*>& levels);
 
@@ -124,9 +114,8 @@ struct ValidationIntervals {
   std::string note;
 };
 
-// Predicts every validation sweep at the fit's `parameters`, with
-// intervals; levels are the validation sweep ids with something to predict,
-// each level's s_m from the others.
+// Every validation sweep predicted at `parameters`, with intervals; a level
+// is a validation sweep id with something to predict, its s_m from the others.
 ValidationIntervals PredictValidationIntervals(const std::vector<const Sweep*>& fitted,
                                                const std::vector<const Sweep*>& validation,
                                                const IdentificationOptions& options,

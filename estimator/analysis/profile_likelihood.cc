@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <memory>
 #include <optional>
 #include <vector>
 
@@ -24,9 +23,8 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 // The profiled quantity: a parameter (ParameterIndex), alpha_e, or none (a refit).
 constexpr int kEffective = kNumParameters;
 constexpr int kNone = -1;
-// The lower end of eta_e and w, which the model needs positive, is tried at
-// this share of the estimate; a profile still below the threshold there
-// reaches the bound 0.
+// Share of the estimate at which the lower end of eta_e and w (positive) is
+// tried; a profile still below the threshold there reaches the bound 0.
 constexpr double kPositiveFloorShare = 1e-3;
 // The first trial's share of the linearised half-width: where the
 // linearisation is right the second trial (secant, 4x) lands on the end;
@@ -207,13 +205,12 @@ struct SideResult {
   }
 };
 
-// One side's search (see the header): the quantity, its direction, the
-// estimate, the linearised path (d p / d theta) and the first step.
+// One side's search (see the header).
 struct Side {
   int quantity = 0;
   double sign = 1.0;
   ParameterVector estimate{};
-  ParameterVector path{};
+  ParameterVector path{};  // d p / d theta, linearised
   double first_step = 0.0;
 };
 

@@ -56,9 +56,7 @@ struct ProfileProblem {
   std::vector<const Sweep*> fitted;
   std::array<bool, kNumParameters> fixed{};
   ResidualOptions residual;
-  // The last stage's penalties with the weights it used (in the cost's own
-  // units, StageSummary::penalties): not weighed again.
-  PenaltyOptions penalties;
+  PenaltyOptions penalties;  // the last stage's, at the weights it used (StageSummary::penalties)
   SolverSettings solver;
   double omega_ref_rad_s = 0.0;  // Omega_ref of alpha_e
   double threshold = 0.0;        // Delta, in the cost's units
@@ -94,8 +92,8 @@ struct ProfileLikelihood {
   int fits = 0;             // every constrained fit
 };
 
-// Fits the last stage again from `p` (updated), only the fixed parameters
-// held; returns the final cost (infinity when it cannot be evaluated).
+// Fits the last stage again from `p` (updated); returns the final cost
+// (infinity when it cannot be evaluated).
 double RefitProfileProblem(const ProfileProblem& problem, ParameterVector* p);
 
 // The profile intervals of every free parameter and of alpha_e around

@@ -44,7 +44,6 @@ struct SweepPrediction {
 
 SweepPrediction PredictSweep(const ParameterVector& parameters, const Sweep& sweep, bool fitted);
 
-// PredictSweep of every fitted sweep, then of every validation sweep.
 std::vector<SweepPrediction> PredictSweeps(const ParameterVector& parameters,
                                            const std::vector<const Sweep*>& fitted,
                                            const std::vector<const Sweep*>& validation);

@@ -14,11 +14,9 @@ std::string ReadTextFile(const std::string& path, const std::string& what_to_giv
   const fs::file_status status = fs::status(path, error);
   if (!fs::exists(status)) throw InputError(path, 0, "", "no such file; " + what_to_give);
   if (!fs::is_regular_file(status)) {
-    throw InputError(path, 0, "",
-                     std::string(fs::is_directory(status) ? "is a folder" : "is not a regular "
-                                                                           "file (a device or "
-                                                                           "pipe)") +
-                         "; " + what_to_give);
+    const char* what =
+        fs::is_directory(status) ? "is a folder" : "is not a regular file (a device or pipe)";
+    throw InputError(path, 0, "", std::string(what) + "; " + what_to_give);
   }
   const std::uintmax_t size = fs::file_size(path, error);
   if (!error && size > kMaxTextFileBytes) {

@@ -43,8 +43,7 @@ constexpr size_t kCurveRowBytes = 112;
 
 }  // namespace
 
-std::vector<CurveSpec> CurveSpecsForSweeps(const std::vector<const Sweep*>& sweeps,
-                                           int points_per_side) {
+std::vector<CurveSpec> CurveSpecsForSweeps(const std::vector<const Sweep*>& sweeps) {
   std::vector<CurveSpec> specs;
   for (const Sweep* first : sweeps) {
     if (std::any_of(specs.begin(), specs.end(),
@@ -68,7 +67,6 @@ std::vector<CurveSpec> CurveSpecsForSweeps(const std::vector<const Sweep*>& swee
     (spec.kind == SweepKind::kFrequency ? spec.a_base : spec.omega_rad_s) = Median(held);
     spec.control_low = *std::min_element(controls.begin(), controls.end());
     spec.control_high = *std::max_element(controls.begin(), controls.end());
-    spec.points_per_side = points_per_side;
     specs.push_back(spec);
   }
   return specs;

@@ -152,22 +152,22 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
   ParameterUncertainty uncertainty =
       EstimateUncertaintyAtMinimum(run.fitted, run.options, omega_ref_rad_s, &result,
                                    ResolveThreadCount(run.options.solve.solver.num_threads));
-  // The report states the start the best fit came from.
-  IdentificationOptions options = run.options;
-  options.initial = multi_start.starts[multi_start.best_start];
-  outcome->report = MakeIdentificationReport(config.config_path, options, result,
-                                             config.omega_ref_rad_s.value_or(0.0), {}, {});
-  outcome->report.initial_guess_steps = run.initial_guess_steps;
-  outcome->report.multi_start = multi_start;
-  outcome->report.uncertainty = std::move(uncertainty);
+  IdentificationReport& report = outcome->report;
+  report.config_path = config.config_path;
+  report.options = run.options;
+  report.options.initial = multi_start.starts[multi_start.best_start];  // the best fit's start
+  report.result = result;
+  report.omega_ref_rad_s = config.omega_ref_rad_s.value_or(result.parameters[kNaturalFrequency]);
+  report.initial_guess_steps = run.initial_guess_steps;
+  report.multi_start = multi_start;
+  report.uncertainty = std::move(uncertainty);
   std::string predictions_csv;
   RunCurves curves;
-  ComputeAfterFit(run, result, &outcome->report, &predictions_csv, &curves);
+  ComputeAfterFit(run, result, &report, &predictions_csv, &curves);
   AddModelError(run.fitted, run.validation,
-                ResolveThreadCount(run.options.solve.solver.num_threads), &outcome->report);
-  outcome->report.config_in_effect = ConfigToYaml(config, ConfigKeys::kAffectingTheResult);
-  MarkUnidentifiable(&outcome->report);
-  const IdentificationReport& report = outcome->report;
+                ResolveThreadCount(run.options.solve.solver.num_threads), &report);
+  report.config_in_effect = ConfigToYaml(config, ConfigKeys::kAffectingTheResult);
+  MarkUnidentifiable(&report);
   PrintReport(report, out);
   std::vector<NamedFile> files = {{"result.yaml", ReportToYaml(report)},
                                   {"predictions.csv", std::move(predictions_csv)}};

@@ -13,17 +13,14 @@
 
 namespace dwellfit {
 
-// What a run produced: the resolved run (the report points into its sweeps)
-// and the report it wrote.
+// The resolved run (the report points into its sweeps) and the report.
 struct IdentifyOutcome {
   ResolvedRun run;
   IdentificationReport report;
 };
 
 struct IdentifyRunOptions {
-  // Render the figures with gnuplot (curves.csv and figures.gp are written
-  // either way).
-  bool render_figures = true;
+  bool render_figures = true;  // gnuplot's images (curves.csv and figures.gp either way)
 };
 
 // Runs the identification and writes its files; prints the config in effect

@@ -152,7 +152,6 @@ class DirectoryLock {
   int fd_ = -1;
 };
 
-// Renames the staged files, then the manifest, into `directory`.
 // The files the previous run's manifest in `directory` lists that this run's
 // `files` do not hold (figures of a run with figures, before one without):
 // plain names only, never a path out of the directory. None without a

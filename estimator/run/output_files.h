@@ -26,10 +26,9 @@ namespace dwellfit {
 // The file that lists a complete run's files; written last.
 inline constexpr char kManifestFileName[] = "manifest.yaml";
 
-// Checks, without writing anything, that `directory` is or can become a
-// writable directory; throws InputError naming the path and `field` (the
-// config key or flag that set it) otherwise. Call it before a long
-// computation whose result goes there.
+// Checks, without writing, that `directory` is or can become a writable
+// directory (before a long computation); else throws InputError naming the
+// path and `field`, the config key or flag that set it.
 void CheckOutputDirectory(const std::string& directory, const std::string& field);
 
 // Creates `directory` if needed and publishes each (file name, content) pair
@@ -40,10 +39,8 @@ void CheckOutputDirectory(const std::string& directory, const std::string& field
 void WriteFilesAtomically(const std::string& directory,
                           const std::vector<std::pair<std::string, std::string>>& files);
 
-// One report file (docs/chapter-tables.md, say): written beside `path` under
-// a name of this process, flushed, then renamed onto it, so `path` holds the
-// old text or the whole new one. No manifest: a report is one file.
-// Errors name `field`, the flag or key that gave the path.
+// One report file written beside `path`, flushed, then renamed onto it, so
+// `path` holds the old text or the whole new one. Errors name `field`.
 void WriteReportAtomically(const std::string& path, const std::string& text,
                            const std::string& field = "--output");
 

@@ -31,29 +31,6 @@ std::vector<Sweep> LoadSweeps(const std::vector<std::string>& data_files) {
   return sweeps;
 }
 
-// The sweeps `selections` name, in data order. Throws InputError naming
-// `config_path` and `field` when a selection matches no sweep.
-std::vector<const Sweep*> SelectSweeps(const std::vector<Sweep>& sweeps,
-                                       const std::vector<SweepSelection>& selections,
-                                       const std::string& config_path, const std::string& field) {
-  for (const SweepSelection& selection : selections) {
-    const auto selects = [&](const Sweep& sweep) { return selection.Selects(sweep); };
-    if (std::none_of(sweeps.begin(), sweeps.end(), selects)) {
-      std::string available;
-      for (const Sweep& sweep : sweeps) available += (available.empty() ? "" : ", ") + sweep.Name();
-      throw InputError(
-          config_path, 0, field,
-          "sweep '" + selection.Name() + "' is not in the data; available: " + available);
-    }
-  }
-  std::vector<const Sweep*> selected;
-  for (const Sweep& sweep : sweeps) {
-    const auto selects = [&](const SweepSelection& selection) { return selection.Selects(sweep); };
-    if (std::any_of(selections.begin(), selections.end(), selects)) selected.push_back(&sweep);
-  }
-  return selected;
-}
-
 // Throws when the fitted sweeps hold no more dwells than there are free
 // parameters: no degree of freedom would be left to estimate the noise.
 void CheckEnoughDwells(const IdentifyConfig& config, const std::vector<const Sweep*>& fitted) {
@@ -134,6 +111,27 @@ void FindAutomaticStart(const IdentifyConfig& config, ResolvedRun* run) {
 
 }  // namespace
 
+std::vector<const Sweep*> SelectSweeps(const std::vector<Sweep>& sweeps,
+                                       const std::vector<SweepSelection>& selections,
+                                       const std::string& config_path, const std::string& field) {
+  for (const SweepSelection& selection : selections) {
+    const auto selects = [&](const Sweep& sweep) { return selection.Selects(sweep); };
+    if (std::none_of(sweeps.begin(), sweeps.end(), selects)) {
+      std::string available;
+      for (const Sweep& sweep : sweeps) available += (available.empty() ? "" : ", ") + sweep.Name();
+      throw InputError(
+          config_path, 0, field,
+          "sweep '" + selection.Name() + "' is not in the data; available: " + available);
+    }
+  }
+  std::vector<const Sweep*> selected;
+  for (const Sweep& sweep : sweeps) {
+    const auto selects = [&](const SweepSelection& selection) { return selection.Selects(sweep); };
+    if (std::any_of(selections.begin(), selections.end(), selects)) selected.push_back(&sweep);
+  }
+  return selected;
+}
+
 ResolvedRun ResolveRun(const IdentifyConfig& config) {
   return ResolveRun(config, LoadSweeps(config.data_files));
 }
@@ -141,7 +139,6 @@ ResolvedRun ResolveRun(const IdentifyConfig& config) {
 ResolvedRun ResolveRun(const IdentifyConfig& config, std::vector<Sweep> sweeps) {
   CheckSettings(config);
   ResolvedRun run;
-  run.config_path = config.config_path;
   run.sweeps = std::move(sweeps);
   DetectJumps(config.jump_detection, &run.sweeps);
   ApplyJumpOverrides(config.jump_overrides, config.config_path, &run.sweeps);

@@ -1,18 +1,9 @@
-// The one path from a config to a fit, taken by `identify`, the chapter's
-// tables, the coverage study and the benchmark alike.
-//
-// ResolveRun turns an IdentifyConfig into a run ready to fit:
-//   1. sweeps: read from the config's data files (or given: simulated replicas);
-//   2. labelled: jumps detected in every sweep (DetectJumps), then replaced
-//      where the config states them (`jumps:`, ApplyJumpOverrides);
-//   3. selected: the `fit` and `validate` sweeps;
-//   4. started: the initial guesses the config leaves to the data found from
-//      the fitted sweeps (AutomaticInitialGuess), with how each was found,
-//      and for a multi-start the automatic start;
-//   5. checked: the options with their start filled in are usable, and
-//      every fixed parameter has a given value.
-// FitRun then fits from that start: IdentifyMultiStart with the config's
-// `multi_start` (one start by default).
+// The one path from a config to a fit, taken by `identify`, the studies and
+// the benchmarks alike. ResolveRun reads the sweeps (or takes simulated ones),
+// labels their jumps (DetectJumps, then the config's `jumps:`), selects the
+// `fit` and `validate` sweeps, finds the guesses the config leaves to the data
+// (AutomaticInitialGuess; for a multi-start also the automatic start) and
+// checks the start; FitRun fits from there (IdentifyMultiStart).
 #ifndef DWELLFIT_ESTIMATOR_RUN_RESOLVED_RUN_H_
 #define DWELLFIT_ESTIMATOR_RUN_RESOLVED_RUN_H_
 
@@ -27,8 +18,7 @@
 
 namespace dwellfit {
 
-// A config resolved into a run. `fitted` and `validation` point into
-// `sweeps`, so the struct moves (the pointers stay valid) but never copies.
+// `fitted` and `validation` point into `sweeps`: the struct moves, never copies.
 struct ResolvedRun {
   ResolvedRun() = default;
   ResolvedRun(ResolvedRun&&) = default;
@@ -36,14 +26,12 @@ struct ResolvedRun {
   ResolvedRun(const ResolvedRun&) = delete;
   ResolvedRun& operator=(const ResolvedRun&) = delete;
 
-  std::string config_path;  // for errors and reports
   // Every sweep, its branches labelled; the selections in data order.
   std::vector<Sweep> sweeps;
   std::vector<const Sweep*> fitted;
   std::vector<const Sweep*> validation;
-  // The config's options with `initial` complete: the given guesses and the
-  // automatic ones (omega in rad/s). Valid (IsValid). A caller may change the
-  // solver's thread count or switch penalties off before FitRun.
+  // The config's options with `initial` complete (omega in rad/s). A caller
+  // may change the solver's thread count or switch penalties off before FitRun.
   IdentificationOptions options;
   MultiStartOptions multi_start;
   // Whether some initial guess came from the data, and how those were found
@@ -63,6 +51,12 @@ ResolvedRun ResolveRun(const IdentifyConfig& config);
 
 // The same on sweeps already in memory (e.g. simulated from a dwell plan).
 ResolvedRun ResolveRun(const IdentifyConfig& config, std::vector<Sweep> sweeps);
+
+// The sweeps `selections` name, in data order. Throws InputError naming
+// `config_path` and `field` when a selection matches no sweep.
+std::vector<const Sweep*> SelectSweeps(const std::vector<Sweep>& sweeps,
+                                       const std::vector<SweepSelection>& selections,
+                                       const std::string& config_path, const std::string& field);
 
 // Fits the run's fitted sweeps from its start (IdentifyMultiStart).
 MultiStartResult FitRun(const ResolvedRun& run);

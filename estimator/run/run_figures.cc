@@ -201,7 +201,6 @@ RunCurves TraceRunCurves(const ParameterVector& parameters,
   } catch (const InputError& error) {
     // The run's status says what happened; the files it can write are
     // still written.
-    traced.curves.clear();
     traced.warning = std::string("no curves or figures: ") + error.what();
     return traced;
   }
@@ -216,7 +215,6 @@ std::string AppendCurvesAndFigures(const IdentificationReport& report, const Ide
     out << "warning: " << traced.warning << "\n";
     return traced.warning;
   }
-  const std::vector<ResponseCurve>& curves = traced.curves;
   FigureSet figures;
   figures.corner_lines = EstimateLines(report);
   figures.overview = OverviewJumps(report);
@@ -224,7 +222,7 @@ std::string AppendCurvesAndFigures(const IdentificationReport& report, const Ide
   figures.control_unit = config.units.a_base.empty() ? "data's unit" : config.units.a_base;
   figures.log_amplitude = config.log_amplitude;
   figures.residual_label = ResidualLabel(report.options.solve.residual, figures.amplitude_unit);
-  for (const ResponseCurve& curve : curves)
+  for (const ResponseCurve& curve : traced.curves)
     figures.sweeps.push_back(MakeFigureSweep(report, curve, config.units.a_base));
   files->emplace_back("curves.csv", std::move(traced.csv));
   files->emplace_back(kFigureScriptName, GnuplotFigureScript(figures));

@@ -15,10 +15,9 @@
 
 namespace dwellfit {
 
-// The model's response curve of every sweep of `sweeps` (one per sweep id,
-// in order) at `parameters`, and their curves.csv text. Where the model has
-// no curve (a fit that stopped with no damping, say), `warning` says why and
-// there are neither curves nor text.
+// The model's response curve of every sweep id of `sweeps` at `parameters`,
+// and their curves.csv text; where the model has no curve (no damping, say),
+// only a `warning` saying why.
 struct RunCurves {
   std::vector<ResponseCurve> curves;
   std::string csv;

@@ -66,13 +66,11 @@ struct FamilyOutcome {
 // The documented family, in a fixed order.
 std::vector<FamilyMember> ConvergenceFamily();
 
-// Simulates `member` and fits it on `base` (its solver, stages, residual and
-// penalty settings) from the automatic start. Never throws: a run that
-// cannot start gives kInvalidInput with the reason.
+// Simulates `member` and fits it on `base`'s settings from the automatic
+// start. Never throws: a run that cannot start gives kInvalidInput.
 FamilyOutcome RunFamilyMember(const IdentifyConfig& base, const FamilyMember& member);
 
-// The outcomes as a Markdown report (deterministic: errors are shown as
-// powers of ten).
+// The outcomes as a Markdown report (errors as powers of ten: deterministic).
 std::string ConvergenceFamilyMarkdown(const std::vector<FamilyOutcome>& outcomes);
 
 }  // namespace dwellfit

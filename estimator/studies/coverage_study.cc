@@ -88,8 +88,7 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
   study.penalty = config.identification.solve.penalties.bifurcation_range.enabled;
   study.omega_ref_rad_s = config.omega_ref_rad_s.value_or(plan.truth[kNaturalFrequency]);
 
-  // Rows: the free parameters, then alpha_e (index kNumParameters).
-  std::vector<int> rows;
+  std::vector<int> rows;  // the free parameters, then alpha_e (index kNumParameters)
   for (int i = 0; i < kNumParameters; ++i) {
     if (!config.identification.fixed[i]) rows.push_back(i);
   }
@@ -106,8 +105,6 @@ CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& pl
 
   double sum_noise_sigma = 0.0;
   for (int r = 0; r < options.replicas; ++r) {
-    // The simulated sweeps go the way of measured ones: labelled, the
-    // config's jumps applied, selected, the start found from them.
     const ResolvedRun run = ResolveReplicaRun(config, plan, options.relative_noise,
                                               options.first_seed + static_cast<std::uint64_t>(r));
     IdentificationResult result = FitRun(run).best;

@@ -1,18 +1,13 @@
-// Coverage study: do the 95 % intervals of EstimateUncertainty cover the
-// truth 95 % of the time?
+// Coverage study: do the 95 % intervals cover the truth 95 % of the time?
 //
-// Each replica r = 0..R-1 simulates the dwell plan with multiplicative noise
-// a *= 1 + sigma_rel N(0, 1) (seed first_seed + r) and takes the path of a
-// measured run (resolved_run.h): branches labelled by jump detection on the
-// noisy sweeps and the config's `jumps:`, the config's sweeps selected, the
-// initial guesses it leaves out found from the replica's data, the fit
-// (multi-start when configured), and the uncertainty at the estimate. For every free parameter and
-// for alpha_e = alpha - (2/3) delta Omega_ref^2 it counts the replicas whose 95 % interval contains
-// the plan's truth, and compares the mean standard error with the empirical standard deviation of
-// the estimates over the replicas (the two agree when the linearised covariance is right).
-// The intervals are those identify reports (IntervalMethod::kProfile: the profile likelihood of
-// the fitted cost, the fit made a minimum first, EstimateUncertaintyAtMinimum), or a linearised
-// kind for comparison; docs/uncertainty.md has the measured table.
+// Replica r = 0..R-1 simulates the dwell plan with multiplicative noise
+// a *= 1 + sigma_rel N(0, 1) (seed first_seed + r) and is fitted as a
+// measured run (ResolveReplicaRun, FitRun). For every free parameter and
+// alpha_e it counts the replicas whose interval contains the truth, and
+// compares the mean standard error with the estimates' standard deviation
+// (they agree when the linearised covariance is right). The intervals are
+// identify's (kProfile, EstimateUncertaintyAtMinimum) or a linearised kind;
+// docs/uncertainty.md has the measured table.
 #ifndef DWELLFIT_ESTIMATOR_STUDIES_COVERAGE_STUDY_H_
 #define DWELLFIT_ESTIMATOR_STUDIES_COVERAGE_STUDY_H_
 
@@ -29,11 +24,9 @@ namespace dwellfit {
 
 struct CoverageStudyOptions {
   int replicas = 200;
-  double relative_noise = 0.01;  // sigma_rel of DwellNoise
-  std::uint64_t first_seed = 1;  // replica r uses seed first_seed + r
-  // How the intervals treat the bifurcation-range penalty
-  // (parameter_uncertainty.h); identify uses the default.
-  IntervalMethod method = IntervalMethod::kProfile;
+  double relative_noise = 0.01;                      // sigma_rel of DwellNoise
+  std::uint64_t first_seed = 1;                      // replica r uses seed first_seed + r
+  IntervalMethod method = IntervalMethod::kProfile;  // identify's
 };
 
 // A fit that leaves this many fitted dwells past the end of their branch
@@ -50,8 +43,8 @@ struct CoverageRow {
   double empirical_std = 0.0;        // sample standard deviation of the estimates
   double mean_standard_error = 0.0;  // over replicas with an interval
   int on_bound = 0;  // replicas whose estimate sits on its bound 0 (eta_e, mu1, mu2)
-  // The same count over the replicas whose fit left fewer than
-  // kKinkedFitDwells dwells past their branch end (a smooth minimum).
+  // The same over the replicas with fewer than kKinkedFitDwells dwells past
+  // their branch end (a smooth minimum).
   int smooth_covered = 0;
   int smooth_replicas = 0;
 
@@ -72,22 +65,18 @@ struct CoverageStudy {
   int refitted = 0;            // replicas fitted again from a lower point their profile found
   int kinked = 0;              // replicas with a fitted dwell past its branch end
   double omega_ref_rad_s = 0.0;
-  double mean_noise_sigma = 0.0;      // mean estimated residual sigma
-  int degrees_of_freedom = 0;         // of the first replica
-  std::vector<CoverageRow> rows;      // free parameters in index order, then alpha_e
-  std::vector<std::string> messages;  // distinct unavailability messages, if any
-  // Whether some initial guess came from each replica's data.
-  bool start_from_data = false;
-  // Replica 0's fitted sweeps with their jumps (DescribeJumps).
-  std::vector<std::string> first_replica_jumps;
-  double seconds = 0.0;  // wall time of all replicas
+  double mean_noise_sigma = 0.0;                 // mean estimated residual sigma
+  int degrees_of_freedom = 0;                    // of the first replica
+  std::vector<CoverageRow> rows;                 // free parameters in index order, then alpha_e
+  std::vector<std::string> messages;             // distinct unavailability messages, if any
+  bool start_from_data = false;                  // some initial guess from each replica's data
+  std::vector<std::string> first_replica_jumps;  // replica 0's fitted sweeps (DescribeJumps)
+  double seconds = 0.0;                          // wall time of all replicas
 };
 
 // Runs the study on the config's fitted sweeps of `plan` (its noise is
-// replaced by options'). Omega_ref: the config's effective-nonlinearity
-// reference, else the truth's omega. Throws InputError when the plan, the
-// selection or a `jumps:` entry does not fit the simulated sweeps, or when no
-// start can be found from a replica's data.
+// replaced by options'); Omega_ref: the config's, else the truth's omega.
+// Throws InputError as ResolveRun does on a replica.
 CoverageStudy RunCoverageStudy(const IdentifyConfig& config, const DwellPlan& plan,
                                const CoverageStudyOptions& options);
 

@@ -23,14 +23,11 @@ struct Method {
   std::vector<ResidualKind> stages;
   bool range_penalty = false;  // the bifurcation range (through the roots for all_roots)
   bool phase_bias = false;     // the measured phase is off by the study's bias
-  // Multiplies the config's bifurcation_range.weight: the chapter enforces
-  // the ranges through the roots by "a large penalty" (section 3.2.3).
-  double range_weight = 1.0;
+  double range_weight = 1.0;   // times the config's bifurcation_range.weight
 };
 
-// The weight of the root-transition penalty in the all-roots method, in
-// units of the data's cost where the stage starts (docs/model.md): large, as
-// the chapter's.
+// The all-roots method's multiple of the config's range weight: the
+// chapter's "large penalty" (3.2.3).
 constexpr double kAllRootsRangeWeight = 1e4;
 
 std::vector<Method> Methods(bool with_phase) {

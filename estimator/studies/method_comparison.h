@@ -21,11 +21,8 @@ struct MethodComparisonOptions {
   int noise_seeds = 5;
   double relative_noise = 0.01;
   std::uint64_t first_seed = 1;
-  // The phase error the phase-lag fit is shown with [degrees].
-  double phase_bias_deg = 2.0;
-  // Add each fit's wall-clock time to the tables. Off for the committed
-  // report: times differ from run to run and machine to machine.
-  bool wall_time = false;
+  double phase_bias_deg = 2.0;  // the phase error the phase-lag fit is shown with [degrees]
+  bool wall_time = false;       // add wall-clock times (they vary: off for the committed report)
   bool IsValid(std::string* error) const;
 };
 

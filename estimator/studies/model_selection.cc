@@ -6,7 +6,6 @@
 #include <limits>
 #include <map>
 #include <set>
-#include <utility>
 
 #include "dwellfit/estimator/analysis/sweep_prediction.h"
 #include "dwellfit/estimator/common/input_error.h"
@@ -41,11 +40,6 @@ IdentifyConfig VariantConfig(const IdentifyConfig& config, const ModelVariant& v
   return copy;
 }
 
-bool SelectedByAny(const Sweep& sweep, const std::vector<SweepSelection>& selections) {
-  return std::any_of(selections.begin(), selections.end(),
-                     [&](const SweepSelection& s) { return s.Selects(sweep); });
-}
-
 // Every combination of the block's choices, delta slowest, omega fastest.
 std::vector<ModelVariant> ModelVariants(const ModelSelectionConfig& selection) {
   std::vector<ModelVariant> variants;
@@ -59,11 +53,9 @@ std::vector<ModelVariant> ModelVariants(const ModelSelectionConfig& selection) {
   return variants;
 }
 
-// One held-out sweep predicted: its predictions (with their parameter
-// uncertainty when `covariance` is given) and their errors (a missing
-// prediction counts 100 %, in Hz the measured frequency); with no usable
-// fit, every measured jump and upper branch counts 100 % and the relative
-// RMS is left out.
+// One held-out sweep's predictions (with s_p when `covariance` is given) and
+// their errors: a missing prediction counts 100 % (in Hz the measured
+// frequency); without a usable fit the relative RMS is left out.
 struct SweepResult {
   PredictionErrors errors;
   std::vector<HeldOutPrediction> predictions;
@@ -79,18 +71,12 @@ SweepResult PredictHeldOutSweep(const Sweep& sweep, const ParameterVector& param
     const bool known = std::isfinite(p.predicted);
     const double percent = known ? std::abs(p.ErrorPercent()) : 100.0;
     const double hz = known ? std::abs(p.predicted - p.measured) : p.measured;
-    switch (p.quantity) {
-      case HeldOutQuantity::kJumpDown:
-        errors.jump_down_percent.push_back(percent);
-        errors.jump_down_hz.push_back(hz);
-        break;
-      case HeldOutQuantity::kJumpUp:
-        errors.jump_up_percent.push_back(percent);
-        errors.jump_up_hz.push_back(hz);
-        break;
-      case HeldOutQuantity::kUpperBranchAmplitude:
-        errors.upper_branch_percent.push_back(percent);
-        break;
+    const bool down = p.quantity == HeldOutQuantity::kJumpDown;
+    if (p.quantity == HeldOutQuantity::kUpperBranchAmplitude) {
+      errors.upper_branch_percent.push_back(percent);
+    } else {
+      (down ? errors.jump_down_percent : errors.jump_up_percent).push_back(percent);
+      (down ? errors.jump_down_hz : errors.jump_up_hz).push_back(hz);
     }
   }
   const double relative_rms =
@@ -108,8 +94,7 @@ struct Plan {
   std::vector<int> fold_training;                     // per level
   std::vector<std::vector<std::string>> fold_sweeps;  // per level: its pool sweeps' names
   std::vector<std::string> validation;                // the config's validate sweeps' names
-  // Per training set: the sweeps (names) it predicts.
-  std::vector<std::vector<std::string>> predicts;
+  std::vector<std::vector<std::string>> predicts;     // per training set: the sweeps it predicts
 };
 
 std::string Key(const std::vector<SweepSelection>& selections) {
@@ -155,19 +140,11 @@ std::vector<const Sweep*> PoolSweeps(const IdentifyConfig& config,
                                      const std::vector<SweepSelection>& pool,
                                      const std::vector<Sweep>& sweeps,
                                      std::vector<std::string>* levels) {
-  for (const SweepSelection& selection : pool) {
-    if (std::none_of(sweeps.begin(), sweeps.end(),
-                     [&](const Sweep& sweep) { return selection.Selects(sweep); })) {
-      throw InputError(config.config_path, 0, "model_selection.pool",
-                       "sweep '" + selection.Name() + "' is not in the data");
-    }
-  }
-  std::vector<const Sweep*> selected;
-  for (const Sweep& sweep : sweeps) {
-    if (!SelectedByAny(sweep, pool)) continue;
-    selected.push_back(&sweep);
-    if (std::find(levels->begin(), levels->end(), sweep.id) == levels->end()) {
-      levels->push_back(sweep.id);
+  const std::vector<const Sweep*> selected =
+      SelectSweeps(sweeps, pool, config.config_path, "model_selection.pool");
+  for (const Sweep* sweep : selected) {
+    if (std::find(levels->begin(), levels->end(), sweep->id) == levels->end()) {
+      levels->push_back(sweep->id);
     }
   }
   return selected;
@@ -183,8 +160,9 @@ Plan MakePlan(const IdentifyConfig& config, const ModelSelectionConfig& selectio
   Plan plan;
   const std::vector<const Sweep*> pool_sweeps = PoolSweeps(config, pool, sweeps, &plan.levels);
   TrainingIndex(config.fit_sweeps, &plan);
-  for (const Sweep& sweep : sweeps) {
-    if (SelectedByAny(sweep, config.validate_sweeps)) plan.validation.push_back(sweep.Name());
+  for (const Sweep* sweep :
+       SelectSweeps(sweeps, config.validate_sweeps, config.config_path, "validate")) {
+    plan.validation.push_back(sweep->Name());
   }
   plan.predicts[0] = plan.validation;
   if (selection.scheme == CrossValidationScheme::kNone) return plan;
@@ -224,10 +202,8 @@ struct TaskResult {
   std::exception_ptr error;  // an InputError of the config's own fit
 };
 
-// A fit the solver calls usable, but whose parameters are not finite or
-// not physical (eta_e or w not positive), is counted as failed, with the
-// reason. (A fit that ends without an enforced fold or dominated by the
-// penalties already has FitStatus::kFailure.)
+// A fit the solver calls usable whose parameters are not finite or not
+// physical (eta_e or w not positive) is counted as failed, with the reason.
 void DemoteImplausibleFit(IdentificationResult* result) {
   if (!result->IsSolutionUsable()) return;
   const ParameterVector& p = result->parameters;

@@ -1,11 +1,9 @@
 // Model selection: the config's fit repeated for every model variant of its
 // `model_selection:` block (delta, mu2 and w each free or held at a value),
 // each scored by its fitted cost, AIC and BIC, and by leave-one-level-out
-// cross-validation over a pool of sweeps. Every fit is the one pipeline of
-// `identify` (ResolveRun, FitRun). docs/model-selection.md states the
-// prediction errors, the stability test, the recommendation rule (also in
-// ModelSelectionReport::rule) and the prediction intervals, with the beam's
-// numbers.
+// cross-validation over a pool of sweeps, each fit made as `identify` makes
+// it (ResolveRun, FitRun). docs/model-selection.md states the errors, the
+// stability test, the rule and the intervals, with the beam's numbers.
 //
 // Likelihood: the last stage's residuals taken as independent Gaussian with
 // one variance estimated from the fit, sigma^2 = RSS / n, RSS = 2 x the data
@@ -21,8 +19,7 @@
 // the config's reference, else the fits' median w): with delta free, alpha
 // and delta trade off along a valley and only alpha_e is determined.
 //
-// Fits run on `threads` threads, each fit's residuals on one; the report
-// does not depend on the thread count.
+// Fits run on `threads` threads; the report does not depend on their count.
 #ifndef DWELLFIT_ESTIMATOR_STUDIES_MODEL_SELECTION_H_
 #define DWELLFIT_ESTIMATOR_STUDIES_MODEL_SELECTION_H_
 
@@ -55,8 +52,7 @@ struct ModelVariant {
   int FreeParameters(const IdentifyConfig& config) const;
 };
 
-// Errors of predicted sweeps (docs/model-selection.md), pooled over the
-// sweeps scored.
+// Errors of predicted sweeps, pooled over the sweeps scored.
 struct PredictionErrors {
   std::vector<double> jump_down_percent;  // one per measured jump-down
   std::vector<double> jump_down_hz;       // the same in Hz
@@ -116,8 +112,7 @@ struct VariantResult {
   double jump_up_hz = 0.0, jump_up_percent = 0.0;
   double upper_branch_percent = 0.0;
   int near_best = 0;  // scores on which it is near-best (rule step 2); -1: not a candidate
-  // The prediction intervals' coverage (cross-validation only).
-  IntervalCoverage jump_down_coverage, jump_up_coverage, upper_branch_coverage;
+  IntervalCoverage jump_down_coverage, jump_up_coverage, upper_branch_coverage;  // of the folds
 };
 
 struct ModelSelectionReport {
@@ -125,22 +120,18 @@ struct ModelSelectionReport {
   ModelSelectionConfig selection;
   std::vector<std::string> pool_levels;  // in data order
   std::vector<VariantResult> variants;
-  int recommended = -1;  // index into variants; -1: none qualifies
-  std::string rule;      // the rule applied, in words
-  std::string verdict;   // why the recommended variant, or why none
-  // The tolerances the rule used: the resonance's half-power width [Hz] and
-  // the amplitude score's [percentage points].
-  double jump_tolerance_hz = 0.0;
-  double amplitude_tolerance_percent = 0.0;
-  // What the user must know about the recommendation (much worse on
-  // amplitudes, unstable, ...): also in the verdict.
-  std::vector<std::string> warnings;
+  int recommended = -1;                      // index into variants; -1: none qualifies
+  std::string rule;                          // the rule applied, in words
+  std::string verdict;                       // why the recommended variant, or why none
+  double jump_tolerance_hz = 0.0;            // the rule's: the resonance's half-power width
+  double amplitude_tolerance_percent = 0.0;  // the rule's, in percentage points
+  std::vector<std::string> warnings;         // about the recommendation, also in the verdict
 };
 
-// Runs the study of config.model_selection (its defaults when unset).
-// `threads` > 0 replaces the block's thread count. Throws InputError naming
-// the config for a pool sweep that is not in the data, a pool of fewer than
-// two levels, or a config whose own fit cannot be set up (ResolveRun).
+// Runs the study of config.model_selection (its defaults when unset);
+// `threads` > 0 replaces its thread count. Throws InputError naming the config
+// for a pool sweep not in the data, a pool of one level, or a config whose own
+// fit cannot be set up (ResolveRun).
 ModelSelectionReport RunModelSelection(const IdentifyConfig& config, int threads = 0);
 
 // model_selection.csv: one row per variant (columns documented in
@@ -154,24 +145,20 @@ std::string ModelSelectionMarkdown(const ModelSelectionReport& report);
 // half-width and its two parts, inside); no rows without cross-validation.
 std::string ModelSelectionLevelsCsv(const ModelSelectionReport& report);
 
-// The config of the recommended variant, ready for `identify --config`: the
-// config in effect (ConfigToYaml: absolute paths) with the variant's free and
-// fixed parameters (a fixed one at its value in initial_guess), under a
-// header saying where it came from. Empty when nothing is recommended.
+// The config in effect (absolute paths) with the recommended variant applied
+// (WithVariant), ready for `identify --config`, under a header saying where
+// it came from. Empty when nothing is recommended.
 std::string RecommendedConfigYaml(const IdentifyConfig& config, const ModelSelectionReport& report);
 
 // The config with `variant` applied (free, or fixed at its value).
 IdentifyConfig WithVariant(const IdentifyConfig& config, const ModelVariant& variant);
 
-// Applies the rule (docs/model-selection.md) to report->variants (their
-// eligible, unstable, scores, BIC and own fits' mu1): sets recommended,
-// near_best, the tolerances, rule, verdict and warnings. Part of
-// RunModelSelection; exposed for tests.
+// Applies the rule to report->variants: sets recommended, near_best, the
+// tolerances, rule, verdict and warnings. Exposed for tests.
 void RecommendVariant(ModelSelectionReport* report);
 
-// Fills every fold's predictions' model_sd, half_width and inside, and the
-// variant's coverage (estimator/analysis/prediction_intervals.h). Part of
-// RunModelSelection; exposed for tests.
+// Fills every fold's prediction intervals and the variant's coverage.
+// Exposed for tests.
 void AddPredictionIntervals(VariantResult* result);
 
 }  // namespace dwellfit

@@ -1,8 +1,5 @@
-// One noisy replica of a dwell plan resolved as a measured run: the plan
-// simulated with relative noise sigma and a seed, then labelled, the
-// config's jumps applied, its sweeps selected and the start found from the
-// replica's data (resolved_run.h). The coverage and sensitivity studies
-// both fit replicas made here.
+// One noisy replica of a dwell plan (relative noise sigma, seed) resolved as
+// a measured run (resolved_run.h), for the coverage and sensitivity studies.
 #ifndef DWELLFIT_ESTIMATOR_STUDIES_REPLICA_RUN_H_
 #define DWELLFIT_ESTIMATOR_STUDIES_REPLICA_RUN_H_
 

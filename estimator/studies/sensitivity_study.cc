@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
-#include <fstream>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -186,14 +185,12 @@ void SummarizeCase(const SensitivityStudy& study, int case_index, std::ostringst
   }
 }
 
-std::string ReadText(const std::string& path) {
-  return ReadTextFile(path, "give the folders of the shards");
-}
+constexpr char kGiveTheShards[] = "give the folders of the shards";
 
 SensitivityStudy ReadStudyYaml(const std::string& path) {
   SensitivityStudy study;
   try {
-    const YAML::Node node = YAML::Load(ReadText(path));
+    const YAML::Node node = YAML::Load(ReadTextFile(path, kGiveTheShards));
     for (const YAML::Node& key : node["axis_keys"])
       study.axis_keys.push_back(key.as<std::string>());
     study.cases = node["cases"].as<int>();
@@ -262,7 +259,7 @@ int ParseCount(const std::string& text, const std::string& path, int line) {
 
 void ReadFitRows(const std::string& path, const SensitivityStudy& shape,
                  std::vector<FitRow>* rows) {
-  std::istringstream csv(ReadText(path));
+  std::istringstream csv(ReadTextFile(path, kGiveTheShards));
   std::string line;
   std::getline(csv, line);
   const size_t keys = shape.axis_keys.size();
@@ -356,37 +353,6 @@ std::string StudyFigureScript(const SensitivityStudy& study) {
   return gp.str();
 }
 
-}  // namespace
-
-std::vector<VaryAxis> ParseVaryFlag(const std::string& flag_value, const std::string& origin) {
-  std::vector<VaryAxis> axes;
-  if (Trim(flag_value).empty()) return axes;
-  for (const std::string& part : SplitOutside(flag_value, ';')) {
-    const size_t equals = part.find('=');
-    VaryAxis axis;
-    axis.key = Trim(part.substr(0, equals));
-    if (equals == std::string::npos || axis.key.empty()) {
-      throw InputError(origin, 0, axis.key,
-                       "'" + part +
-                           "' is not key=value1|value2|...; e.g. "
-                           "'penalties.bifurcation_range.exponent=2|4|10'");
-    }
-    for (const std::string& value : SplitOutside(part.substr(equals + 1), '|')) {
-      if (Trim(value).empty()) {
-        throw InputError(origin, 0, axis.key, "an empty value in '" + part + "'");
-      }
-      axis.values.push_back(Trim(value));
-    }
-    for (const VaryAxis& other : axes) {
-      if (other.key == axis.key) throw InputError(origin, 0, axis.key, "the key is varied twice");
-    }
-    axes.push_back(axis);
-  }
-  return axes;
-}
-
-namespace {
-
 // StudyFingerprint's text of the plan: truth, sweeps and noise, to the last bit.
 std::string PlanText(const DwellPlan& plan) {
   std::string text = "plan truth:";
@@ -417,6 +383,33 @@ std::string StudyFingerprint(const SensitivityOptions& options,
 }
 
 }  // namespace
+
+std::vector<VaryAxis> ParseVaryFlag(const std::string& flag_value, const std::string& origin) {
+  std::vector<VaryAxis> axes;
+  if (Trim(flag_value).empty()) return axes;
+  for (const std::string& part : SplitOutside(flag_value, ';')) {
+    const size_t equals = part.find('=');
+    VaryAxis axis;
+    axis.key = Trim(part.substr(0, equals));
+    if (equals == std::string::npos || axis.key.empty()) {
+      throw InputError(origin, 0, axis.key,
+                       "'" + part +
+                           "' is not key=value1|value2|...; e.g. "
+                           "'penalties.bifurcation_range.exponent=2|4|10'");
+    }
+    for (const std::string& value : SplitOutside(part.substr(equals + 1), '|')) {
+      if (Trim(value).empty()) {
+        throw InputError(origin, 0, axis.key, "an empty value in '" + part + "'");
+      }
+      axis.values.push_back(Trim(value));
+    }
+    for (const VaryAxis& other : axes) {
+      if (other.key == axis.key) throw InputError(origin, 0, axis.key, "the key is varied twice");
+    }
+    axes.push_back(axis);
+  }
+  return axes;
+}
 
 bool SensitivityOptions::IsValid(std::string* why) const {
   auto fail = [why](const std::string& text) {

@@ -1,13 +1,10 @@
-// Sensitivity study: many fits of one config, varying what the caller says
-// (docs/sensitivity.md: the axes, replicas, outputs and shards). Cases are
-// the Cartesian product of the `vary` axes; each is fitted `replicas` times
-// (noisy replicas of a dwell plan, ResolveReplicaRun; without a plan, the
-// config's own data once), every fit on the one path of a measured run.
+// Sensitivity study (docs/sensitivity.md): the config fitted for every case
+// of the Cartesian product of the `vary` axes, `replicas` times each (noisy
+// replicas of a dwell plan; without a plan, the config's data once).
 //
-// Fit i = case * replicas + replica; fits run on `threads` threads (each fit
-// single-threaded) into slots by index, so the output does not depend on the
-// thread count. A shard k/N runs the fits with i % N == k; MergeShards joins
-// the shards' rows back into the order of one run.
+// Fit i = case * replicas + replica, stored by index, so the output does not
+// depend on the thread count. A shard k/N runs the fits with i % N == k;
+// MergeShards joins the shards' rows back into the order of one run.
 #ifndef DWELLFIT_ESTIMATOR_STUDIES_SENSITIVITY_STUDY_H_
 #define DWELLFIT_ESTIMATOR_STUDIES_SENSITIVITY_STUDY_H_
 
@@ -70,9 +67,8 @@ struct SensitivityStudy {
   int total_fits = 0;  // of the whole study (all shards)
   int shard = 0, shards = 1;
   std::optional<ParameterVector> truth;  // the plan's (omega in Hz)
-  // CRC-32 (8 hex digits) of everything that decides the fits: each case's
-  // config in effect, the plan, the noise, the seeds, the replicas and the
-  // standard-error switch. Shards merge only with their own study's.
+  // CRC-32 (8 hex digits) of all that decides the fits (configs, plan, noise,
+  // seeds, replicas, standard errors): shards merge only with their own.
   std::string fingerprint;
   std::vector<FitRow> rows;  // this shard's, by fit index
   double seconds = 0.0;
@@ -81,8 +77,7 @@ struct SensitivityStudy {
 // Called after each fit with (done, of this shard).
 using Progress = std::function<void(int done, int total)>;
 
-// Runs the study. Throws InputError for a bad config, override, plan or
-// option (naming the flag or file).
+// Throws InputError for a bad config, override, plan or option.
 SensitivityStudy RunSensitivityStudy(const SensitivityOptions& options,
                                      const Progress& progress = nullptr);
 
@@ -90,10 +85,8 @@ SensitivityStudy RunSensitivityStudy(const SensitivityOptions& options,
 std::string FitsToCsv(const SensitivityStudy& study);
 std::string SummaryToYaml(const SensitivityStudy& study);
 
-// The files of a study's output folder (docs/sensitivity.md): fits.csv,
-// summary.yaml, study.yaml (what MergeShards needs) and, with `figures`,
-// figures.gp and the images gnuplot draws from it; a missing or failing
-// gnuplot is a line on `warnings`, never an error.
+// fits.csv, summary.yaml, study.yaml (for MergeShards) and, with `figures`,
+// figures.gp and gnuplot's images (no gnuplot: a line on `warnings`).
 std::vector<std::pair<std::string, std::string>> StudyFiles(const SensitivityStudy& study,
                                                             bool figures, std::ostream& warnings);
 

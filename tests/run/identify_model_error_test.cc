@@ -94,8 +94,10 @@ TEST(IdentifyModelError, BeamValidationJumpDownsFallInsideTheirIntervals) {
   const ResolvedRun run = ResolveRun(config);
   const MultiStartResult fit = FitRun(run);
   ASSERT_EQ(fit.best.status, FitStatus::kConverged) << fit.best.message;
-  IdentificationReport report =
-      MakeIdentificationReport(config.config_path, run.options, fit.best, 0.0, run.fitted, {});
+  IdentificationReport report;
+  report.options = run.options;
+  report.result = fit.best;
+  report.omega_ref_rad_s = fit.best.parameters[kNaturalFrequency];
   AddModelError(run.fitted, run.validation, 2, &report);
   EXPECT_FALSE(report.level_refits.computed);
   EXPECT_THAT(report.level_refits.message, HasSubstr("2 levels fitted"));
