@@ -57,12 +57,11 @@ ceres::CostFunction* ProblemBuilder::MakeBatch(
     return batch;
   }
   std::vector<ceres::CostFunction*> members;
-  for (size_t i = first; i < end; ++i) members.push_back(MakeResidual(points[i], warm_started));
+  for (size_t i = first; i < end; ++i) members.push_back(MakeResidual(points[i]));
   return new BatchedCostFunction(std::move(members));
 }
 
-ceres::CostFunction* ProblemBuilder::MakeResidual(
-    const DwellPoint& point, std::vector<VerticalErrorResidual*>* warm_started) const {
+ceres::CostFunction* ProblemBuilder::MakeResidual(const DwellPoint& point) const {
   if (options_.residual == ResidualKind::kAlgebraic) {
     return AlgebraicResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
                                      options_.dwell_weight);
@@ -78,12 +77,9 @@ ceres::CostFunction* ProblemBuilder::MakeResidual(
                                     options_.residual_options.error, weight,
                                     options_.residual_options.amplitude_floor);
   }
-  VerticalErrorResidual* functor = nullptr;
-  ceres::CostFunction* cost = VerticalErrorResidual::Create(
-      point.drive_frequency_rad_s, point.a_base, point.amplitude, point.branch,
-      options_.residual_options.error, weight, options_.residual_options.amplitude_floor, &functor);
-  if (warm_started != nullptr) warm_started->push_back(functor);
-  return cost;
+  return VerticalErrorResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
+                                       point.branch, options_.residual_options.error, weight,
+                                       options_.residual_options.amplitude_floor);
 }
 
 void ProblemBuilder::Add(ceres::CostFunction* cost, const ParameterLayout& layout,

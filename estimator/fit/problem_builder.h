@@ -68,12 +68,8 @@ class ProblemBuilder {
   // The residual blocks AddSweep adds for `sweep`.
   int ResidualBlocks(const Sweep& sweep) const;
 
-  // The cost function of one dwell on one 6-double block, owned by the
-  // caller; a vertical error's functor is appended to `warm_started`.
-  ceres::CostFunction* MakeResidual(
-      const DwellPoint& point, std::vector<VerticalErrorResidual*>* warm_started = nullptr) const;
-
-  const ProblemBuilderOptions& options() const { return options_; }
+  // The cost function of one dwell on one 6-double block, owned by the caller.
+  ceres::CostFunction* MakeResidual(const DwellPoint& point) const;
 
  private:
   // dwell_weight, times 1/sigma of the error where the dwell's sigma is used.

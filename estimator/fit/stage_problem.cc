@@ -98,7 +98,7 @@ void StageProblem::AddDwells() {
 }
 
 void StageProblem::AddPenalties(const PenaltyOptions& penalties) {
-  ProblemBuilderOptions options = builder_.options();
+  ProblemBuilderOptions options = setup_.residuals;
   options.penalties = penalties;
   const ProblemBuilder penalty_builder(options);
   const std::vector<ceres::ResidualBlockId> added = AddOwned(&problem_, false, [&] {

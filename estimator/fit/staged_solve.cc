@@ -369,10 +369,10 @@ struct StartRating {
 // Rates `values` (written into the blocks) on `problem`, the stage's
 // problem of the dwells alone.
 StartRating RateStart(const SolveContext& context, StageProblem* problem,
-                      const std::vector<double>& values, const PenaltyOptions& penalties) {
+                      const std::vector<double>& values) {
   context.fit.SetValues(values);
   problem->EvaluateAfresh();
-  return {problem->MissingFolds(penalties.bifurcation_range), problem->DataCost()};
+  return {problem->MissingFolds(context.options.penalties.bifurcation_range), problem->DataCost()};
 }
 
 // "the dwells' vertical cost is 8.77", after the missing folds, if any.
@@ -443,21 +443,19 @@ struct ChosenStart {
 ChosenStart ChooseStart(const SolveContext& context, const StartRequest& request) {
   const ResidualKind kind = request.kind;
   const std::vector<double>* previous_start = request.previous_start;
-  const PenaltyOptions& penalties = context.options.penalties;
   ChosenStart chosen;
-  std::string* note = &chosen.note;
   std::vector<double> best = context.fit.Values();
   chosen.rated = std::make_unique<StageProblem>(context.fit, MakeSetup(context, kind));
   StageProblem* problem = chosen.rated.get();
   // The previous start first, so that the problem ends holding the values
   // at the usual start, where the previous stage ended.
   std::optional<StartRating> earlier;
-  if (previous_start != nullptr) earlier = RateStart(context, problem, *previous_start, penalties);
-  StartRating rating = RateStart(context, problem, best, penalties);
+  if (previous_start != nullptr) earlier = RateStart(context, problem, *previous_start);
+  StartRating rating = RateStart(context, problem, best);
   std::vector<double> last_rated = best;
   if (earlier) {
     const bool earlier_better = earlier->BetterThan(rating);
-    *note = StartNote(kind, request.after_start_stage, earlier_better, *earlier, rating);
+    chosen.note = StartNote(kind, request.after_start_stage, earlier_better, *earlier, rating);
     if (earlier_better) {
       best = *previous_start;
       rating = *earlier;
@@ -469,18 +467,19 @@ ChosenStart ChooseStart(const SolveContext& context, const StartRequest& request
     fold_stage.fold_stage = true;
     fold_stage.note = "fold stage: the vertical stage's start lacks " +
                       boost::algorithm::join(rating.missing_folds, "; ");
-    if (!RunStage(context, ResidualKind::kAlgebraic, penalties, /*start_only=*/true, &fold_stage,
-                  &chosen.failure)) {
+    if (!RunStage(context, ResidualKind::kAlgebraic, context.options.penalties, /*start_only=*/true,
+                  &fold_stage, &chosen.failure)) {
       return chosen;
     }
     const std::vector<double> after = context.fit.Values();
-    const StartRating folded = RateStart(context, problem, after, penalties);
+    const StartRating folded = RateStart(context, problem, after);
     last_rated = after;
     if (folded.BetterThan(rating)) {
-      *note = note->empty() ? "started where the fold stage ended"
-                            : *note +
-                                  "; then, that start lacking an enforced fold, where the "
-                                  "fold stage ended";
+      chosen.note = chosen.note.empty()
+                        ? "started where the fold stage ended"
+                        : chosen.note +
+                              "; then, that start lacking an enforced fold, where the "
+                              "fold stage ended";
       best = after;
     }
   }
