@@ -66,13 +66,10 @@ StageProblem::StageProblem(const FitDescription& fit, const StageSetup& setup)
   CHECK_EQ(setup.scale.size(), fixed_.size());
   for (const FitBlock& block : fit.blocks) problem_.AddParameterBlock(block.values, block.size);
   int blocks = 0;
-  int points = 0;
   for (const FitDataset& dataset : fit.datasets) {
-    for (const Sweep* sweep : dataset.sweeps) {
-      blocks += builder_.ResidualBlocks(*sweep);
-      points += static_cast<int>(sweep->points.size());
-    }
+    for (const Sweep* sweep : dataset.sweeps) blocks += builder_.ResidualBlocks(*sweep);
   }
+  const int points = fit.NumDwells();
   if (setup.threaded_evaluation) evaluator_.Reserve(blocks, points);
   if (setup.residuals.residual == ResidualKind::kVertical) warm_started_.reserve(points);
   AddDwells();
