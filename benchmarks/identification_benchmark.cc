@@ -146,13 +146,13 @@ void BM_CompressedDwellEvaluation(benchmark::State& state) {
   for (double& value : moved) value *= 1.001;
   ParameterVector point = start;
   ProblemBuilder builder(ProblemBuilderOptions{});
-  ParallelResidualEvaluator evaluator(point.data(), kNumParameters,
+  ParallelResidualEvaluator evaluator({{point.data(), kNumParameters}},
                                       static_cast<int>(state.range(1)), 1);
   std::vector<std::unique_ptr<ceres::CostFunction>> wrappers;
   for (const Sweep* sweep : beam.fitted) {
     for (const DwellPoint& dwell : sweep->points) {
       if (wrappers.size() < dwells)
-        wrappers.emplace_back(evaluator.Wrap(builder.MakeResidual(dwell)));
+        wrappers.emplace_back(evaluator.Wrap(builder.MakeResidual(dwell), {point.data()}));
     }
   }
   if (wrappers.size() < dwells) {

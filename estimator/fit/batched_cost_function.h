@@ -33,8 +33,6 @@ class BatchedCostFunction : public ceres::CostFunction {
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
-  int num_members() const { return static_cast<int>(members_.size()); }
-
  private:
   std::vector<std::unique_ptr<ceres::CostFunction>> members_;
   std::vector<int> first_row_;  // of each member in the batch

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <sstream>
 
+#include "dwellfit/estimator/common/string_printf.h"
 #include "glog/logging.h"
 
 namespace dwellfit {
@@ -19,18 +19,11 @@ namespace {
 
 std::string Quoted(const std::string& name) { return "'" + name + "'"; }
 
-template <typename T>
-std::string ToText(const T& value) {
-  std::ostringstream text;
-  text << value;
-  return text.str();
-}
-
 // A per-entry vector of `block` given with the wrong length.
 bool CheckLength(const FitBlock& block, size_t length, const char* field, std::string* error) {
   if (length == 0 || length == static_cast<size_t>(block.size)) return true;
-  *error = "block " + Quoted(block.name) + ": " + field + " has " + ToText(length) +
-           " entries, the block " + ToText(block.size) + " (give one per entry, or none)";
+  *error = "block " + Quoted(block.name) + ": " + field + " has " + std::to_string(length) +
+           " entries, the block " + std::to_string(block.size) + " (give one per entry, or none)";
   return false;
 }
 
@@ -42,7 +35,7 @@ bool BlockIsValid(const FitDescription& fit, int b, std::string* error) {
     return false;
   }
   if (block.size < 1) {
-    *error = name + ": size must be at least 1, got " + ToText(block.size);
+    *error = name + ": size must be at least 1, got " + std::to_string(block.size);
     return false;
   }
   if (!CheckLength(block, block.entry_names.size(), "entry_names", error) ||
@@ -52,14 +45,14 @@ bool BlockIsValid(const FitDescription& fit, int b, std::string* error) {
   }
   for (int i = 0; i < block.size; ++i) {
     if (!std::isfinite(block.values[i])) {
-      *error = name + ": " + fit.EntryName(b, i) + " is " + ToText(block.values[i]) +
-               "; every value must be a finite number";
+      *error = name + ": " + fit.EntryName(fit.Offset(b) + i) + " is " +
+               StringPrintf("%g", block.values[i]) + "; every value must be a finite number";
       return false;
     }
     const bool free = block.fixed.empty() || !block.fixed[i];
     if (free && !block.scale.empty() && !(block.scale[i] > 0.0 && std::isfinite(block.scale[i]))) {
-      *error = name + ": scale of " + fit.EntryName(b, i) +
-               " must be positive and finite (> 0), got " + ToText(block.scale[i]);
+      *error = name + ": scale of " + fit.EntryName(fit.Offset(b) + i) +
+               " must be positive and finite (> 0), got " + StringPrintf("%g", block.scale[i]);
       return false;
     }
   }
@@ -91,7 +84,7 @@ bool IsInModelRange(const FitDescription& fit, const FitDataset& dataset, int i,
   *error = "dataset " + Quoted(dataset.name) + ": " + ParameterName(i) + " (" +
            fit.EntryName(fit.AmbientIndex(slot)) + ") must be " +
            (positive ? "positive (> 0)" : "non-negative (>= 0: it is bounded below by 0)") +
-           ", got " + ToText(value);
+           ", got " + StringPrintf("%g", value);
   return false;
 }
 
@@ -118,9 +111,9 @@ bool DatasetIsValid(const FitDescription& fit, const FitDataset& dataset, std::s
       return false;
     }
     if (slot.index < 0 || slot.index >= fit.blocks[b].size) {
-      *error = name + ": " + ParameterName(i) + " is mapped to entry " + ToText(slot.index) +
-               " of block " + Quoted(fit.blocks[b].name) + ", which has entries 0 to " +
-               ToText(fit.blocks[b].size - 1);
+      *error = name + ": " + ParameterName(i) + " is mapped to entry " +
+               std::to_string(slot.index) + " of block " + Quoted(fit.blocks[b].name) +
+               ", which has entries 0 to " + std::to_string(fit.blocks[b].size - 1);
       return false;
     }
     if (!IsInModelRange(fit, dataset, i, slot, error)) return false;
@@ -169,16 +162,12 @@ int FitDescription::AmbientIndex(const ParameterSlot& slot) const {
   return Offset(b) + slot.index;
 }
 
-std::string FitDescription::EntryName(int block, int index) const {
-  const FitBlock& b = blocks[block];
-  if (!b.entry_names.empty()) return b.entry_names[index];
-  return b.size == 1 ? b.name : b.name + "[" + ToText(index) + "]";
-}
-
 std::string FitDescription::EntryName(int ambient) const {
   int b = 0;
   while (ambient >= blocks[b].size) ambient -= blocks[b++].size;
-  return EntryName(b, ambient);
+  const FitBlock& block = blocks[b];
+  if (!block.entry_names.empty()) return block.entry_names[ambient];
+  return block.size == 1 ? block.name : block.name + "[" + std::to_string(ambient) + "]";
 }
 
 std::vector<double> FitDescription::Values() const {
@@ -227,14 +216,10 @@ int FitDescription::NumDwells() const {
 FitDescription SingleBlockFit(const std::vector<const Sweep*>& sweeps,
                               const std::array<bool, kNumParameters>& fixed,
                               ParameterVector* parameters) {
-  FitBlock block;
-  block.values = parameters->data();
-  block.size = kNumParameters;
-  block.name = "parameters";
-  block.entry_names.assign(kParameterNames.begin(), kParameterNames.end());
-  block.fixed.assign(fixed.begin(), fixed.end());
   FitDescription fit;
-  fit.blocks = {block};
+  fit.blocks = {{parameters->data(), kNumParameters, "parameters"}};
+  fit.blocks[0].entry_names.assign(kParameterNames.begin(), kParameterNames.end());
+  fit.blocks[0].fixed.assign(fixed.begin(), fixed.end());
   fit.datasets = {{"fit", sweeps, IdentityMap(parameters->data())}};
   return fit;
 }
@@ -245,6 +230,12 @@ bool ParameterLayout::IsIdentity() const {
     if (index[i] != i) return false;
   }
   return true;
+}
+
+ParameterVector ParameterLayout::Values() const {
+  ParameterVector p;
+  for (int i = 0; i < kNumParameters; ++i) p[i] = blocks[block[i]][index[i]];
+  return p;
 }
 
 ParameterLayout LayoutOf(const FitDescription& fit, const ParameterMap& map) {
@@ -261,14 +252,6 @@ ParameterLayout LayoutOf(const FitDescription& fit, const ParameterMap& map) {
     layout.block[i] = position;
     layout.index[i] = map[i].index;
   }
-  return layout;
-}
-
-ParameterLayout SingleBlockLayout(double* parameters) {
-  ParameterLayout layout;
-  layout.blocks = {parameters};
-  layout.sizes = {kNumParameters};
-  for (int i = 0; i < kNumParameters; ++i) layout.index[i] = i;
   return layout;
 }
 

@@ -84,7 +84,6 @@ struct FitDescription {
   int BlockOf(const double* values) const;            // or -1
   int AmbientIndex(const ParameterSlot& slot) const;  // or -1 when not described
   // For messages: entry_names[index] or "name[index]" ("name" for a 1-block).
-  std::string EntryName(int block, int index) const;
   std::string EntryName(int ambient) const;
   std::vector<double> Values() const;  // ambient order
   void SetValues(const std::vector<double>& values) const;
@@ -108,12 +107,11 @@ struct ParameterLayout {
   std::array<int, kNumParameters> index{};  // entry in that block
   // One block of six whose entry i holds parameter i.
   bool IsIdentity() const;
+  ParameterVector Values() const;  // the six parameters at the blocks' values
 };
 
-// The layout of `map` over the blocks of `fit` (every slot described), and
-// the identity layout on one 6-double block.
+// The layout of `map` over the blocks of `fit` (every slot described).
 ParameterLayout LayoutOf(const FitDescription& fit, const ParameterMap& map);
-ParameterLayout SingleBlockLayout(double* parameters);
 
 }  // namespace dwellfit
 

@@ -1,70 +1,55 @@
 #include "dwellfit/estimator/fit/identification_options.h"
 
 #include <cmath>
-#include <initializer_list>
-#include <sstream>
 #include <utility>
+
+#include "dwellfit/estimator/common/string_printf.h"
 
 namespace dwellfit {
 namespace {
 
-// The value of `all` whose name is `name`, into *value; false when none.
-template <typename Enum>
-bool FromName(const std::string& name, std::initializer_list<Enum> all,
-              const char* (*name_of)(Enum), Enum* value) {
-  for (Enum candidate : all) {
-    if (name == name_of(candidate)) {
-      *value = candidate;
+// The enumerator whose name (`names`, in enumerator order) is `name`, into
+// *value; false when none.
+template <typename Enum, size_t N>
+bool FromName(const std::string& name, const char* const (&names)[N], Enum* value) {
+  for (size_t i = 0; i < N; ++i) {
+    if (name == names[i]) {
+      *value = static_cast<Enum>(i);
       return true;
     }
   }
   return false;
 }
 
-template <typename T>
-std::string ToText(const T& value) {
-  std::ostringstream text;
-  text << value;
-  return text.str();
-}
+// Names in enumerator order.
+constexpr const char* kResidualKindNames[] = {"algebraic", "vertical", "phase_lag", "all_roots"};
+constexpr const char* kErrorMeasureNames[] = {"absolute", "relative"};
+constexpr const char* kJumpTargetNames[] = {"frequency_jump_up", "frequency_jump_down",
+                                            "amplitude_jump_up", "amplitude_jump_down"};
 
 // Whether `value` is a non-negative number; else *error names `field`.
 bool IsNonNegative(const std::string& field, double value, std::string* error) {
   if (value >= 0.0 && std::isfinite(value)) return true;
-  *error = field + " must be a non-negative number (>= 0), got " + ToText(value);
+  *error = field + " must be a non-negative number (>= 0), got " + StringPrintf("%g", value);
   return false;
 }
 
 }  // namespace
 
 const char* ResidualKindName(ResidualKind kind) {
-  switch (kind) {
-    case ResidualKind::kAlgebraic:
-      return "algebraic";
-    case ResidualKind::kVertical:
-      return "vertical";
-    case ResidualKind::kPhaseLag:
-      return "phase_lag";
-    case ResidualKind::kAllRoots:
-      return "all_roots";
-  }
-  return "vertical";
+  return kResidualKindNames[static_cast<int>(kind)];
 }
 
 bool ResidualKindFromName(const std::string& name, ResidualKind* kind) {
-  return FromName(name,
-                  {ResidualKind::kAlgebraic, ResidualKind::kVertical, ResidualKind::kPhaseLag,
-                   ResidualKind::kAllRoots},
-                  ResidualKindName, kind);
+  return FromName(name, kResidualKindNames, kind);
 }
 
 const char* ErrorMeasureName(ErrorMeasure measure) {
-  return measure == ErrorMeasure::kAbsolute ? "absolute" : "relative";
+  return kErrorMeasureNames[static_cast<int>(measure)];
 }
 
 bool ErrorMeasureFromName(const std::string& name, ErrorMeasure* measure) {
-  return FromName(name, {ErrorMeasure::kAbsolute, ErrorMeasure::kRelative}, ErrorMeasureName,
-                  measure);
+  return FromName(name, kErrorMeasureNames, measure);
 }
 
 bool ResidualOptions::IsValid(std::string* error) const {
@@ -91,25 +76,10 @@ bool SolverSettings::IsValid(std::string* error) const {
   return true;
 }
 
-const char* JumpTargetName(JumpTarget target) {
-  switch (target) {
-    case JumpTarget::kFrequencyJumpUp:
-      return "frequency_jump_up";
-    case JumpTarget::kFrequencyJumpDown:
-      return "frequency_jump_down";
-    case JumpTarget::kAmplitudeJumpUp:
-      return "amplitude_jump_up";
-    case JumpTarget::kAmplitudeJumpDown:
-      return "amplitude_jump_down";
-  }
-  return "frequency_jump_down";
-}
+const char* JumpTargetName(JumpTarget target) { return kJumpTargetNames[static_cast<int>(target)]; }
 
 bool JumpTargetFromName(const std::string& name, JumpTarget* target) {
-  return FromName(name,
-                  {JumpTarget::kFrequencyJumpUp, JumpTarget::kFrequencyJumpDown,
-                   JumpTarget::kAmplitudeJumpUp, JumpTarget::kAmplitudeJumpDown},
-                  JumpTargetName, target);
+  return FromName(name, kJumpTargetNames, target);
 }
 
 bool BifurcationRangeOptions::IsValid(std::string* error) const {
@@ -144,17 +114,17 @@ bool IdentificationOptions::InitialIsValid(std::string* error) const {
   for (int i = 0; i < kNumParameters; ++i) {
     const std::string field = std::string("initial.") + ParameterName(i);
     if (!std::isfinite(initial[i])) {
-      *error = field + " must be a finite number, got " + ToText(initial[i]);
+      *error = field + " must be a finite number, got " + StringPrintf("%g", initial[i]);
       return false;
     }
     const bool positive = i == kEtaE || i == kNaturalFrequency;
     if (positive && !(initial[i] > 0.0)) {
-      *error = field + " must be positive (> 0), got " + ToText(initial[i]);
+      *error = field + " must be positive (> 0), got " + StringPrintf("%g", initial[i]);
       return false;
     }
     if ((i == kMu1 || i == kMu2) && initial[i] < 0.0) {
       *error = field + " must be non-negative (>= 0: it is bounded below by 0), got " +
-               ToText(initial[i]);
+               StringPrintf("%g", initial[i]);
       return false;
     }
   }

@@ -158,15 +158,11 @@ std::optional<BackbonePoint> FindBackbonePoint(const Level& level,
                      id.c_str(), RadPerSecondToHz(omega)));
     return std::nullopt;
   }
-  BackbonePoint point;
-  point.omega = omega;
-  point.a = best->amplitude;
-  point.a_base = best->a_base;
-  point.description =
+  return BackbonePoint{
+      omega, best->amplitude, best->a_base,
       StringPrintf("%s %s %.3f Hz a %.4g a_base %.4g", id.c_str(),
                    level.kind == SweepKind::kFrequency ? "peak" : "upper-branch end",
-                   RadPerSecondToHz(omega), point.a, point.a_base);
-  return point;
+                   RadPerSecondToHz(omega), best->amplitude, best->a_base)};
 }
 
 // The damping per unit forcing effectiveness at amplitude a,
@@ -242,13 +238,8 @@ std::vector<OffResonanceDwell> CollectOffResonance(const std::vector<const Sweep
       // P = Omega a (m1 + m2 a), the damping part of the fixed point.
       const double p = omega * a * (damping.m1 + damping.m2 * a);
       if (!(p <= kOffResonanceMaxP * point.a_base)) continue;
-      OffResonanceDwell dwell;
-      dwell.y = omega * omega * (1.0 + 0.5 * delta * a * a);
-      dwell.a2 = a * a;
-      dwell.q = std::sqrt(point.a_base * point.a_base - p * p) / a;
-      dwell.omega = omega;
-      dwell.branch = point.branch;
-      dwells.push_back(dwell);
+      dwells.push_back({omega * omega * (1.0 + 0.5 * delta * a * a), a * a,
+                        std::sqrt(point.a_base * point.a_base - p * p) / a, omega, point.branch});
     }
   }
   return dwells;
@@ -278,14 +269,12 @@ bool LooksSoftening(const std::vector<const Sweep*>& sweeps) {
 struct JointFit {
   double w2 = 0.0;
   double e = 0.0;
-  int dwells = 0;
 };
 
 JointFit FitFrequencyAndForcing(const std::vector<OffResonanceDwell>& dwells, double y0, double a0,
                                 double omega0, bool softening) {
   JointFit fit;
   const int n = static_cast<int>(dwells.size());
-  fit.dwells = n;
   for (int pass = 0; pass < 2; ++pass) {
     Eigen::MatrixXd a(n, 2);
     Eigen::VectorXd rhs(n);
@@ -398,7 +387,7 @@ BackboneFit FitBackbone(const std::vector<const Sweep*>& sweeps,
         "s_i (w^2 + (3/4) alpha a_i^2 - Omega_i^2) = 2 eta_e sqrt(a_base_i^2 - P_i^2) / a_i "
         "for (w^2, eta_e), alpha tied to the backbone point by "
         "Omega_0^2 = w^2 + (3/4) alpha a_0^2",
-        joint.dwells);
+        static_cast<int>(off_resonance.size()));
   }
   if (!(fit.w2 > 0.0) || !std::isfinite(fit.w2 + fit.b)) {
     throw InputError(StringPrintf(
@@ -414,16 +403,11 @@ void SetStiffness(const BackboneFit& fit, const KnownParameters& known,
                   InitialGuessReport* report) {
   ParameterVector& guess = report->guess;
   std::vector<std::string>& steps = report->steps;
-  if (known[kNaturalFrequency]) {
-    guess[kNaturalFrequency] = *known[kNaturalFrequency];
-    steps.push_back(
-        StringPrintf("omega = %s: given", RadPerSecondText(guess[kNaturalFrequency]).c_str()));
-  } else {
-    guess[kNaturalFrequency] = std::sqrt(fit.w2);
-    steps.push_back(StringPrintf("omega = %s: %s; w^2 is its value at a = 0",
-                                 RadPerSecondText(guess[kNaturalFrequency]).c_str(),
-                                 fit.how.c_str()));
-  }
+  guess[kNaturalFrequency] = known[kNaturalFrequency].value_or(std::sqrt(fit.w2));
+  const std::string how =
+      known[kNaturalFrequency] ? "given" : fit.how + "; w^2 is its value at a = 0";
+  steps.push_back(StringPrintf("omega = %s: %s", RadPerSecondText(guess[kNaturalFrequency]).c_str(),
+                               how.c_str()));
   if (!TakeGiven(known, kAlpha, report)) {
     guess[kAlpha] = fit.b / 0.75;
     steps.push_back(StringPrintf(
@@ -442,12 +426,10 @@ void SetStiffness(const BackboneFit& fit, const KnownParameters& known,
 void SetForcing(const BackboneFit& fit, const std::vector<OffResonanceDwell>& off_resonance,
                 const KnownParameters& known, InitialGuessReport* report) {
   ParameterVector& guess = report->guess;
-  if (TakeGiven(known, kEtaE, report)) {
-    // as given
-  } else if (fit.joint_e) {
+  if (!TakeGiven(known, kEtaE, report) && fit.joint_e) {
     guess[kEtaE] = 0.5 * *fit.joint_e;
     report->steps.push_back(StringPrintf("eta_e = %.4g: %s", guess[kEtaE], fit.how.c_str()));
-  } else {
+  } else if (!known[kEtaE]) {
     std::vector<double> q, abs_d;
     for (const OffResonanceDwell& d : off_resonance) {
       q.push_back(d.q);

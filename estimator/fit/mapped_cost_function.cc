@@ -1,8 +1,8 @@
 #include "dwellfit/estimator/fit/mapped_cost_function.h"
 
 #include <algorithm>
-#include <vector>
 
+#include "ceres/internal/fixed_array.h"
 #include "glog/logging.h"
 
 namespace dwellfit {
@@ -10,7 +10,7 @@ namespace dwellfit {
 namespace {
 
 // Residuals of a wrapped function whose Jacobian fits on the stack (every
-// dwellfit functor has one).
+// dwellfit functor has one; more go on the heap).
 constexpr int kStackResiduals = 4;
 
 }  // namespace
@@ -34,14 +34,9 @@ bool MappedCostFunction::Evaluate(double const* const* parameters, double* resid
   if (jacobians == nullptr) return model_cost_->Evaluate(model_blocks, residuals, nullptr);
 
   const int rows = num_residuals();
-  double on_stack[kStackResiduals * kNumParameters];
-  std::vector<double> on_heap;
-  double* model_jacobian = on_stack;
-  if (rows > kStackResiduals) {
-    on_heap.resize(static_cast<size_t>(rows) * kNumParameters);
-    model_jacobian = on_heap.data();
-  }
-  double* model_jacobians[] = {model_jacobian};
+  ceres::internal::FixedArray<double, kStackResiduals * kNumParameters> model_jacobian(
+      rows * kNumParameters);
+  double* model_jacobians[] = {model_jacobian.data()};
   if (!model_cost_->Evaluate(model_blocks, residuals, model_jacobians)) return false;
 
   for (size_t b = 0; b < layout_.blocks.size(); ++b) {

@@ -1,13 +1,13 @@
 #include "dwellfit/estimator/fit/multi_start.h"
 
 #include <algorithm>
-#include <atomic>
 #include <boost/random/uniform_real_distribution.hpp>
 #include <cmath>
 #include <random>
-#include <thread>
 
 #include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
+#include "tbb/parallel_for.h"
+#include "tbb/task_arena.h"
 
 namespace dwellfit {
 
@@ -78,7 +78,6 @@ MultiStartResult IdentifyMultiStart(const std::vector<const Sweep*>& fitted,
     result.best.message = error;
     result.starts = {options.initial};
     result.final_costs = {0.0};
-    result.converged = {false};
     return result;
   }
   result.starts = MultiStartPoints(options, automatic, multi_start);
@@ -89,23 +88,18 @@ MultiStartResult IdentifyMultiStart(const std::vector<const Sweep*>& fitted,
   IdentificationOptions per_start = options;
   per_start.solve.solver.num_threads = std::max(
       1, ResolveThreadCount(options.solve.solver.num_threads) / std::max(parallel_starts, 1));
-  std::atomic<int> next{0};
-  auto worker = [&]() {
-    for (int i = next++; i < n; i = next++) {
+  tbb::task_arena arena(parallel_starts);
+  arena.execute([&] {
+    tbb::parallel_for(0, n, [&](int i) {
       IdentificationOptions start = per_start;
       start.initial = result.starts[i];
       fits[i] = Identify(fitted, start);
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < parallel_starts; ++t) pool.emplace_back(worker);
-  worker();
-  for (std::thread& thread : pool) thread.join();
+    });
+  });
 
   int best_usable = -1;
   for (int i = 0; i < n; ++i) {
     result.final_costs.push_back(fits[i].final_cost);
-    result.converged.push_back(fits[i].converged);
     if (!Usable(fits[i])) {
       ++result.failed;
       continue;

@@ -33,7 +33,6 @@ struct MultiStartResult {
   int best_start = 0;                   // index into `starts`
   std::vector<ParameterVector> starts;  // every starting point, in order
   std::vector<double> final_costs;      // of each start
-  std::vector<bool> converged;          // of each start
   int reached_best = 0;                 // starts whose estimate matches the best's
   // Starts whose fit is not usable or not finite: never the best unless all.
   int failed = 0;

@@ -222,12 +222,10 @@ class ParallelResidualEvaluator::ReplayingCostFunction : public ceres::CostFunct
 
   // Where the wrapped function's parameter block j starts in the evaluator's point.
   int Offset(size_t j) const { return owner_->block_offsets_[first_offset_ + j]; }
-  double* Point() { return owner_->storage_.data() + storage_offset_; }
-  const double* Point() const { return owner_->storage_.data() + storage_offset_; }
-  double* Residuals() { return Point() + total_; }
-  const double* Residuals() const { return Point() + total_; }
-  double* Jacobian() { return Point() + total_ + rows_; }
-  const double* Jacobian() const { return Point() + total_ + rows_; }
+  // In owner_->storage_, which const evaluations read and Precompute writes.
+  double* Point() const { return owner_->storage_.data() + storage_offset_; }
+  double* Residuals() const { return Point() + total_; }
+  double* Jacobian() const { return Point() + total_ + rows_; }
 
   // `parameters` are the precomputed point.
   bool AtPoint(double const* const* parameters) const {
@@ -290,8 +288,7 @@ ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, 
                                                      int min_rows_per_thread)
     : blocks_(std::move(blocks)),
       num_threads_(num_threads),
-      min_rows_per_thread_(min_rows_per_thread),
-      workers_(nullptr) {
+      min_rows_per_thread_(min_rows_per_thread) {
   CHECK(!blocks_.empty());
   for (const Block& block : blocks_) {
     CHECK(block.values != nullptr);
@@ -303,11 +300,6 @@ ParallelResidualEvaluator::ParallelResidualEvaluator(std::vector<Block> blocks, 
   CHECK_GE(min_rows_per_thread, 1);
   CopyToPoint(BlockValues(), &iterate_);  // sized once: IterateEntry hands out pointers into it
 }
-
-ParallelResidualEvaluator::ParallelResidualEvaluator(const double* parameters, int size,
-                                                     int num_threads, int min_rows_per_thread)
-    : ParallelResidualEvaluator(std::vector<Block>{{parameters, size}}, num_threads,
-                                min_rows_per_thread) {}
 
 ParallelResidualEvaluator::~ParallelResidualEvaluator() = default;
 
@@ -326,10 +318,6 @@ ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_f
   wrappers_.push_back(wrapper);
   rows_ += cost_function->num_residuals();
   return wrapper;
-}
-
-ceres::CostFunction* ParallelResidualEvaluator::Wrap(ceres::CostFunction* cost_function) {
-  return Wrap(cost_function, {const_cast<double*>(blocks_[0].values)});
 }
 
 void ParallelResidualEvaluator::Reserve(int wrappers, int residuals) {

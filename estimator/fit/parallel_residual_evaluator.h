@@ -56,16 +56,12 @@ class ParallelResidualEvaluator : public ceres::EvaluationCallback {
   // `num_threads` >= 1; `min_rows_per_thread` >= 1 (less for benchmarks).
   ParallelResidualEvaluator(std::vector<Block> blocks, int num_threads,
                             int min_rows_per_thread = kMinRowsPerThread);
-  ParallelResidualEvaluator(const double* parameters, int size, int num_threads,
-                            int min_rows_per_thread = kMinRowsPerThread);
   ~ParallelResidualEvaluator() override;
 
   // Takes ownership of `cost_function` on `parameter_blocks` (watched
   // blocks); returns its replaying wrapper, owned by the caller.
   ceres::CostFunction* Wrap(ceres::CostFunction* cost_function,
                             const std::vector<double*>& parameter_blocks);
-  // The same on the first watched block alone.
-  ceres::CostFunction* Wrap(ceres::CostFunction* cost_function);
   // The one residual block that stands in for every wrapper made so far
   // (above; at most once): `size + 1` residuals on every watched block.
   // Owned by the caller; the wrappers stay usable in a problem of their own.

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 #include <utility>
 #include <vector>
 
@@ -19,16 +18,6 @@
 #include "dwellfit/residuals/functors/vertical_error_residual.h"
 
 namespace dwellfit {
-
-bool ProblemBuilderOptions::IsValid(std::string* error) const {
-  if (!(dwell_weight > 0.0) || !std::isfinite(dwell_weight)) {
-    std::ostringstream message;
-    message << "dwell_weight must be positive and finite (> 0), got " << dwell_weight;
-    *error = message.str();
-    return false;
-  }
-  return residual_options.IsValid(error) && penalties.IsValid(error);
-}
 
 ProblemBuilder::ProblemBuilder(const ProblemBuilderOptions& options) : options_(options) {}
 
@@ -68,12 +57,11 @@ ceres::CostFunction* ProblemBuilder::MakeBatch(
     return batch;
   }
   std::vector<ceres::CostFunction*> members;
-  for (size_t i = first; i < end; ++i) members.push_back(MakeResidual(points[i], warm_started));
+  for (size_t i = first; i < end; ++i) members.push_back(MakeResidual(points[i]));
   return new BatchedCostFunction(std::move(members));
 }
 
-ceres::CostFunction* ProblemBuilder::MakeResidual(
-    const DwellPoint& point, std::vector<VerticalErrorResidual*>* warm_started) const {
+ceres::CostFunction* ProblemBuilder::MakeResidual(const DwellPoint& point) const {
   if (options_.residual == ResidualKind::kAlgebraic) {
     return AlgebraicResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
                                      options_.dwell_weight);
@@ -89,12 +77,9 @@ ceres::CostFunction* ProblemBuilder::MakeResidual(
                                     options_.residual_options.error, weight,
                                     options_.residual_options.amplitude_floor);
   }
-  VerticalErrorResidual* functor = nullptr;
-  ceres::CostFunction* cost = VerticalErrorResidual::Create(
-      point.drive_frequency_rad_s, point.a_base, point.amplitude, point.branch,
-      options_.residual_options.error, weight, options_.residual_options.amplitude_floor, &functor);
-  if (warm_started != nullptr) warm_started->push_back(functor);
-  return cost;
+  return VerticalErrorResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
+                                       point.branch, options_.residual_options.error, weight,
+                                       options_.residual_options.amplitude_floor);
 }
 
 void ProblemBuilder::Add(ceres::CostFunction* cost, const ParameterLayout& layout,
@@ -118,24 +103,16 @@ int ProblemBuilder::AddSweep(const Sweep& sweep, const ParameterLayout& layout,
                            "column, or choose other stages");
     }
   }
-  if (!options_.batch_dwells) {
-    for (const DwellPoint& point : sweep.points) {
-      Add(MakeResidual(point, warm_started), layout, problem, evaluator);
-    }
-  } else {
-    const size_t count = sweep.points.size();
-    for (size_t first = 0; first < count; first += kDwellsPerBatch) {
-      const size_t end = std::min(count, first + kDwellsPerBatch);
-      Add(MakeBatch(sweep.points, first, end, warm_started), layout, problem, evaluator);
-    }
+  const size_t count = sweep.points.size();
+  for (size_t first = 0; first < count; first += kDwellsPerBatch) {
+    const size_t end = std::min(count, first + kDwellsPerBatch);
+    Add(MakeBatch(sweep.points, first, end, warm_started), layout, problem, evaluator);
   }
-  return static_cast<int>(sweep.points.size());
+  return static_cast<int>(count);
 }
 
 int ProblemBuilder::ResidualBlocks(const Sweep& sweep) const {
-  const size_t dwells = sweep.points.size();
-  return static_cast<int>(options_.batch_dwells ? (dwells + kDwellsPerBatch - 1) / kDwellsPerBatch
-                                                : dwells);
+  return static_cast<int>((sweep.points.size() + kDwellsPerBatch - 1) / kDwellsPerBatch);
 }
 
 JumpTarget TargetOf(const Sweep& sweep, const JumpBracket& jump) {
@@ -194,10 +171,9 @@ bool FoldExists(const Sweep& sweep, const JumpBracket& jump, const ParameterVect
   return penalty.SolveFold(p).exists;
 }
 
-int ProblemBuilder::AddPenalties(const Sweep& sweep, const ParameterLayout& layout,
-                                 ceres::Problem* problem,
-                                 ParallelResidualEvaluator* evaluator) const {
-  int blocks = 0;
+void ProblemBuilder::AddPenalties(const Sweep& sweep, const ParameterLayout& layout,
+                                  ceres::Problem* problem,
+                                  ParallelResidualEvaluator* evaluator) const {
   const bool algebraic = options_.residual == ResidualKind::kAlgebraic;
   const BifurcationRangeOptions& range = options_.penalties.bifurcation_range;
   for (const JumpBracket& jump : sweep.jumps) {
@@ -205,7 +181,6 @@ int ProblemBuilder::AddPenalties(const Sweep& sweep, const ParameterLayout& layo
     Add(algebraic ? MakeFoldCondition(sweep, jump)
                   : MakeBifurcationRangePenalty(sweep, jump, range, options_.residual),
         layout, problem, evaluator);
-    ++blocks;
   }
   const BranchStabilityOptions& stability = options_.penalties.branch_stability;
   if (stability.enabled && !algebraic && !sweep.points.empty()) {
@@ -217,10 +192,8 @@ int ProblemBuilder::AddPenalties(const Sweep& sweep, const ParameterLayout& layo
       Add(BranchStabilityPenalty::Create(point.drive_frequency_rad_s, point.amplitude, point.branch,
                                          lambda, stability.weight),
           layout, problem, evaluator);
-      ++blocks;
     }
   }
-  return blocks;
 }
 
 }  // namespace dwellfit

@@ -17,7 +17,6 @@
 #ifndef DWELLFIT_ESTIMATOR_FIT_PROBLEM_BUILDER_H_
 #define DWELLFIT_ESTIMATOR_FIT_PROBLEM_BUILDER_H_
 
-#include <string>
 #include <vector>
 
 #include "ceres/problem.h"
@@ -37,9 +36,6 @@ struct ProblemBuilderOptions {
   // covariance's 1/s against the caller's standardised blocks. > 0.
   double dwell_weight = 1.0;
   PenaltyOptions penalties;  // eqs. (3.17) and (3.19), for AddPenalties
-  // Up to kDwellsPerBatch consecutive dwells per residual block.
-  bool batch_dwells = false;
-  bool IsValid(std::string* error) const;
 };
 
 class ProblemBuilder {
@@ -48,13 +44,14 @@ class ProblemBuilder {
   // theirs, few enough that a sweep's batches spread over the threads.
   static constexpr size_t kDwellsPerBatch = 32;
 
-  // `options` should be valid; the staged solve checks them.
+  // The staged solve has checked the residual options and penalties.
   explicit ProblemBuilder(const ProblemBuilderOptions& options);
 
   // Adds the residuals of every dwell of `sweep` (two each for kPhaseLag,
   // which throws InputError naming a dwell without a measured phase) on the
-  // blocks of `layout` (which must outlive `problem`), in order, batched
-  // with `batch_dwells`; through `evaluator` (the problem's evaluation
+  // blocks of `layout` (which must outlive `problem`), in order, up to
+  // kDwellsPerBatch consecutive dwells per residual block; through
+  // `evaluator` (the problem's evaluation
   // callback) when given. The vertical error's functors are appended to
   // `warm_started`, when given. Returns the number of dwells added.
   int AddSweep(const Sweep& sweep, const ParameterLayout& layout, ceres::Problem* problem,
@@ -65,19 +62,14 @@ class ProblemBuilder {
   // enforced measured jump, a BranchStabilityPenalty per dwell labelled
   // lower or upper. On the algebraic residual the enforced jumps get their
   // unweighted FoldConditionResidual instead, and no branch-stability term.
-  // Returns the number of blocks added.
-  int AddPenalties(const Sweep& sweep, const ParameterLayout& layout, ceres::Problem* problem,
-                   ParallelResidualEvaluator* evaluator = nullptr) const;
+  void AddPenalties(const Sweep& sweep, const ParameterLayout& layout, ceres::Problem* problem,
+                    ParallelResidualEvaluator* evaluator = nullptr) const;
 
   // The residual blocks AddSweep adds for `sweep`.
   int ResidualBlocks(const Sweep& sweep) const;
 
-  // The cost function of one dwell on one 6-double block, owned by the
-  // caller; a vertical error's functor is appended to `warm_started`.
-  ceres::CostFunction* MakeResidual(
-      const DwellPoint& point, std::vector<VerticalErrorResidual*>* warm_started = nullptr) const;
-
-  const ProblemBuilderOptions& options() const { return options_; }
+  // The cost function of one dwell on one 6-double block, owned by the caller.
+  ceres::CostFunction* MakeResidual(const DwellPoint& point) const;
 
  private:
   // dwell_weight, times 1/sigma of the error where the dwell's sigma is used.

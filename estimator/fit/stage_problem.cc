@@ -15,10 +15,9 @@
 
 namespace dwellfit {
 
-ceres::Problem::Options StageProblem::ProblemOptions(ParallelResidualEvaluator* evaluator,
-                                                     bool threaded) {
+ceres::Problem::Options StageProblem::ProblemOptions(ParallelResidualEvaluator* evaluator) {
   ceres::Problem::Options options;
-  if (threaded) options.evaluation_callback = evaluator;
+  options.evaluation_callback = evaluator;
   options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // cost_functions_ owns them
   return options;
 }
@@ -53,41 +52,28 @@ std::vector<ParallelResidualEvaluator::Block> StageProblem::EvaluatedBlocks(
   return blocks;
 }
 
-namespace {
-
-ProblemBuilderOptions Batched(ProblemBuilderOptions options) {
-  options.batch_dwells = true;
-  return options;
-}
-
-}  // namespace
-
 StageProblem::StageProblem(const FitDescription& fit, const StageSetup& setup)
     : fit_(fit),
       setup_(setup),
-      held_(setup.held),
       held_constant_(fit.blocks.size(), false),
-      builder_(Batched(setup.residuals)),
+      builder_(setup.residuals),
       eta_e_entries_(fit.EntriesHolding({kEtaE})),
       damping_entries_(fit.EntriesHolding({kMu1, kMu2})),
       fixed_(fit.FixedEntries()),
       evaluator_(EvaluatedBlocks(fit), setup.num_threads),
-      problem_(ProblemOptions(&evaluator_, setup.threaded_evaluation)),
-      dwell_problem_(ProblemOptions(nullptr, false)) {
+      problem_(ProblemOptions(Evaluator())),
+      dwell_problem_(ProblemOptions(nullptr)) {
   CHECK_EQ(setup.scale.size(), fixed_.size());
   for (const FitBlock& block : fit.blocks) problem_.AddParameterBlock(block.values, block.size);
   int blocks = 0;
-  int points = 0;
   for (const FitDataset& dataset : fit.datasets) {
-    for (const Sweep* sweep : dataset.sweeps) {
-      blocks += builder_.ResidualBlocks(*sweep);
-      points += static_cast<int>(sweep->points.size());
-    }
+    for (const Sweep* sweep : dataset.sweeps) blocks += builder_.ResidualBlocks(*sweep);
   }
+  const int points = fit.NumDwells();
   if (setup.threaded_evaluation) evaluator_.Reserve(blocks, points);
   if (setup.residuals.residual == ResidualKind::kVertical) warm_started_.reserve(points);
   AddDwells();
-  if (Compressed() && !dwell_blocks_.empty()) {
+  if (setup.threaded_evaluation && !dwell_blocks_.empty()) {
     std::vector<double*> all;
     for (const FitBlock& block : fit.blocks) all.push_back(block.values);
     ceres::CostFunction* compressed = evaluator_.Compress();
@@ -109,7 +95,7 @@ void StageProblem::AddDwells() {
 }
 
 void StageProblem::AddPenalties(const PenaltyOptions& penalties) {
-  ProblemBuilderOptions options = builder_.options();
+  ProblemBuilderOptions options = setup_.residuals;
   options.penalties = penalties;
   const ProblemBuilder penalty_builder(options);
   const std::vector<ceres::ResidualBlockId> added = AddOwned(&problem_, false, [&] {
@@ -122,17 +108,11 @@ void StageProblem::AddPenalties(const PenaltyOptions& penalties) {
   penalty_blocks_.insert(penalty_blocks_.end(), added.begin(), added.end());
 }
 
-ParameterVector StageProblem::ValuesOf(const ParameterLayout& layout) {
-  ParameterVector p;
-  for (int i = 0; i < kNumParameters; ++i) p[i] = layout.blocks[layout.block[i]][layout.index[i]];
-  return p;
-}
-
 std::vector<std::string> StageProblem::MissingFolds(const BifurcationRangeOptions& range) const {
   std::vector<std::string> missing;
   if (!range.enabled) return missing;
   for (size_t d = 0; d < fit_.datasets.size(); ++d) {
-    const ParameterVector p = ValuesOf(layouts_[d]);
+    const ParameterVector p = layouts_[d].Values();
     for (const Sweep* sweep : fit_.datasets[d].sweeps) {
       for (const JumpBracket& jump : sweep->jumps) {
         if (!IsEnforced(range, *sweep, jump) || FoldExists(*sweep, jump, p)) continue;
@@ -200,6 +180,32 @@ void StageProblem::Configure() {
 
 namespace {
 
+// `cost` at `blocks` with every Jacobian (row-major, one per block); false
+// if it fails.
+bool EvaluateWithJacobians(const ceres::CostFunction& cost, const std::vector<double*>& blocks,
+                           std::vector<double>* residuals,
+                           std::vector<std::vector<double>>* jacobians) {
+  residuals->resize(cost.num_residuals());
+  jacobians->resize(blocks.size());
+  std::vector<double*> pointers;
+  for (size_t j = 0; j < blocks.size(); ++j) {
+    (*jacobians)[j].resize(cost.num_residuals() * cost.parameter_block_sizes()[j]);
+    pointers.push_back((*jacobians)[j].data());
+  }
+  return cost.Evaluate(blocks.data(), residuals->data(), pointers.data());
+}
+
+// Whether `cost` evaluates at `blocks`, with finite residuals and Jacobian.
+bool EvaluatesFinite(const ceres::CostFunction& cost, const std::vector<double*>& blocks) {
+  std::vector<double> residuals;
+  std::vector<std::vector<double>> jacobians;
+  if (!EvaluateWithJacobians(cost, blocks, &residuals, &jacobians)) return false;
+  const auto finite = [](const std::vector<double>& values) {
+    return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
+  };
+  return finite(residuals) && std::all_of(jacobians.begin(), jacobians.end(), finite);
+}
+
 double CostOf(const std::vector<ceres::ResidualBlockId>& blocks, ceres::Problem* problem) {
   if (blocks.empty()) return 0.0;
   ceres::Problem::EvaluateOptions evaluate;
@@ -215,7 +221,7 @@ double CostOf(const std::vector<ceres::ResidualBlockId>& blocks, ceres::Problem*
 
 double StageProblem::DataCost() {
   // The dwells' own blocks answer from the evaluator's values at the point.
-  if (Compressed()) evaluator_.PrepareForEvaluation(false, true);
+  if (setup_.threaded_evaluation) evaluator_.PrepareForEvaluation(false, true);
   return CostOf(dwell_blocks_, dwell_problem());
 }
 
@@ -241,14 +247,9 @@ bool StageProblem::CostGradient(std::vector<double>* gradient) {
     std::vector<double*> blocks;
     problem_.GetParameterBlocksForResidualBlock(id, &blocks);
     const int rows = cost->num_residuals();
-    std::vector<double> residuals(rows);
-    std::vector<std::vector<double>> jacobians(blocks.size());
-    std::vector<double*> jacobian_pointers(blocks.size());
-    for (size_t j = 0; j < blocks.size(); ++j) {
-      jacobians[j].resize(static_cast<size_t>(rows) * cost->parameter_block_sizes()[j]);
-      jacobian_pointers[j] = jacobians[j].data();
-    }
-    if (!cost->Evaluate(blocks.data(), residuals.data(), jacobian_pointers.data())) return false;
+    std::vector<double> residuals;
+    std::vector<std::vector<double>> jacobians;
+    if (!EvaluateWithJacobians(*cost, blocks, &residuals, &jacobians)) return false;
     double weight = 1.0;
     if (const ceres::LossFunction* loss = problem_.GetLossFunctionForResidualBlock(id)) {
       double squared_norm = 0.0;
@@ -296,31 +297,6 @@ void StageProblem::MoveToIterate() {
   }
 }
 
-bool StageProblem::EvaluatesFinite(const ceres::CostFunction& cost,
-                                   const std::vector<double*>& blocks) {
-  std::vector<double> residuals(cost.num_residuals());
-  std::vector<std::vector<double>> jacobian(blocks.size());
-  std::vector<double*> jacobians;
-  for (size_t b = 0; b < blocks.size(); ++b) {
-    jacobian[b].resize(cost.num_residuals() * cost.parameter_block_sizes()[b]);
-    jacobians.push_back(jacobian[b].data());
-  }
-  std::vector<const double*> point(blocks.begin(), blocks.end());
-  if (!cost.Evaluate(point.data(), residuals.data(), jacobians.data())) return false;
-  bool finite = true;
-  for (double r : residuals) finite = finite && std::isfinite(r);
-  for (const std::vector<double>& j : jacobian) {
-    for (double v : j) finite = finite && std::isfinite(v);
-  }
-  return finite;
-}
-
-bool StageProblem::EvaluatesFinite(ceres::ResidualBlockId block) {
-  std::vector<double*> blocks;
-  problem_.GetParameterBlocksForResidualBlock(block, &blocks);
-  return EvaluatesFinite(*problem_.GetCostFunctionForResidualBlock(block), blocks);
-}
-
 std::string StageProblem::DescribeFailure(const std::string& ceres_message) {
   // Each dwell on its own (the problem may hold them in batches).
   int dwells = 0;
@@ -328,7 +304,7 @@ std::string StageProblem::DescribeFailure(const std::string& ceres_message) {
   const Sweep* sweep = nullptr;  // of the first dwell that fails
   const DwellPoint* point = nullptr;
   for (size_t d = 0; d < fit_.datasets.size(); ++d) {
-    ParameterVector p = ValuesOf(layouts_[d]);
+    ParameterVector p = layouts_[d].Values();
     const std::vector<double*> block = {p.data()};
     for (const Sweep* s : fit_.datasets[d].sweeps) {
       for (const DwellPoint& dwell : s->points) {
@@ -342,7 +318,12 @@ std::string StageProblem::DescribeFailure(const std::string& ceres_message) {
   }
   bool bad_other = false;
   for (const std::vector<ceres::ResidualBlockId>* ids : {&penalty_blocks_, &caller_blocks_}) {
-    for (ceres::ResidualBlockId id : *ids) bad_other = bad_other || !EvaluatesFinite(id);
+    for (ceres::ResidualBlockId id : *ids) {
+      std::vector<double*> blocks;
+      problem_.GetParameterBlocksForResidualBlock(id, &blocks);
+      bad_other =
+          bad_other || !EvaluatesFinite(*problem_.GetCostFunctionForResidualBlock(id), blocks);
+    }
   }
   if (point == nullptr) {
     return bad_other ? "a penalty or caller's term is not finite there (penalties, "

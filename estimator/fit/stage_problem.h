@@ -2,8 +2,8 @@
 // FitDescription, for every solve of SolveStaged and the covariance.
 //
 // In order: every described block; the dwells of every dataset in batches
-// (ProblemBuilder::AddSweep), through a ParallelResidualEvaluator unless
-// !threaded_evaluation, optionally compressed into one block; when asked,
+// (ProblemBuilder::AddSweep), through a ParallelResidualEvaluator and
+// compressed into one block unless !threaded_evaluation; when asked,
 // the penalties and the caller's residual blocks; last the bounds, fixed
 // and held entries and scaling (Configure).
 #ifndef DWELLFIT_ESTIMATOR_FIT_STAGE_PROBLEM_H_
@@ -27,18 +27,14 @@ struct StageSetup {
   // The dwells' residual (its `penalties` unused: AddPenalties takes them).
   ProblemBuilderOptions residuals;
   std::vector<double> scale;  // per ambient entry: the change of one step unit
-  // Per ambient entry: held in addition to the fixed entries (empty: none).
-  std::vector<bool> held;
   bool bound_damping = true;  // mu1, mu2 >= 0 (eta_e >= 0 always)
   // Evaluate the dwells and penalties through the ParallelResidualEvaluator
-  // on `num_threads` (>= 1) threads; false: Ceres evaluates each block
-  // itself (the covariance, which evaluates twice).
+  // on `num_threads` (>= 1) threads, the solver seeing the dwells as one
+  // block (ParallelResidualEvaluator::Compress) and their own blocks
+  // (dwell_blocks) in a problem of their own; false: Ceres evaluates each
+  // block itself (the covariance, which evaluates twice).
   bool threaded_evaluation = true;
   int num_threads = 1;
-  // With threaded_evaluation: the solver sees the dwells as one block
-  // (ParallelResidualEvaluator::Compress); their own blocks (dwell_blocks)
-  // live in a problem of their own.
-  bool compress_dwells = true;
 };
 
 class StageProblem {
@@ -53,7 +49,8 @@ class StageProblem {
   // Bounds, fixed and held entries, scaling. Call after the residuals; again
   // after Hold, to solve once more on the same residual blocks.
   void Configure();
-  // Replaces StageSetup::held from the next Configure on.
+  // Per ambient entry: held in addition to the fixed entries (empty: none),
+  // from the next Configure on.
   void Hold(const std::vector<bool>& held);
   // The next evaluation gives the values a problem just assembled would:
   // every block evaluated anew, root solves from the measured amplitudes.
@@ -82,7 +79,9 @@ class StageProblem {
   // The problem a solve solves (with compressed dwells: their one block).
   ceres::Problem* problem() { return &problem_; }
   // The problem holding dwell_blocks().
-  ceres::Problem* dwell_problem() { return Compressed() ? &dwell_problem_ : &problem_; }
+  ceres::Problem* dwell_problem() {
+    return setup_.threaded_evaluation ? &dwell_problem_ : &problem_;
+  }
   int dwells() const { return dwells_; }
   // Why a solve could not evaluate its cost: the dwells (or penalties) not
   // finite at the current values, named by file, line and sweep, or else
@@ -93,13 +92,7 @@ class StageProblem {
   const std::vector<ceres::ResidualBlockId>& caller_blocks() const { return caller_blocks_; }
 
  private:
-  // Whether the block evaluates, with finite residuals and Jacobian.
-  bool EvaluatesFinite(ceres::ResidualBlockId block);
-  static bool EvaluatesFinite(const ceres::CostFunction& cost, const std::vector<double*>& blocks);
-  static ParameterVector ValuesOf(const ParameterLayout& layout);
-
-  static ceres::Problem::Options ProblemOptions(ParallelResidualEvaluator* evaluator,
-                                                bool threaded);
+  static ceres::Problem::Options ProblemOptions(ParallelResidualEvaluator* evaluator);
   // Runs `add`, then owns the cost functions of the blocks it added to
   // `problem` (each once when `may_share`: a caller's may serve several
   // blocks), even when it throws; returns those blocks.
@@ -110,13 +103,12 @@ class StageProblem {
   ParallelResidualEvaluator* Evaluator() {
     return setup_.threaded_evaluation ? &evaluator_ : nullptr;
   }
-  bool Compressed() const { return setup_.threaded_evaluation && setup_.compress_dwells; }
   bool IsBounded(int entry) const;  // lower bound 0
   bool IsHeld(int entry) const;
 
   const FitDescription& fit_;
   const StageSetup setup_;
-  std::vector<bool> held_;           // per ambient entry (empty: none); see Hold
+  std::vector<bool> held_;           // see Hold
   std::vector<bool> held_constant_;  // per block: set constant by Configure
   const ProblemBuilder builder_;
   std::vector<ParameterLayout> layouts_;  // per dataset

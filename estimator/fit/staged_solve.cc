@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "boost/algorithm/string/join.hpp"
 #include "dwellfit/estimator/fit/bound_rest_watcher.h"
 #include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
 #include "dwellfit/estimator/fit/stage_problem.h"
@@ -19,24 +20,14 @@
 namespace dwellfit {
 
 const char* FitStatusName(FitStatus status) {
-  switch (status) {
-    case FitStatus::kConverged:
-      return "converged";
-    case FitStatus::kNoConvergence:
-      return "no_convergence";
-    case FitStatus::kFailure:
-      return "failure";
-    case FitStatus::kInvalidInput:
-      return "invalid_input";
-    case FitStatus::kUnidentifiable:
-      return "unidentifiable";
-  }
-  return "invalid_input";
+  // In enumerator order.
+  constexpr const char* kNames[] = {"converged", "no_convergence", "failure", "invalid_input",
+                                    "unidentifiable"};
+  return kNames[static_cast<int>(status)];
 }
 
 ceres::Solver::Options MakeSolverOptions(const SolverSettings& settings) {
   ceres::Solver::Options options;
-  options.minimizer_type = ceres::TRUST_REGION;
   options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
   options.linear_solver_type = ceres::DENSE_QR;
   SetConvergenceTests(settings, &options);
@@ -44,7 +35,6 @@ ceres::Solver::Options MakeSolverOptions(const SolverSettings& settings) {
   // own threads would sum in an order that varies between runs.
   options.num_threads = 1;
   options.logging_type = ceres::SILENT;
-  options.minimizer_progress_to_stdout = false;
   options.use_nonmonotonic_steps = settings.nonmonotonic_steps;
   // Ceres' default of 5 cuts the non-monotonic excursions short on the
   // narrow valleys of measured data with penalties.
@@ -68,11 +58,6 @@ bool ReflectDampingIntoPhysicalRange(const std::vector<double*>& eta_e_entries,
     changed = changed || *mu != before;
   }
   return changed;
-}
-
-bool ReflectDampingIntoPhysicalRange(ParameterVector* parameters) {
-  ParameterVector& p = *parameters;
-  return ReflectDampingIntoPhysicalRange({&p[kEtaE]}, {&p[kMu1], &p[kMu2]});
 }
 
 namespace {
@@ -255,7 +240,6 @@ void Polish(const SolveContext& context, const SolverSettings& settings, StagePr
 bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptions& penalties,
               bool start_only, StageSummary* stage, std::string* failure,
               std::unique_ptr<StageProblem> rated = nullptr) {
-  StageSetup setup = MakeSetup(context, kind);
   SolverSettings settings = context.options.solver;
   if (start_only) settings.function_tolerance = settings.start_function_tolerance;
   // The algebraic stage takes the enforced jumps' fold conditions, unweighted
@@ -264,12 +248,13 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
       kind == ResidualKind::kAlgebraic && penalties.bifurcation_range.enabled;
   const bool with_penalties = IsBranchLabelled(kind) && PenaltiesEnabled(penalties);
   const int entries = context.fit.NumEntries();
-  setup.held.assign(entries, false);
+  std::vector<bool> held(entries, false);
   std::vector<bool> released(entries, false);
   int polishes = 0;
   stage->residual = kind;
   std::unique_ptr<StageProblem> assembled =
-      rated != nullptr ? std::move(rated) : std::make_unique<StageProblem>(context.fit, setup);
+      rated != nullptr ? std::move(rated)
+                       : std::make_unique<StageProblem>(context.fit, MakeSetup(context, kind));
   StageProblem& problem = *assembled;
   const PenaltyOptions weighted =
       with_penalties ? WeighPenalties(penalties, &problem, stage) : penalties;
@@ -278,7 +263,7 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
   problem.AddCallerResiduals();
   stage->residual_blocks = problem.dwells();
   for (int round = 0;; ++round) {
-    problem.Hold(setup.held);
+    problem.Hold(held);
     if (round > 0) problem.EvaluateAfresh();
     std::optional<int> resting;
     const std::vector<double> start = context.fit.Values();
@@ -297,7 +282,7 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
     // Each entry is held at most twice and released once: never reached.
     if (round + 1 >= kMaxSolvesPerStage) break;
     if (resting) {
-      setup.held[*resting] = true;
+      held[*resting] = true;
       VLOG(1) << ResidualKindName(kind) << " stage: holding " << context.fit.EntryName(*resting)
               << " at its bound";
       continue;
@@ -307,12 +292,12 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
       Polish(context, settings, &problem, stage);
       continue;
     }
-    if (!ReleaseHeld(&problem, &setup.held, &released)) break;
+    if (!ReleaseHeld(&problem, &held, &released)) break;
   }
   for (int i = 0; i < entries; ++i) {
-    if (setup.held[i]) stage->held_at_bound.push_back(i);
+    if (held[i]) stage->held_at_bound.push_back(i);
   }
-  if (!setup.bound_damping && ReflectDamping(context.fit)) {
+  if (kind == ResidualKind::kAlgebraic && ReflectDamping(context.fit)) {  // unbounded damping
     VLOG(1) << "reflected the " << ResidualKindName(kind) << " stage's damping";
   }
   stage->values = context.fit.Values();
@@ -347,9 +332,7 @@ std::vector<double> StartScale(const FitDescription& fit) {
   std::vector<double> scale = fit.Values();
   for (double& value : scale) value = std::abs(value);
   for (const FitDataset& dataset : fit.datasets) {
-    const ParameterLayout layout = LayoutOf(fit, dataset.parameters);
-    ParameterVector p;
-    for (int i = 0; i < kNumParameters; ++i) p[i] = layout.blocks[layout.block[i]][layout.index[i]];
+    const ParameterVector p = LayoutOf(fit, dataset.parameters).Values();
     double a_max = 0.0;
     for (const Sweep* sweep : dataset.sweeps) {
       for (const DwellPoint& point : sweep->points) a_max = std::max(a_max, point.amplitude);
@@ -371,12 +354,6 @@ std::vector<double> StartScale(const FitDescription& fit) {
   return scale;
 }
 
-std::string JoinLines(const std::vector<std::string>& lines) {
-  std::string joined;
-  for (const std::string& line : lines) joined += (joined.empty() ? "" : "; ") + line;
-  return joined;
-}
-
 // How good a point is as the start of a branch-labelled stage: fewer
 // enforced folds missing, then a lower cost of the dwells.
 struct StartRating {
@@ -392,16 +369,17 @@ struct StartRating {
 // Rates `values` (written into the blocks) on `problem`, the stage's
 // problem of the dwells alone.
 StartRating RateStart(const SolveContext& context, StageProblem* problem,
-                      const std::vector<double>& values, const PenaltyOptions& penalties) {
+                      const std::vector<double>& values) {
   context.fit.SetValues(values);
   problem->EvaluateAfresh();
-  return {problem->MissingFolds(penalties.bifurcation_range), problem->DataCost()};
+  return {problem->MissingFolds(context.options.penalties.bifurcation_range), problem->DataCost()};
 }
 
 // "the dwells' vertical cost is 8.77", after the missing folds, if any.
 std::string DescribeRating(ResidualKind kind, const StartRating& rating) {
   std::ostringstream text;
-  if (!rating.missing_folds.empty()) text << "it lacks " << JoinLines(rating.missing_folds) << "; ";
+  if (!rating.missing_folds.empty())
+    text << "it lacks " << boost::algorithm::join(rating.missing_folds, "; ") << "; ";
   text << "the dwells' " << ResidualKindName(kind) << " cost is " << rating.data_cost;
   return text.str();
 }
@@ -457,30 +435,27 @@ struct StartRequest {
   bool fold_stage_ran = false;     // a fold stage already ran in this solve
 };
 struct ChosenStart {
-  bool ok = true;                          // false: the fold stage failed (`failure`)
   std::optional<StageSummary> fold_stage;  // the fold stage, when one ran
   std::string note;                        // why the start was chosen, for the stage
-  std::string failure;
+  std::string failure;                     // why the fold stage failed ("" when it did not)
   std::unique_ptr<StageProblem> rated;
 };
 ChosenStart ChooseStart(const SolveContext& context, const StartRequest& request) {
   const ResidualKind kind = request.kind;
   const std::vector<double>* previous_start = request.previous_start;
-  const PenaltyOptions& penalties = context.options.penalties;
   ChosenStart chosen;
-  std::string* note = &chosen.note;
   std::vector<double> best = context.fit.Values();
   chosen.rated = std::make_unique<StageProblem>(context.fit, MakeSetup(context, kind));
   StageProblem* problem = chosen.rated.get();
   // The previous start first, so that the problem ends holding the values
   // at the usual start, where the previous stage ended.
   std::optional<StartRating> earlier;
-  if (previous_start != nullptr) earlier = RateStart(context, problem, *previous_start, penalties);
-  StartRating rating = RateStart(context, problem, best, penalties);
+  if (previous_start != nullptr) earlier = RateStart(context, problem, *previous_start);
+  StartRating rating = RateStart(context, problem, best);
   std::vector<double> last_rated = best;
   if (earlier) {
     const bool earlier_better = earlier->BetterThan(rating);
-    *note = StartNote(kind, request.after_start_stage, earlier_better, *earlier, rating);
+    chosen.note = StartNote(kind, request.after_start_stage, earlier_better, *earlier, rating);
     if (earlier_better) {
       best = *previous_start;
       rating = *earlier;
@@ -490,21 +465,21 @@ ChosenStart ChooseStart(const SolveContext& context, const StartRequest& request
     context.fit.SetValues(best);
     StageSummary& fold_stage = chosen.fold_stage.emplace();
     fold_stage.fold_stage = true;
-    fold_stage.note =
-        "fold stage: the vertical stage's start lacks " + JoinLines(rating.missing_folds);
-    if (!RunStage(context, ResidualKind::kAlgebraic, penalties, /*start_only=*/true, &fold_stage,
-                  &chosen.failure)) {
-      chosen.ok = false;
+    fold_stage.note = "fold stage: the vertical stage's start lacks " +
+                      boost::algorithm::join(rating.missing_folds, "; ");
+    if (!RunStage(context, ResidualKind::kAlgebraic, context.options.penalties, /*start_only=*/true,
+                  &fold_stage, &chosen.failure)) {
       return chosen;
     }
     const std::vector<double> after = context.fit.Values();
-    const StartRating folded = RateStart(context, problem, after, penalties);
+    const StartRating folded = RateStart(context, problem, after);
     last_rated = after;
     if (folded.BetterThan(rating)) {
-      *note = note->empty() ? "started where the fold stage ended"
-                            : *note +
-                                  "; then, that start lacking an enforced fold, where the "
-                                  "fold stage ended";
+      chosen.note = chosen.note.empty()
+                        ? "started where the fold stage ended"
+                        : chosen.note +
+                              "; then, that start lacking an enforced fold, where the "
+                              "fold stage ended";
       best = after;
     }
   }
@@ -590,11 +565,9 @@ bool SolveFromDescent(const SolveContext& context, const StageSummary& last, Sta
 
 // The minimum check: where a step lowers the cost (FindDescent), the last
 // stage solves again from there, and the check runs once more. Returns why
-// the point is not a minimum ("" when it is). False in `*solved` when that
-// solve failed (`*failure`).
-std::string CheckMinimum(const SolveContext& context, FitSummary* summary, bool* solved,
-                         std::string* failure) {
-  *solved = true;
+// the point is not a minimum ("" when it is). Why that solve failed, when it
+// did, in `*failure`.
+std::string CheckMinimum(const SolveContext& context, FitSummary* summary, std::string* failure) {
   for (int round = 0; round < 2; ++round) {
     const StageSummary last = summary->stages.back();
     const std::optional<Descent> descent = FindDescent(context, last);
@@ -611,10 +584,7 @@ std::string CheckMinimum(const SolveContext& context, FitSummary* summary, bool*
     again.penalty_unit = last.penalty_unit;
     again.penalty_exponent = last.penalty_exponent;
     again.penalties = last.penalties;
-    if (!SolveFromDescent(context, last, &again, failure)) {
-      *solved = false;
-      return "";
-    }
+    if (!SolveFromDescent(context, last, &again, failure)) return "";
   }
   return "";
 }
@@ -653,7 +623,8 @@ void Conclude(const FitDescription& fit, FitSummary* summary) {
   } else if (std::any_of(eta_e.begin(), eta_e.end(), [](const double* e) { return !(*e > 0.0); })) {
     failure = "the fit ended at eta_e = 0, where the model has no forcing";
   } else if (!last.missing_folds.empty()) {
-    failure = "the fit ended without the enforced fold(s) " + JoinLines(last.missing_folds) +
+    failure = "the fit ended without the enforced fold(s) " +
+              boost::algorithm::join(last.missing_folds, "; ") +
               ": the bifurcation-range penalty could not bring them in (start closer, "
               "enforce fewer jumps, or free more parameters)";
   } else if (last.final_penalty_cost > std::max(last.final_data_cost, last.penalty_unit)) {
@@ -703,7 +674,7 @@ FitSummary SolveStaged(const FitDescription& fit, const StagedSolveOptions& opti
         summary.stages.push_back(std::move(*chosen.fold_stage));
         fold_stage_ran = true;
       }
-      if (!chosen.ok) return EvaluationFailed(chosen.failure, &summary);
+      if (!chosen.failure.empty()) return EvaluationFailed(chosen.failure, &summary);
     }
     previous_start = fit.Values();
     // The algebraic stage fits the dwells alone.
@@ -720,8 +691,7 @@ FitSummary SolveStaged(const FitDescription& fit, const StagedSolveOptions& opti
     const bool start_only = kind == ResidualKind::kAlgebraic && s + 1 < options.stages.size();
     for (const PenaltyOptions& penalties : runs) {
       summary.stages.emplace_back();
-      summary.stages.back().note = std::move(chosen.note);
-      chosen.note.clear();
+      summary.stages.back().note = std::exchange(chosen.note, "");
       // The first run solves on the problem its start was rated on.
       if (!RunStage(context, kind, penalties, start_only, &summary.stages.back(), &error,
                     std::move(chosen.rated))) {
@@ -729,9 +699,8 @@ FitSummary SolveStaged(const FitDescription& fit, const StagedSolveOptions& opti
       }
     }
   }
-  bool solved = true;
-  const std::string not_minimum = CheckMinimum(context, &summary, &solved, &error);
-  if (!solved) return EvaluationFailed(error, &summary);
+  const std::string not_minimum = CheckMinimum(context, &summary, &error);
+  if (!error.empty()) return EvaluationFailed(error, &summary);
   Conclude(fit, &summary);
   summary.not_minimum = not_minimum;
   if (!not_minimum.empty() && summary.status == FitStatus::kConverged) {

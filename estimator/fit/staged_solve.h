@@ -122,13 +122,10 @@ FitSummary SolveStaged(const FitDescription& fit, const StagedSolveOptions& opti
 
 // G(a) of eq. (3.11) depends on mu1, mu2 only through k1^2, k2^2 and k1 k2,
 // and on eta_e only through 1/eta_e^2. Maps a point fitted on G alone to its
-// physical twin: eta_e -> |eta_e|, (mu1, mu2) -> -(mu1, mu2) when neither is
-// positive, then a negative damping (no twin) to 0. Returns whether
-// anything changed.
-bool ReflectDampingIntoPhysicalRange(ParameterVector* parameters);
-
-// The same on a description's eta_e entries and damping (mu1, mu2)
-// entries, each listed once.
+// physical twin: eta_e -> |eta_e|, (mu1, mu2) -> -(mu1, mu2) when none is
+// positive, then a negative damping (no twin) to 0, on a description's eta_e
+// and damping (mu1, mu2) entries, each listed once. Returns whether anything
+// changed.
 bool ReflectDampingIntoPhysicalRange(const std::vector<double*>& eta_e_entries,
                                      const std::vector<double*>& damping_entries);
 

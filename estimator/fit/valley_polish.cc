@@ -164,10 +164,7 @@ ValleyPolish PolishAlongValley(ceres::Problem* problem, const std::vector<double
   // test (or the start, when nothing was lower).
   polish.improved = cost->best_cost() < polish.initial_cost;
   polish.final_cost = polish.improved ? cost->best_cost() : polish.initial_cost;
-  if (polish.improved)
-    u = cost->best_u();
-  else
-    std::fill(u.begin(), u.end(), 0.0);
+  u = polish.improved ? cost->best_u() : std::vector<double>(k, 0.0);
   cost->MoveTo(u.data());
   std::ostringstream message;
   message << "BFGS " << polish.iterations << " iterations, cost " << polish.initial_cost << " -> "

@@ -80,21 +80,11 @@ class DwellRun {
     const double scale = std::max(state->amplitude, 0.1 * linear);
     const double volt_scale = std::abs(gauge.SmallSignalVoltsPerMetre()) * scale;
     const auto pole = [](double cutoff_hz) { return cutoff_hz > 0.0 ? kTwoPi * cutoff_hz : 0.0; };
-    equation_ = {p,
-                 omega,
-                 a_base,
-                 state->phase,
-                 scale,
-                 volt_scale,
-                 pole(options.channels.base_filter_cutoff_hz),
-                 pole(options.channels.response_filter_cutoff_hz),
-                 &gauge};
-    x_ = {state->u / scale,
-          state->v / (omega * scale),
-          state->y_base / a_base,
-          state->y_response / volt_scale,
-          0.0,
-          0.0};
+    equation_ = RigEquation({p, omega, a_base, state->phase, scale, volt_scale,
+                             pole(options.channels.base_filter_cutoff_hz),
+                             pole(options.channels.response_filter_cutoff_hz), &gauge});
+    x_ = State({state->u / scale, state->v / (omega * scale), state->y_base / a_base,
+                state->y_response / volt_scale, 0.0, 0.0});
     stepper_ = odeint::make_controlled(options.integration_tolerance, options.integration_tolerance,
                                        odeint::runge_kutta_dopri5<State>());
   }
@@ -193,9 +183,7 @@ double FilterGain(double cutoff_hz, double f_hz) {
   return cutoff_hz > 0.0 ? 1.0 / std::hypot(1.0, f_hz / cutoff_hz) : 1.0;
 }
 
-// Per-sample noise of standard deviation relative_sigma A sqrt(N/2), A the
-// channel's amplitude: the first harmonic of N samples then carries a
-// relative error of relative_sigma (header).
+// The channels' noise (header).
 void AddNoise(const RigOptions& options, const StrainGauge& gauge, double a_base,
               const RigDwellTruth& truth, double f_hz, std::mt19937_64* random, DwellTrace* trace) {
   if (options.noise_relative_sigma == 0.0) return;
@@ -313,10 +301,7 @@ RigRun SimulateRig(const DwellPlan& plan, const RigOptions& options, const RigPr
   for (const SweepPlan& sweep : plan.sweeps) {
     PhysicalState state;  // every sweep starts from rest
     for (SweepDirection direction : sweep.directions) {
-      Sweep truth;
-      truth.id = sweep.id;
-      truth.direction = direction;
-      truth.kind = sweep.kind;
+      Sweep truth{sweep.id, direction, sweep.kind};
       for (double control : ControlGrid(sweep, direction)) {
         const bool frequency = sweep.kind == SweepKind::kFrequency;
         const double f_hz = frequency ? control : sweep.held_frequency_hz;
@@ -328,12 +313,8 @@ RigRun SimulateRig(const DwellPlan& plan, const RigOptions& options, const RigPr
         dwell.Record(&trace);
         AddNoise(options, gauge, a_base, dwell_truth, f_hz, &random, &trace);
         CheckRecorded(trace);
-        DwellPoint point;
-        point.drive_frequency_rad_s = HzToRadPerSecond(f_hz);
-        point.a_base = a_base;
-        point.amplitude = dwell_truth.amplitude;
-        point.phase_rad = dwell_truth.lag_rad;
-        truth.points.push_back(point);
+        truth.points.push_back(
+            {HzToRadPerSecond(f_hz), a_base, dwell_truth.amplitude, dwell_truth.lag_rad});
         run.traces.push_back(std::move(trace));
         run.dwell_truth.push_back(dwell_truth);
         if (progress) progress(static_cast<int>(run.traces.size()), total);

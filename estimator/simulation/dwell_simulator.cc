@@ -224,10 +224,7 @@ std::vector<Sweep> SimulateDwells(const DwellPlan& plan) {
     Branch side = sweep_plan.start_branch;
     double a = 0.0;  // at rest before the first dwell
     for (SweepDirection direction : sweep_plan.directions) {
-      Sweep sweep;
-      sweep.id = sweep_plan.id;
-      sweep.direction = direction;
-      sweep.kind = sweep_plan.kind;
+      Sweep sweep{sweep_plan.id, direction, sweep_plan.kind};
       const bool frequency = sweep_plan.kind == SweepKind::kFrequency;
       for (double control : ControlGrid(sweep_plan, direction)) {
         DwellPoint point;

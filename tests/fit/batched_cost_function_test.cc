@@ -50,7 +50,6 @@ TEST(BatchedCostFunction, StacksItsMembersResidualsAndJacobians) {
   std::vector<ceres::CostFunction*> members;
   for (double c : constants) members.push_back(NewTwoRows(c));
   const BatchedCostFunction batch(members);
-  EXPECT_EQ(batch.num_members(), 3);
   EXPECT_EQ(batch.num_residuals(), 6);
   EXPECT_EQ(batch.parameter_block_sizes(), std::vector<int32_t>({1, 2}));
 

@@ -106,9 +106,10 @@ TEST_F(ClampedBeamIdentification, Mu2IsHeldOnItsBoundWhereTheCostPushesItOutward
   options.penalties.bifurcation_range.weight *= held_stage->penalty_unit;
   const ProblemBuilder builder(options);
   ceres::Problem problem;
+  const ParameterLayout layout = LayoutOf(SingleBlockFit({}, {}, &p), IdentityMap(p.data()));
   for (const Sweep* sweep : data_->fitted) {
-    builder.AddSweep(*sweep, SingleBlockLayout(p.data()), &problem);
-    builder.AddPenalties(*sweep, SingleBlockLayout(p.data()), &problem);
+    builder.AddSweep(*sweep, layout, &problem);
+    builder.AddPenalties(*sweep, layout, &problem);
   }
   double cost = 0.0;
   std::vector<double> gradient;

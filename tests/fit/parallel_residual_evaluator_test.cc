@@ -86,13 +86,13 @@ struct Fit {
 Fit FitWithEvaluator(const std::vector<Sample>& data, int num_threads) {
   Fit fit;
   fit.parameters = kStart;
-  ParallelResidualEvaluator evaluator(fit.parameters.data(), 3, num_threads);
+  ParallelResidualEvaluator evaluator({{fit.parameters.data(), 3}}, num_threads);
   ceres::Problem::Options problem_options;
   problem_options.evaluation_callback = &evaluator;
   ceres::Problem problem(problem_options);
   for (const Sample& sample : data) {
-    problem.AddResidualBlock(evaluator.Wrap(NewDecayingCosine(sample)), nullptr,
-                             fit.parameters.data());
+    problem.AddResidualBlock(evaluator.Wrap(NewDecayingCosine(sample), {fit.parameters.data()}),
+                             nullptr, fit.parameters.data());
   }
   ceres::Solve(FitOptions(), &problem, &fit.summary);
   fit.replayed = evaluator.replayed();
@@ -159,10 +159,11 @@ int ThreadsUsed(int blocks, int num_threads, size_t wait_for,
   ThreadRecordingCost::Record record;
   record.wait_for = wait_for;
   Parameters parameters = kStart;
-  ParallelResidualEvaluator evaluator(parameters.data(), 3, num_threads, min_rows_per_thread);
+  ParallelResidualEvaluator evaluator({{parameters.data(), 3}}, num_threads, min_rows_per_thread);
   std::vector<std::unique_ptr<ceres::CostFunction>> wrappers;
   for (const Sample& sample : data) {
-    wrappers.emplace_back(evaluator.Wrap(new ThreadRecordingCost(sample, &record)));
+    wrappers.emplace_back(
+        evaluator.Wrap(new ThreadRecordingCost(sample, &record), {parameters.data()}));
   }
   std::vector<double> gradient;
   EXPECT_TRUE(evaluator.CostGradient(parameters.data(), &gradient));
@@ -288,12 +289,13 @@ class IterateRecorder : public ceres::IterationCallback {
 TEST(ParallelResidualEvaluator, IterateIsTheSolversIterate) {
   const std::vector<Sample> data = SyntheticData(kNumSamples);
   Parameters parameters = {4.0, -0.1, 1.0};  // growing, not decaying: the cost rises on the way
-  ParallelResidualEvaluator evaluator(parameters.data(), 3, 2);
+  ParallelResidualEvaluator evaluator({{parameters.data(), 3}}, 2);
   ceres::Problem::Options problem_options;
   problem_options.evaluation_callback = &evaluator;
   ceres::Problem problem(problem_options);
   for (const Sample& sample : data) {
-    problem.AddResidualBlock(evaluator.Wrap(NewDecayingCosine(sample)), nullptr, parameters.data());
+    problem.AddResidualBlock(evaluator.Wrap(NewDecayingCosine(sample), {parameters.data()}),
+                             nullptr, parameters.data());
   }
   ceres::Solver::Options options = FitOptions();
   options.use_nonmonotonic_steps = true;
@@ -403,10 +405,10 @@ TEST(ParallelResidualEvaluator, CostGradientMatchesCeresGradient) {
 
   for (int threads : {1, 3}) {
     Parameters block = kStart;  // deliberately not `point`
-    ParallelResidualEvaluator evaluator(block.data(), 3, threads);
+    ParallelResidualEvaluator evaluator({{block.data(), 3}}, threads);
     std::vector<std::unique_ptr<ceres::CostFunction>> wrappers;
     for (const Sample& sample : data)
-      wrappers.emplace_back(evaluator.Wrap(NewDecayingCosine(sample)));
+      wrappers.emplace_back(evaluator.Wrap(NewDecayingCosine(sample), {block.data()}));
     std::vector<double> gradient;
     ASSERT_TRUE(evaluator.CostGradient(point.data(), &gradient));
     ASSERT_EQ(gradient.size(), 3u);
@@ -431,8 +433,9 @@ TEST(ParallelResidualEvaluator, UnseenPointIsEvaluatedDirectly) {
   };
 
   Parameters block = kStart;
-  ParallelResidualEvaluator evaluator(block.data(), 3, 1);
-  const std::unique_ptr<ceres::CostFunction> wrapper(evaluator.Wrap(NewDecayingCosine(sample)));
+  ParallelResidualEvaluator evaluator({{block.data(), 3}}, 1);
+  const std::unique_ptr<ceres::CostFunction> wrapper(
+      evaluator.Wrap(NewDecayingCosine(sample), {block.data()}));
   EXPECT_EQ(wrapper->num_residuals(), 1);
   EXPECT_EQ(wrapper->parameter_block_sizes(), std::vector<int32_t>{3});
 
@@ -481,13 +484,13 @@ TEST(ParallelResidualEvaluator, FailureOfAWrappedFunctionIsReplayed) {
   constexpr int kBlocks = 1000;
   constexpr int kFailing = 700;  // in the third thread's chunk
   double x = 2.0;
-  ParallelResidualEvaluator evaluator(&x, 1, 3);
+  ParallelResidualEvaluator evaluator({{&x, 1}}, 3);
   ceres::Problem::Options problem_options;
   problem_options.evaluation_callback = &evaluator;
   ceres::Problem problem(problem_options);
   std::vector<ceres::CostFunction*> wrappers;  // owned by the problem
   for (int i = 0; i < kBlocks; ++i) {
-    wrappers.push_back(evaluator.Wrap(new SqrtCost(i == kFailing ? 1.0 : 0.0)));
+    wrappers.push_back(evaluator.Wrap(new SqrtCost(i == kFailing ? 1.0 : 0.0), {&x}));
     problem.AddResidualBlock(wrappers.back(), nullptr, &x);
   }
 
@@ -619,10 +622,10 @@ namespace {
 Fit FitCompressed(const std::vector<Sample>& data, int num_threads) {
   Fit fit;
   fit.parameters = kStart;
-  ParallelResidualEvaluator evaluator(fit.parameters.data(), 3, num_threads);
+  ParallelResidualEvaluator evaluator({{fit.parameters.data(), 3}}, num_threads);
   std::vector<std::unique_ptr<ceres::CostFunction>> wrappers;
   for (const Sample& sample : data)
-    wrappers.emplace_back(evaluator.Wrap(NewDecayingCosine(sample)));
+    wrappers.emplace_back(evaluator.Wrap(NewDecayingCosine(sample), {fit.parameters.data()}));
   ceres::Problem::Options problem_options;
   problem_options.evaluation_callback = &evaluator;
   ceres::Problem problem(problem_options);
@@ -782,10 +785,10 @@ class InfiniteSlopeAtZero : public ceres::SizedCostFunction<1, 1> {
 // rejects it); where a row fails to evaluate the block fails.
 TEST(ParallelResidualEvaluator, CompressedBlockAtAnInfiniteSlopeOrAFailure) {
   double x = 0.0;
-  ParallelResidualEvaluator evaluator(&x, 1, 2);
+  ParallelResidualEvaluator evaluator({{&x, 1}}, 2);
   std::vector<std::unique_ptr<ceres::CostFunction>> wrappers;
   for (int i = 0; i < 600; ++i)
-    wrappers.emplace_back(evaluator.Wrap(new InfiniteSlopeAtZero(0.01 * i)));
+    wrappers.emplace_back(evaluator.Wrap(new InfiniteSlopeAtZero(0.01 * i), {&x}));
   const std::unique_ptr<ceres::CostFunction> compressed(evaluator.Compress());
   double expected = 0.0;
   for (int i = 0; i < 600; ++i) expected += 0.5 * (0.01 * i) * (0.01 * i);

@@ -100,18 +100,23 @@ TEST(ScaledSubsetManifold, StepsAreRelativeAndFixedEntriesNeverMove) {
 
 // The dwells go onto a problem the caller owns, beside blocks of its own, and
 // read the caller's block directly (no adapter for the one-block layout).
-TEST(ProblemBuilder, AddsOneResidualBlockPerDwellOnACallerOwnedProblem) {
+TEST(ProblemBuilder, AddsTheDwellsInBatchesOnACallerOwnedProblem) {
   const std::vector<Sweep> sweeps = TwoSweeps();
   const ProblemBuilder builder(ProblemBuilderOptions{});
   ceres::Problem problem;  // the caller's, which may hold other blocks too
   double other_block[1] = {3.0};
   problem.AddParameterBlock(other_block, 1);
   ParameterVector p = kTruth;
+  const ParameterLayout layout = LayoutOf(SingleBlockFit({}, {}, &p), IdentityMap(p.data()));
+  int dwells = 0;
   int blocks = 0;
-  for (const Sweep& sweep : sweeps)
-    blocks += builder.AddSweep(sweep, SingleBlockLayout(p.data()), &problem);
-  EXPECT_EQ(blocks, static_cast<int>(sweeps[0].points.size() + sweeps[1].points.size()));
+  for (const Sweep& sweep : sweeps) {
+    dwells += builder.AddSweep(sweep, layout, &problem);
+    blocks += builder.ResidualBlocks(sweep);
+  }
+  EXPECT_EQ(dwells, static_cast<int>(sweeps[0].points.size() + sweeps[1].points.size()));
   EXPECT_EQ(problem.NumResidualBlocks(), blocks);
+  EXPECT_EQ(problem.NumResiduals(), dwells);
   EXPECT_EQ(problem.NumParameterBlocks(), 2);
   std::vector<ceres::ResidualBlockId> ids;
   problem.GetResidualBlocks(&ids);
@@ -140,17 +145,20 @@ TEST(ProblemBuilder, PointSigmaWeightsTheVerticalResidual) {
 }
 
 TEST(ReflectDampingIntoPhysicalRange, MapsTheAlgebraicTwinToThePhysicalOne) {
+  const auto reflect = [](ParameterVector* p) {
+    return ReflectDampingIntoPhysicalRange({&(*p)[kEtaE]}, {&(*p)[kMu1], &(*p)[kMu2]});
+  };
   ParameterVector twin = kTruth;
   twin[kEtaE] = -100.0;
   twin[kMu1] = -0.2;
   twin[kMu2] = -300.0;
-  EXPECT_TRUE(ReflectDampingIntoPhysicalRange(&twin));
+  EXPECT_TRUE(reflect(&twin));
   EXPECT_EQ(twin, kTruth);
   ParameterVector physical = kTruth;
-  EXPECT_FALSE(ReflectDampingIntoPhysicalRange(&physical));
+  EXPECT_FALSE(reflect(&physical));
   ParameterVector mixed = kTruth;
   mixed[kMu2] = -5.0;
-  EXPECT_TRUE(ReflectDampingIntoPhysicalRange(&mixed));
+  EXPECT_TRUE(reflect(&mixed));
   EXPECT_EQ(mixed[kMu1], 0.2);
   EXPECT_EQ(mixed[kMu2], 0.0);
 }

@@ -69,9 +69,8 @@ TEST(StageProblem, OneBlockGetsBoundsFixedEntriesAndScaling) {
 
   // The algebraic stage leaves the damping unbounded; a held entry leaves
   // the tangent space and the watcher.
-  StageSetup algebraic_setup = SetupFor(fit, ResidualKind::kAlgebraic);
-  algebraic_setup.held = {true, false, false, false, false, false};
-  StageProblem algebraic(fit, algebraic_setup);
+  StageProblem algebraic(fit, SetupFor(fit, ResidualKind::kAlgebraic));
+  algebraic.Hold({true, false, false, false, false, false});
   algebraic.Configure();
   EXPECT_EQ(algebraic.problem()->GetParameterLowerBound(p.data(), kMu1), kNoBound);
   EXPECT_EQ(algebraic.problem()->ParameterBlockTangentSize(p.data()), 3);
@@ -217,9 +216,8 @@ TEST(StageProblem, SolvingAgainWithOtherHeldEntriesMatchesANewProblem) {
   const ParameterVector reused_end = p;
 
   p = after_first;
-  StageSetup held_setup = setup;
-  held_setup.held = held;
-  StageProblem fresh(fit, held_setup);
+  StageProblem fresh(fit, setup);
+  fresh.Hold(held);
   fresh.Configure();
   ceres::Solver::Summary fresh_summary;
   ceres::Solve(options, fresh.problem(), &fresh_summary);
@@ -239,8 +237,8 @@ TEST(StageProblem, SolvingAgainWithOtherHeldEntriesMatchesANewProblem) {
   EXPECT_EQ(reused.problem()->ParameterBlockTangentSize(p.data()), kNumParameters);
 }
 
-// The dwells compressed into one block (the default) and as their own
-// blocks: the same start cost, and a vertical-error solve on the noisy
+// The dwells compressed into one block (threaded evaluation, the default)
+// and as their own blocks: the same start cost, and a vertical-error solve on the noisy
 // thesis case that ends at the same estimate, cost and data cost.
 TEST(StageProblem, CompressedDwellsSolveAsTheDwellsThemselves) {
   const std::vector<Sweep> sweeps = SimulateDataset(kThesisTruth, 0.01, 7);
@@ -252,7 +250,7 @@ TEST(StageProblem, CompressedDwellsSolveAsTheDwellsThemselves) {
     ParameterVector p = start;
     const FitDescription fit = SingleBlockFit(Pointers(sweeps), {}, &p);
     StageSetup setup = SetupFor(fit, ResidualKind::kVertical);
-    setup.compress_dwells = compress;
+    setup.threaded_evaluation = compress;
     setup.num_threads = 2;
     StageProblem stage(fit, setup);
     stage.Configure();

@@ -14,7 +14,6 @@
 #include "ceres/normal_prior.h"
 #include "dwellfit/estimator/fit/identification.h"
 #include "dwellfit/estimator/fit/multi_start.h"
-#include "dwellfit/estimator/fit/problem_builder.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/fit_test_support.h"
@@ -94,12 +93,6 @@ TEST_F(StagedSolve, InvalidIdentificationAndMultiStartOptionsNameTheField) {
   const MultiStartResult multi = IdentifyMultiStart(Pointers(sweeps_), options, {}, multi_start);
   EXPECT_EQ(multi.best.status, FitStatus::kInvalidInput);
   EXPECT_THAT(multi.best.message, HasSubstr("multi_start.spread must be a factor greater than 1"));
-
-  ProblemBuilderOptions builder;
-  builder.dwell_weight = 0.0;
-  std::string error;
-  EXPECT_FALSE(builder.IsValid(&error));
-  EXPECT_THAT(error, HasSubstr("dwell_weight must be positive and finite (> 0), got 0"));
 }
 
 // An algebraic stage whose end only starts the vertical stage ends on the
