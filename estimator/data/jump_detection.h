@@ -39,20 +39,14 @@ struct JumpDetectionOptions {
 
 // What DetectJumps weighs in one sweep (for logs, reports and tests).
 //
-// Steps: r_i = ln(a_{i+1} / a_i) between consecutive dwells i, i+1.
-// Candidates: steps whose larger side reaches options.min_relative_amplitude
-// times the sweep's largest amplitude and whose two controls differ (a fold
-// cannot lie between equal controls).
-// Excess: e_i = r_i - p ln(c_{i+1} / c_i). In an amplitude sweep the response
-// grows like a power of the base level, a ~ a_base^p (p = 1 for a linear
-// response, about 1/3 on a hardening backbone), and a_base is stepped
-// linearly, so r_i shrinks along the sweep by itself; p is the median of
-// r_i / ln(c_{i+1} / c_i) over the candidates. A frequency sweep has no such
-// trend (the slope changes sign at the peak): p = 0 and e_i = r_i.
-// Noise: sigma = 1.4826 MAD(e) over the candidates, the robust standard
-// deviation of a step. Over the candidates, not the whole sweep: the noise
-// floor far from resonance is noisier in ln(a) than the response near it.
-// The MAD ignores the jump itself and a smeared transition of a few steps.
+// Steps r_i = ln(a_{i+1} / a_i) between consecutive dwells; candidates: steps
+// whose larger side reaches min_relative_amplitude of the sweep's largest
+// amplitude and whose two controls differ (a fold cannot lie between equal
+// controls). Excess e_i = r_i - p ln(c_{i+1} / c_i): an amplitude sweep's
+// response grows like a_base^p by itself, p the median of r_i / ln(c_{i+1} /
+// c_i) over the candidates; a frequency sweep has p = 0. Noise: 1.4826 MAD(e)
+// over the candidates (not the noisier floor far from resonance); the MAD
+// ignores the jump itself and a smeared transition of a few steps.
 struct JumpEvidence {
   int candidate_steps = 0;
   int step = -1;             // the candidate with the largest |e_i| (-1: none)
@@ -128,15 +122,9 @@ void ApplyJumpOverrides(const std::vector<JumpOverride>& overrides, const std::s
 
 // One line per sweep for logs and reports, frequencies in Hz, e.g.
 //   "F/up: jump_down between 42.20 and 42.30 Hz (a 4.7e-3 -> 2.8e-4)"
-//   "A/up: jump_up between a_base 0.0350 and 0.0360 (a 1.2e-3 -> 4.1e-3)"
 //   "F/down: no jump (41 dwells, largest a 1.0e-3)"
-//   "L/up: jump_down between 213.055 and 213.118 Hz into missing data
-//    (a 1.2e-3 -> not measured)"
-// A jump stated in the config ends in " [config]". A jump whose direction
-// does not fit a hardening response (frequency sweeps: a jump up going up or a
-// jump down going down, which fits softening) or the model at all (amplitude
-// sweeps: a jump down as a_base rises, a jump up as it falls) gets a note; it
-// is kept all the same.
+// A jump stated in the config ends in " [config]"; one whose direction fits
+// a softening response, or no response of the model, gets a note.
 std::string DescribeJumps(const Sweep& sweep);
 
 }  // namespace dwellfit

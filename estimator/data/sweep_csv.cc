@@ -3,6 +3,7 @@
 #include <glog/logging.h>
 #include <libfccp/csv.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -69,14 +70,14 @@ struct Range {
   const char* advice;   // what a value outside the range usually means
 };
 
-const Range kFrequencyRange = {kMinFrequencyHz, kMaxFrequencyHz, "the drive frequency [Hz]",
-                               "Omega^4", "freq_hz is in Hz (not rad/s or kHz)"};
-const Range kABaseRange = {kMinMagnitude, kMaxMagnitude, "the base level a_base", "a_base^2",
+const Range kFrequencyRange = {1e-6, 1e9, "the drive frequency [Hz]", "Omega^4",
+                               "freq_hz is in Hz (not rad/s or kHz)"};
+const Range kABaseRange = {1e-20, 1e20, "the base level a_base", "a_base^2",
                            "give a_base in a unit that puts it inside the range"};
 const Range kAmplitudeRange = {
-    kMinMagnitude, kMaxMagnitude, "the amplitude a", "a^6",
+    1e-20, 1e20, "the amplitude a", "a^6",
     "give a in a unit that puts it inside the range, or write 0 for a missing measurement"};
-const Range kSigmaRange = {kMinMagnitude, kMaxMagnitude, "the standard deviation sigma", "sigma^2",
+const Range kSigmaRange = {1e-20, 1e20, "the standard deviation sigma", "sigma^2",
                            "sigma is in the unit of a"};
 
 // Parses the whole of `text` as a finite double, locale-independently.
@@ -343,12 +344,8 @@ void AddRow(const Location& where, const RowValues& row, SweepBuilder* builder) 
   Sweep& sweep = builder->sweep;
   if (!(row.amplitude > 0.0)) {
     ++sweep.dropped_nonpositive;
-    MissingDwell missing;
-    missing.drive_frequency_rad_s = HzToRadPerSecond(row.freq_hz);
-    missing.a_base = row.a_base;
-    missing.points_before = static_cast<int>(sweep.points.size());
-    missing.source_line = row.line;
-    sweep.missing.push_back(missing);
+    sweep.missing.push_back(MissingDwell{HzToRadPerSecond(row.freq_hz), row.a_base,
+                                         static_cast<int>(sweep.points.size()), row.line});
     return;
   }
   DwellPoint point;
@@ -369,17 +366,16 @@ void WarnAboutDroppedRows(const std::string& path, const std::vector<SweepBuilde
       LOG(WARNING) << path << ": sweep " << sweep.Name() << ": all " << builder.num_rows
                    << " rows have a <= 0 (missing measurements); the sweep is left out";
     } else {
-      int trailing = 0;
-      for (const MissingDwell& row : sweep.missing) {
-        trailing += row.points_before == static_cast<int>(sweep.points.size());
-      }
+      const auto trailing =
+          std::count_if(sweep.missing.begin(), sweep.missing.end(), [&](const MissingDwell& row) {
+            return row.points_before == static_cast<int>(sweep.points.size());
+          });
       LOG(WARNING) << path << ": sweep " << sweep.Name() << ": dropped "
                    << sweep.dropped_nonpositive << " of " << builder.num_rows
                    << " rows with a <= 0 (missing measurements"
                    << (trailing > 0 ? ", " + std::to_string(trailing) +
-                                          " of them after the last "
-                                          "measured row"
-                                    : std::string())
+                                          " of them after the last measured row"
+                                    : "")
                    << ")";
     }
   }
