@@ -65,17 +65,6 @@ bool PathWithin(const std::string& path, const std::string& prefix) {
   return path.size() == prefix.size() || path[prefix.size()] == '.' || path[prefix.size()] == '[';
 }
 
-std::vector<std::string> SplitKeyPath(const std::string& key_path) {
-  std::vector<std::string> segments;
-  std::string::size_type begin = 0;
-  while (true) {
-    const std::string::size_type dot = key_path.find('.', begin);
-    segments.push_back(key_path.substr(begin, dot - begin));
-    if (dot == std::string::npos) return segments;
-    begin = dot + 1;
-  }
-}
-
 int OneBasedLine(const YAML::Mark& mark) { return mark.is_null() ? 0 : mark.line + 1; }
 
 // The entries of the list at an override's key: a list's entries, one value
