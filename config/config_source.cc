@@ -1,11 +1,8 @@
 #include "dwellfit/config/config_source.h"
 
 #include <algorithm>
-#include <filesystem>
-#include <fstream>
 #include <optional>
 #include <sstream>
-#include <system_error>
 #include <utility>
 
 #include "dwellfit/config/strict_yaml.h"

@@ -93,14 +93,6 @@ const char* CrossValidationTrainingName(CrossValidationTraining training) {
   return kTrainingNames[static_cast<int>(training)];
 }
 
-ModelSelectionConfig ModelSelectionConfig::Defaults() {
-  ModelSelectionConfig config;
-  config.delta = {{std::nullopt, "free"}, {0.0, "0"}};
-  config.mu2 = {{std::nullopt, "free"}, {0.0, "0"}};
-  config.omega = {{std::nullopt, "free"}};
-  return config;
-}
-
 bool ModelSelectionConfig::IsValid(std::string* error) const {
   const struct {
     const char* name;
@@ -145,7 +137,7 @@ ModelSelectionConfig ReadModelSelectionConfig(const ConfigValue& value, const Co
   const StrictMap block(
       value, source,
       {"delta", "mu2", "omega_hz", "cross_validation", "training", "pool", "threads"});
-  ModelSelectionConfig config = ModelSelectionConfig::Defaults();
+  ModelSelectionConfig config;
   if (const auto v = block.Optional("delta")) {
     config.delta = ReadChoices(*v, source, kDelta, initial_guess);
   }

@@ -47,9 +47,9 @@ const char* CrossValidationTrainingName(CrossValidationTraining training);
 struct ModelSelectionConfig {
   // The variants are every combination of these choices (delta, then mu2,
   // then omega); each list non-empty, no choice twice.
-  std::vector<ParameterChoice> delta;
-  std::vector<ParameterChoice> mu2;
-  std::vector<ParameterChoice> omega;
+  std::vector<ParameterChoice> delta = {{std::nullopt, "free"}, {0.0, "0"}};
+  std::vector<ParameterChoice> mu2 = {{std::nullopt, "free"}, {0.0, "0"}};
+  std::vector<ParameterChoice> omega = {{std::nullopt, "free"}};
   CrossValidationScheme scheme = CrossValidationScheme::kLeaveOneLevelOut;
   CrossValidationTraining training = CrossValidationTraining::kConfig;
   // Sweeps whose levels form the cross-validation pool; empty: the config's
@@ -58,8 +58,6 @@ struct ModelSelectionConfig {
   // Fits run on this many threads at once (>= 1); results do not depend on it.
   int threads = 2;
 
-  // The defaults: delta free or 0, mu2 free or 0, omega free.
-  static ModelSelectionConfig Defaults();
   bool IsValid(std::string* error) const;
 };
 
