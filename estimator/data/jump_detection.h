@@ -1,13 +1,10 @@
 // Jumps in measured sweeps and the stable branch of every dwell.
 //
-// In a stepped dwell test of the single-mode model (docs/model.md, "Stability and
-// folds") a sweep passes at most one saddle-node fold, so it shows at most one
-// jump: a step between consecutive dwells where the response leaves one stable
-// branch for the other. The detected jump brackets the fold between its two
-// control values and splits the sweep into the branch before and after it.
-//
-// A jump can also be stated in the config (`jumps:`, config/README.md): a
-// JumpOverride replaces what detection found for one sweep.
+// A sweep of the single-mode model passes at most one saddle-node fold
+// (docs/model.md, "Stability and folds"), so it shows at most one jump: a step
+// between consecutive dwells that brackets the fold and splits the sweep into
+// the branch before and after it. A JumpOverride (the config's `jumps:`)
+// replaces what detection found for one sweep.
 #ifndef DWELLFIT_ESTIMATOR_DATA_JUMP_DETECTION_H_
 #define DWELLFIT_ESTIMATOR_DATA_JUMP_DETECTION_H_
 
@@ -72,12 +69,10 @@ JumpEvidence WeighJumpEvidence(const JumpDetectionOptions& options, const Sweep&
 // hysteresis, or a sharp peak sampled by a handful of dwells, can pass for a
 // jump or hide one; state such sweeps in the config (`jumps:`).
 //
-// Jump into missing data: when no step is accepted, the rows after the last
-// dwell were all recorded as missing (Sweep::missing) and the last dwell
-// reaches min_relative_amplitude of the largest amplitude, the response left
-// the branch it was on and the instrument recorded nothing: a jump down
-// between the last dwell and the first missing row (after it, at another
-// control), marked into_missing_data.
+// Jump into missing data: when no step is accepted, every row after the last
+// dwell is missing (Sweep::missing) and the last dwell reaches
+// min_relative_amplitude of the largest, the response left its branch
+// unrecorded: a jump down to the first missing row at another control.
 //
 // Labels: before a jump down Branch::kUpper and after it kLower; before a jump
 // up kLower and after it kUpper; no jump: every point kOnly. Replaces any
@@ -105,18 +100,14 @@ struct JumpOverride {
 };
 
 // Replaces the jumps of `sweep` with `jump_override` and relabels its branches
-// as DetectJumps would. The bracket must lie between two consecutive dwells:
-// index_before is the last dwell on the `before` side (up to control_before),
-// and the next dwell must lie on the `after` side (from control_after on).
-// Throws InputError naming `config_path` and the sweep when the bracket's
-// control does not match the sweep's kind, runs against the sweep's
-// direction, or does not lie between consecutive dwells.
+// as DetectJumps would. Throws InputError naming `config_path` and the sweep
+// when the bracket's control does not match the sweep's kind, runs against
+// the sweep's direction, or does not lie between two consecutive dwells.
 void ApplyJumpOverride(const JumpOverride& jump_override, const std::string& config_path,
                        Sweep* sweep);
 
-// ApplyJumpOverride for each override, on the sweep it names. Throws
-// InputError naming `config_path` and listing the available sweeps when an
-// override names a sweep not in `sweeps`.
+// ApplyJumpOverride on the sweep each override names; an override of a sweep
+// not in `sweeps` throws InputError listing the available ones.
 void ApplyJumpOverrides(const std::vector<JumpOverride>& overrides, const std::string& config_path,
                         std::vector<Sweep>* sweeps);
 

@@ -136,7 +136,6 @@ HarmonicBalanceResult IdentifyHarmonicBalance(const std::vector<DwellHarmonics>&
 }
 
 void WriteHarmonicBalanceYaml(const HarmonicBalanceResult& result, std::ostream* out) {
-  const char* names[] = {"eta_e", "mu1", "mu2", "delta", "alpha", "omega_hz"};
   *out << "method: harmonic_balance\n"
        << StringPrintf("dwells: %d\nequations: %d\nrms_weighted_residual: %.6g\n", result.dwells,
                        result.rows, result.rms_residual)
@@ -145,7 +144,8 @@ void WriteHarmonicBalanceYaml(const HarmonicBalanceResult& result, std::ostream*
     const bool hz = i == kNaturalFrequency;
     const double value = hz ? RadPerSecondToHz(result.estimate[i]) : result.estimate[i];
     const double error = hz ? RadPerSecondToHz(result.standard_error[i]) : result.standard_error[i];
-    *out << StringPrintf("  %s: {value: %.10g, standard_error: %.4g}\n", names[i], value, error);
+    *out << StringPrintf("  %s: {value: %.10g, standard_error: %.4g}\n",
+                         hz ? "omega_hz" : ParameterName(i), value, error);
   }
   *out << StringPrintf(
       "effective_nonlinearity:\n  reference_hz: %.10g\n  value: %.10g\n  standard_error: %.4g\n",

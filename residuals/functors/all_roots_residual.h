@@ -22,8 +22,6 @@
 #ifndef DWELLFIT_RESIDUALS_FUNCTORS_ALL_ROOTS_RESIDUAL_H_
 #define DWELLFIT_RESIDUALS_FUNCTORS_ALL_ROOTS_RESIDUAL_H_
 
-#include <cmath>
-
 #include "ceres/autodiff_cost_function.h"
 #include "dwellfit/residuals/functors/vertical_error_residual.h"
 #include "dwellfit/residuals/model/model_parameters.h"
