@@ -421,20 +421,14 @@ std::string NotARegularFile(const std::string& path) {
   if (error || !std::filesystem::exists(status) || std::filesystem::is_regular_file(status)) {
     return "";
   }
-  switch (status.type()) {
-    case std::filesystem::file_type::directory:
-      return "is a directory";
-    case std::filesystem::file_type::character:
-      return "is a character device, not a file";
-    case std::filesystem::file_type::block:
-      return "is a block device, not a file";
-    case std::filesystem::file_type::fifo:
-      return "is a named pipe (FIFO), not a file";
-    case std::filesystem::file_type::socket:
-      return "is a socket, not a file";
-    default:
-      return "is not a regular file";
-  }
+  using Type = std::filesystem::file_type;
+  const Type type = status.type();
+  if (type == Type::directory) return "is a directory";
+  if (type == Type::character) return "is a character device, not a file";
+  if (type == Type::block) return "is a block device, not a file";
+  if (type == Type::fifo) return "is a named pipe (FIFO), not a file";
+  if (type == Type::socket) return "is a socket, not a file";
+  return "is not a regular file";
 }
 
 LoadedSweeps LoadSweepsCsv(const std::string& path) {

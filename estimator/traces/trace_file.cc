@@ -97,11 +97,9 @@ IndexRow ReadIndexRow(const std::string& file, int line, char* const* fields) {
                      "expected up or down, got '" + EscapeForMessage(fields[1]) + "'");
   }
   const std::string kind = fields[2];
-  if (kind == SweepKindName(SweepKind::kFrequency)) {
-    trace.kind = SweepKind::kFrequency;
-  } else if (kind == SweepKindName(SweepKind::kAmplitude)) {
-    trace.kind = SweepKind::kAmplitude;
-  } else {
+  trace.kind =
+      kind == SweepKindName(SweepKind::kAmplitude) ? SweepKind::kAmplitude : SweepKind::kFrequency;
+  if (kind != SweepKindName(trace.kind)) {
     throw InputError(file, line, "kind",
                      "expected frequency or amplitude, got '" + EscapeForMessage(kind) + "'");
   }
