@@ -1,7 +1,6 @@
 // The `model_selection:` block of a config (config/README.md): which model
-// variants to compare, how to cross-validate them, and over which sweeps.
-// Read by LoadIdentifyConfig; run by the model-selection study
-// (estimator/studies/model_selection.h, tool `select_model`).
+// variants to compare, how to cross-validate them, and over which sweeps; run
+// by `select_model` (estimator/studies/model_selection.h).
 #ifndef DWELLFIT_CONFIG_MODEL_SELECTION_CONFIG_H_
 #define DWELLFIT_CONFIG_MODEL_SELECTION_CONFIG_H_
 

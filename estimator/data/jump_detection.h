@@ -15,21 +15,20 @@
 
 namespace dwellfit {
 
-// Jump detection in measured sweeps (docs/performance.md has the data sets
-// behind these defaults).
+// Jump detection in measured sweeps (config/README.md, `jump_detection`, has
+// the data sets behind these defaults).
 struct JumpDetectionOptions {
-  // A jump's step between consecutive dwells must change the amplitude by
-  // more than this ratio, either way (in an amplitude sweep: beyond the
-  // sweep's power-law trend in a_base) ...
+  // A jump's step changes the amplitude by more than this ratio, either way
+  // (in an amplitude sweep: beyond the power-law trend in a_base) ...
   double min_ratio = 1.07;
-  // ... its larger side must reach this fraction of the sweep's largest
+  // ... its larger side reaches this fraction of the sweep's largest
   // amplitude (ignores hops in the noise floor far from resonance) ...
   double min_relative_amplitude = 0.2;
-  // ... and its log ratio must exceed this many robust standard deviations
-  // of the sweep's steps (0: no noise test).
+  // ... and its log ratio exceeds this many robust standard deviations of
+  // the sweep's steps (0: no noise test).
   double noise_multiple = 6.0;
-  // Sweeps with fewer candidate steps (above the amplitude gate) get no
-  // detected jump: too few steps to tell a jump from noise.
+  // Sweeps with fewer candidate steps get no detected jump (too few to tell
+  // a jump from noise).
   int min_candidate_steps = 5;
   bool IsValid(std::string* error) const;
 };
