@@ -348,14 +348,8 @@ void AddRow(const Location& where, const RowValues& row, SweepBuilder* builder) 
                                          static_cast<int>(sweep.points.size()), row.line});
     return;
   }
-  DwellPoint point;
-  point.drive_frequency_rad_s = HzToRadPerSecond(row.freq_hz);
-  point.a_base = row.a_base;
-  point.amplitude = row.amplitude;
-  point.phase_rad = row.phase_rad;
-  point.sigma = row.sigma;
-  point.source_line = row.line;
-  sweep.points.push_back(point);
+  sweep.points.push_back(DwellPoint{HzToRadPerSecond(row.freq_hz), row.a_base, row.amplitude,
+                                    row.phase_rad, row.sigma, Branch::kOnly, row.line});
 }
 
 void WarnAboutDroppedRows(const std::string& path, const std::vector<SweepBuilder>& builders) {

@@ -243,12 +243,9 @@ void BuildSweeps(const std::vector<DwellTrace>& dwells, const TraceProcessingOpt
       members.emplace_back();
     }
     const DwellHarmonics& h = out->harmonics[i];
-    DwellPoint point;
-    point.drive_frequency_rad_s = dwells[i].drive_frequency_rad_s;
-    point.a_base = std::abs(h.base[1]);
-    point.amplitude = std::abs(h.u[1]);
-    point.phase_rad = Lag(h);
-    out->sweeps[it->second].points.push_back(point);
+    // Omega, a_base = |A_1|, a = |U_1| and the lag.
+    out->sweeps[it->second].points.push_back(
+        DwellPoint{dwells[i].drive_frequency_rad_s, std::abs(h.base[1]), std::abs(h.u[1]), Lag(h)});
     members[it->second].push_back(i);
   }
   for (std::size_t s = 0; s < out->sweeps.size(); ++s) {
