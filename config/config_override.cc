@@ -63,22 +63,28 @@ void CheckKeyPath(const std::string& key_path, const std::string& entry,
                      "entry '" + entry + "' has no key before '='; write " +
                          "key.path=value, e.g. solver.max_iterations=50");
   }
-  std::string::size_type begin = 0;
-  while (true) {
-    const std::string::size_type dot = key_path.find('.', begin);
-    const std::string segment = key_path.substr(begin, dot - begin);
+  for (const std::string& segment : SplitKeyPath(key_path)) {
     if (segment.empty() || segment.find_first_of(" \t") != std::string::npos) {
       throw InputError(origin, 0, "",
                        "key path '" + key_path + "' in '" + entry +
                            "' is malformed; write keys joined by single dots, e.g. " +
                            "solver.max_iterations=50");
     }
-    if (dot == std::string::npos) break;
-    begin = dot + 1;
   }
 }
 
 }  // namespace
+
+std::vector<std::string> SplitKeyPath(const std::string& key_path) {
+  std::vector<std::string> segments;
+  std::string::size_type begin = 0;
+  while (true) {
+    const std::string::size_type dot = key_path.find('.', begin);
+    segments.push_back(key_path.substr(begin, dot - begin));
+    if (dot == std::string::npos) return segments;
+    begin = dot + 1;
+  }
+}
 
 std::vector<ConfigOverride> ParseSetFlag(const std::string& flag_value, const std::string& origin) {
   std::vector<ConfigOverride> overrides;

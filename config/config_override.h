@@ -44,6 +44,9 @@ ConfigOverride ListFlagOverride(const std::string& key_path, const std::string& 
                                 const std::string& origin,
                                 OverrideAction action = OverrideAction::kReplace);
 
+// "a.b.c" as {a, b, c}; an empty segment ("a..b") stays, empty.
+std::vector<std::string> SplitKeyPath(const std::string& key_path);
+
 // "--set solver.max_iterations=50", "--fix fixed+=[delta]" or "--free
 // fixed-=[omega]": how the override is shown in errors and in the printed
 // config.

@@ -1,11 +1,8 @@
 #include "dwellfit/config/config_source.h"
 
 #include <algorithm>
-#include <filesystem>
-#include <fstream>
 #include <optional>
 #include <sstream>
-#include <system_error>
 #include <utility>
 
 #include "dwellfit/config/strict_yaml.h"
@@ -63,17 +60,6 @@ class DocumentWalker : public YAML::EventHandler {
 bool PathWithin(const std::string& path, const std::string& prefix) {
   if (path.compare(0, prefix.size(), prefix) != 0) return false;
   return path.size() == prefix.size() || path[prefix.size()] == '.' || path[prefix.size()] == '[';
-}
-
-std::vector<std::string> SplitKeyPath(const std::string& key_path) {
-  std::vector<std::string> segments;
-  std::string::size_type begin = 0;
-  while (true) {
-    const std::string::size_type dot = key_path.find('.', begin);
-    segments.push_back(key_path.substr(begin, dot - begin));
-    if (dot == std::string::npos) return segments;
-    begin = dot + 1;
-  }
 }
 
 int OneBasedLine(const YAML::Mark& mark) { return mark.is_null() ? 0 : mark.line + 1; }

@@ -17,12 +17,10 @@ namespace dwellfit {
 
 class ConfigSource {
  public:
-  // Reads and parses the file at `path`. Throws InputError when it cannot be
-  // read or is not valid YAML (with the line of the syntax error); `kind`
-  // names the file in those messages.
+  // Reads and parses the file at `path` (`kind` names it in messages), or
+  // parses `yaml_text` (`file` names it). Throws InputError when the file
+  // cannot be read or is not valid YAML (with the line of the syntax error).
   static ConfigSource Load(const std::string& path, const std::string& kind = "config file");
-  // Parses `yaml_text`; `file` names it in errors. Throws InputError with the
-  // line of a YAML syntax error.
   static ConfigSource Parse(const std::string& file, const std::string& yaml_text);
 
   // `file` is the name used in errors.

@@ -143,33 +143,22 @@ void CheckNoSweepFittedAndValidated(const std::vector<PlacedSelection>& fit,
 // The initial_guess block: `auto`, or per parameter a number (physical
 // units, omega in Hz) or `auto`; a parameter left out is `auto`.
 KnownParameters ReadInitialGuess(const ConfigValue& value, const ConfigSource& source) {
-  struct Key {
-    ParameterIndex index;
-    const char* name;
-    const char* meaning;
-  };
-  const std::array<Key, kNumParameters> keys = {{
-      {kEtaE, "eta_e", "forcing effectiveness, > 0"},
-      {kMu1, "mu1", "linear damping [1/s], >= 0"},
-      {kMu2, "mu2", "quadratic damping, >= 0"},
-      {kDelta, "delta", "nonlinear inertia"},
-      {kAlpha, "alpha", "cubic stiffness"},
-      {kNaturalFrequency, "omega_hz", "linear natural frequency [Hz], > 0"},
-  }};
   KnownParameters known;
   if (value.node.IsScalar() && value.node.Scalar() == "auto") return known;
-  std::vector<std::string> names;
-  for (const Key& key : keys) names.push_back(key.name);
+  std::vector<std::string> names(kParameterNames.begin(), kParameterNames.end());
+  names[kNaturalFrequency] = "omega_hz";
   const StrictMap block(value, source, names);
-  for (const Key& key : keys) {
-    const auto entry = block.Optional(key.name);
+  for (int index = 0; index < kNumParameters; ++index) {
+    const auto entry = block.Optional(names[index]);
     if (!entry || (entry->node.IsScalar() && entry->node.Scalar() == "auto")) continue;
     const double number = ReadFiniteDouble(*entry, source);
-    const bool must_be_positive = key.index == kEtaE || key.index == kNaturalFrequency;
-    const bool must_be_non_negative = key.index == kMu1 || key.index == kMu2;
+    const bool must_be_positive = index == kEtaE || index == kNaturalFrequency;
+    const bool must_be_non_negative = index == kMu1 || index == kMu2;
     if (must_be_positive && !(number > 0.0)) {
       throw source.Error(entry->path, entry->mark,
-                         std::string("the initial guess (") + key.meaning +
+                         std::string("the initial guess (") +
+                             (index == kEtaE ? "forcing effectiveness, > 0"
+                                             : "linear natural frequency [Hz], > 0") +
                              ") must be positive, got " + entry->node.Scalar() +
                              "; or write auto to find it from the data");
     }
@@ -179,7 +168,7 @@ KnownParameters ReadInitialGuess(const ConfigValue& value, const ConfigSource& s
                          "below by 0), got " +
                              entry->node.Scalar());
     }
-    known[key.index] = key.index == kNaturalFrequency ? HzToRadPerSecond(number) : number;
+    known[index] = index == kNaturalFrequency ? HzToRadPerSecond(number) : number;
   }
   return known;
 }
@@ -226,11 +215,7 @@ MultiStartOptions ReadMultiStart(const ConfigValue& value, const ConfigSource& s
   MultiStartOptions multi_start;
   block.Read("starts", &multi_start.starts);
   block.Read("spread", &multi_start.spread);
-  if (const auto v = block.Optional("seed")) {
-    const int seed = ReadInt(*v, source);
-    if (seed < 0) throw source.Error(v->path, v->mark, "must be a non-negative integer");
-    multi_start.seed = static_cast<std::uint64_t>(seed);
-  }
+  if (const auto v = block.Optional("seed")) multi_start.seed = ReadUint64(*v, source);
   block.Read("threads", &multi_start.threads);
   return multi_start;
 }
@@ -385,13 +370,6 @@ std::string ReadJumpSweep(const StrictMap& block, const ConfigSource& source) {
   return selection.Name();
 }
 
-JumpKind ReadJumpKind(const ConfigValue& value, const ConfigSource& source) {
-  const std::vector<std::string> allowed = {JumpKindName(JumpKind::kJumpUp),
-                                            JumpKindName(JumpKind::kJumpDown)};
-  return ReadOneOf(value, source, "jump kind", allowed) == allowed[0] ? JumpKind::kJumpUp
-                                                                      : JumpKind::kJumpDown;
-}
-
 // One entry of `jumps`: a sweep and exactly one of between_hz, between_a_base
 // (each with a kind) or none: true.
 JumpOverride ReadJumpOverride(const ConfigValue& entry, const ConfigSource& source) {
@@ -440,7 +418,10 @@ JumpOverride ReadJumpOverride(const ConfigValue& entry, const ConfigSource& sour
         entry.path + ".kind", entry.mark,
         "missing required key 'kind' in '" + entry.path + "'; give jump_up or jump_down");
   }
-  jump.kind = ReadJumpKind(*kind, source);
+  const std::vector<std::string> kinds = {JumpKindName(JumpKind::kJumpUp),
+                                          JumpKindName(JumpKind::kJumpDown)};
+  jump.kind = ReadOneOf(*kind, source, "jump kind", kinds) == kinds[0] ? JumpKind::kJumpUp
+                                                                       : JumpKind::kJumpDown;
   const auto [before, after] = ReadBracket(*statement, source);
   const bool frequency = key == "between_hz";
   jump.control = frequency ? SweepKind::kFrequency : SweepKind::kAmplitude;

@@ -28,12 +28,15 @@ void Put(YAML::Emitter& out, const char* key, double value) {
   Put(out, key, FormatRoundTrip(value));
 }
 
-void EmitSelections(YAML::Emitter& out, const char* key,
-                    const std::vector<SweepSelection>& selections) {
+// `key: [...]`, the flow list of `text(item)` for each of `items`.
+template <typename Items, typename Text>
+void PutList(YAML::Emitter& out, const char* key, const Items& items, const Text& text) {
   out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (const SweepSelection& selection : selections) out << selection.Name();
+  for (const auto& item : items) out << text(item);
   out << YAML::EndSeq;
 }
+
+std::string SelectionName(const SweepSelection& selection) { return selection.Name(); }
 
 void EmitPenalties(YAML::Emitter& out, const PenaltyOptions& penalties) {
   const BifurcationRangeOptions& range = penalties.bifurcation_range;
@@ -42,9 +45,7 @@ void EmitPenalties(YAML::Emitter& out, const PenaltyOptions& penalties) {
   Put(out, "enabled", range.enabled);
   Put(out, "exponent", range.exponent);
   Put(out, "weight", range.weight);
-  out << YAML::Key << "enforce" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (JumpTarget target : range.enforce) out << JumpTargetName(target);
-  out << YAML::EndSeq;
+  PutList(out, "enforce", range.enforce, JumpTargetName);
   out << YAML::EndMap;
   const BranchStabilityOptions& stability = penalties.branch_stability;
   out << YAML::Key << "branch_stability" << YAML::Value << YAML::BeginMap;
@@ -115,9 +116,7 @@ void EmitFitSettings(YAML::Emitter& out, const IdentificationOptions& identifica
     if (identification.fixed[i]) out << ParameterName(i);
   }
   out << YAML::EndSeq;
-  out << YAML::Key << "stages" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (ResidualKind stage : identification.solve.stages) out << ResidualKindName(stage);
-  out << YAML::EndSeq;
+  PutList(out, "stages", identification.solve.stages, ResidualKindName);
 
   out << YAML::Key << "residual" << YAML::Value << YAML::BeginMap;
   Put(out, "error", ErrorMeasureName(identification.solve.residual.error));
@@ -164,16 +163,11 @@ void EmitMultiStartAndJumpDetection(YAML::Emitter& out, const IdentifyConfig& co
 
 void EmitChoices(YAML::Emitter& out, const char* key, const std::vector<ParameterChoice>& choices,
                  bool omega) {
-  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (const ParameterChoice& choice : choices) {
-    if (!choice.value) {
-      out << "free";
-    } else {
-      out << (omega ? ConvertedNumber(RadPerSecondToHz(*choice.value))
-                    : FormatRoundTrip(*choice.value));
-    }
-  }
-  out << YAML::EndSeq;
+  PutList(out, key, choices, [omega](const ParameterChoice& choice) {
+    if (!choice.value) return std::string("free");
+    return omega ? ConvertedNumber(RadPerSecondToHz(*choice.value))
+                 : FormatRoundTrip(*choice.value);
+  });
 }
 
 void EmitModelSelection(YAML::Emitter& out, const ModelSelectionConfig& selection) {
@@ -184,7 +178,7 @@ void EmitModelSelection(YAML::Emitter& out, const ModelSelectionConfig& selectio
   Put(out, "cross_validation", CrossValidationSchemeName(selection.scheme));
   Put(out, "training", CrossValidationTrainingName(selection.training));
   // No pool: the fitted and validation sweeps (an empty list is refused).
-  if (!selection.pool.empty()) EmitSelections(out, "pool", selection.pool);
+  if (!selection.pool.empty()) PutList(out, "pool", selection.pool, SelectionName);
   Put(out, "threads", selection.threads);
   out << YAML::EndMap;
 }
@@ -201,11 +195,9 @@ std::string ConfigToYaml(const IdentifyConfig& config, ConfigKeys keys) {
     out << YAML::Comment(header) << YAML::Newline;
   }
   out << YAML::BeginMap;
-  out << YAML::Key << "data" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (const std::string& file : config.data_files) out << file;
-  out << YAML::EndSeq;
-  EmitSelections(out, "fit", config.fit_sweeps);
-  EmitSelections(out, "validate", config.validate_sweeps);
+  PutList(out, "data", config.data_files, [](const std::string& file) { return file; });
+  PutList(out, "fit", config.fit_sweeps, SelectionName);
+  PutList(out, "validate", config.validate_sweeps, SelectionName);
   EmitInitialGuess(out, config);
   EmitFitSettings(out, config.identification, keys);
   EmitPenalties(out, config.identification.solve.penalties);

@@ -7,71 +7,11 @@
 #include "dwellfit/estimator/common/string_printf.h"
 
 namespace dwellfit {
-
 namespace {
 
 // The names of the enum values, in the enums' order.
 constexpr const char* kSchemeNames[] = {"none", "leave_one_level_out"};
 constexpr const char* kTrainingNames[] = {"config", "all"};
-
-}  // namespace
-
-const char* CrossValidationSchemeName(CrossValidationScheme scheme) {
-  return kSchemeNames[static_cast<int>(scheme)];
-}
-
-const char* CrossValidationTrainingName(CrossValidationTraining training) {
-  return kTrainingNames[static_cast<int>(training)];
-}
-
-ModelSelectionConfig ModelSelectionConfig::Defaults() {
-  ModelSelectionConfig config;
-  config.delta = {{std::nullopt, "free"}, {0.0, "0"}};
-  config.mu2 = {{std::nullopt, "free"}, {0.0, "0"}};
-  config.omega = {{std::nullopt, "free"}};
-  return config;
-}
-
-bool ModelSelectionConfig::IsValid(std::string* error) const {
-  const struct {
-    const char* name;
-    const std::vector<ParameterChoice>* choices;
-  } lists[] = {{"delta", &delta}, {"mu2", &mu2}, {"omega_hz", &omega}};
-  for (const auto& list : lists) {
-    if (list.choices->empty()) {
-      *error = std::string(list.name) + " lists no choice; give free and/or values";
-      return false;
-    }
-    for (std::size_t i = 0; i < list.choices->size(); ++i) {
-      for (std::size_t j = 0; j < i; ++j) {
-        if ((*list.choices)[i].value == (*list.choices)[j].value) {
-          *error = std::string(list.name) + " lists '" + (*list.choices)[i].text + "' twice";
-          return false;
-        }
-      }
-    }
-  }
-  for (const ParameterChoice& choice : omega) {
-    if (choice.value && !(*choice.value > 0.0)) {
-      *error = "omega_hz: a fixed natural frequency must be positive, got " + choice.text;
-      return false;
-    }
-  }
-  for (const ParameterChoice& choice : mu2) {
-    if (choice.value && *choice.value < 0.0) {
-      *error = "mu2: a fixed value must be >= 0 (the parameter is bounded below by 0), got " +
-               choice.text;
-      return false;
-    }
-  }
-  if (threads < 1) {
-    *error = "threads must be >= 1, got " + std::to_string(threads);
-    return false;
-  }
-  return true;
-}
-
-namespace {
 
 // One list of choices: entries `free`, `initial` (the config's initial
 // guess, which must be given) or a number (omega in Hz).
@@ -145,12 +85,59 @@ std::vector<SweepSelection> ReadPool(const ConfigValue& value, const ConfigSourc
 
 }  // namespace
 
+const char* CrossValidationSchemeName(CrossValidationScheme scheme) {
+  return kSchemeNames[static_cast<int>(scheme)];
+}
+
+const char* CrossValidationTrainingName(CrossValidationTraining training) {
+  return kTrainingNames[static_cast<int>(training)];
+}
+
+bool ModelSelectionConfig::IsValid(std::string* error) const {
+  const struct {
+    const char* name;
+    const std::vector<ParameterChoice>* choices;
+  } lists[] = {{"delta", &delta}, {"mu2", &mu2}, {"omega_hz", &omega}};
+  for (const auto& list : lists) {
+    if (list.choices->empty()) {
+      *error = std::string(list.name) + " lists no choice; give free and/or values";
+      return false;
+    }
+    for (std::size_t i = 0; i < list.choices->size(); ++i) {
+      for (std::size_t j = 0; j < i; ++j) {
+        if ((*list.choices)[i].value == (*list.choices)[j].value) {
+          *error = std::string(list.name) + " lists '" + (*list.choices)[i].text + "' twice";
+          return false;
+        }
+      }
+    }
+  }
+  for (const ParameterChoice& choice : omega) {
+    if (choice.value && !(*choice.value > 0.0)) {
+      *error = "omega_hz: a fixed natural frequency must be positive, got " + choice.text;
+      return false;
+    }
+  }
+  for (const ParameterChoice& choice : mu2) {
+    if (choice.value && *choice.value < 0.0) {
+      *error = "mu2: a fixed value must be >= 0 (the parameter is bounded below by 0), got " +
+               choice.text;
+      return false;
+    }
+  }
+  if (threads < 1) {
+    *error = "threads must be >= 1, got " + std::to_string(threads);
+    return false;
+  }
+  return true;
+}
+
 ModelSelectionConfig ReadModelSelectionConfig(const ConfigValue& value, const ConfigSource& source,
                                               const KnownParameters& initial_guess) {
   const StrictMap block(
       value, source,
       {"delta", "mu2", "omega_hz", "cross_validation", "training", "pool", "threads"});
-  ModelSelectionConfig config = ModelSelectionConfig::Defaults();
+  ModelSelectionConfig config;
   if (const auto v = block.Optional("delta")) {
     config.delta = ReadChoices(*v, source, kDelta, initial_guess);
   }

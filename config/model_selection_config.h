@@ -1,7 +1,6 @@
 // The `model_selection:` block of a config (config/README.md): which model
-// variants to compare, how to cross-validate them, and over which sweeps.
-// Read by LoadIdentifyConfig; run by the model-selection study
-// (estimator/studies/model_selection.h, tool `select_model`).
+// variants to compare, how to cross-validate them, and over which sweeps; run
+// by `select_model` (estimator/studies/model_selection.h).
 #ifndef DWELLFIT_CONFIG_MODEL_SELECTION_CONFIG_H_
 #define DWELLFIT_CONFIG_MODEL_SELECTION_CONFIG_H_
 
@@ -47,9 +46,9 @@ const char* CrossValidationTrainingName(CrossValidationTraining training);
 struct ModelSelectionConfig {
   // The variants are every combination of these choices (delta, then mu2,
   // then omega); each list non-empty, no choice twice.
-  std::vector<ParameterChoice> delta;
-  std::vector<ParameterChoice> mu2;
-  std::vector<ParameterChoice> omega;
+  std::vector<ParameterChoice> delta = {{std::nullopt, "free"}, {0.0, "0"}};
+  std::vector<ParameterChoice> mu2 = {{std::nullopt, "free"}, {0.0, "0"}};
+  std::vector<ParameterChoice> omega = {{std::nullopt, "free"}};
   CrossValidationScheme scheme = CrossValidationScheme::kLeaveOneLevelOut;
   CrossValidationTraining training = CrossValidationTraining::kConfig;
   // Sweeps whose levels form the cross-validation pool; empty: the config's
@@ -58,8 +57,6 @@ struct ModelSelectionConfig {
   // Fits run on this many threads at once (>= 1); results do not depend on it.
   int threads = 2;
 
-  // The defaults: delta free or 0, mu2 free or 0, omega free.
-  static ModelSelectionConfig Defaults();
   bool IsValid(std::string* error) const;
 };
 

@@ -1,8 +1,6 @@
 #include "dwellfit/config/result_parameters.h"
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/text_file.h"

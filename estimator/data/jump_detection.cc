@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <optional>
 #include <string>
@@ -304,11 +303,10 @@ void ApplyJumpOverride(const JumpOverride& jump_override, const std::string& con
 void ApplyJumpOverrides(const std::vector<JumpOverride>& overrides, const std::string& config_path,
                         std::vector<Sweep>* sweeps) {
   for (const JumpOverride& jump_override : overrides) {
-    Sweep* found = nullptr;
-    for (Sweep& sweep : *sweeps) {
-      if (sweep.Name() == jump_override.sweep) found = &sweep;
-    }
-    if (found == nullptr) {
+    const auto found = std::find_if(sweeps->begin(), sweeps->end(), [&](const Sweep& sweep) {
+      return sweep.Name() == jump_override.sweep;
+    });
+    if (found == sweeps->end()) {
       std::string available;
       for (const Sweep& sweep : *sweeps) {
         available += (available.empty() ? "" : ", ") + sweep.Name();
@@ -317,7 +315,7 @@ void ApplyJumpOverrides(const std::vector<JumpOverride>& overrides, const std::s
           config_path, jump_override.line, jump_override.field,
           "sweep '" + jump_override.sweep + "' is not in the data; available: " + available);
     }
-    ApplyJumpOverride(jump_override, config_path, found);
+    ApplyJumpOverride(jump_override, config_path, &*found);
   }
 }
 

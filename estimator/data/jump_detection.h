@@ -1,13 +1,10 @@
 // Jumps in measured sweeps and the stable branch of every dwell.
 //
-// In a stepped dwell test of the single-mode model (docs/model.md, "Stability and
-// folds") a sweep passes at most one saddle-node fold, so it shows at most one
-// jump: a step between consecutive dwells where the response leaves one stable
-// branch for the other. The detected jump brackets the fold between its two
-// control values and splits the sweep into the branch before and after it.
-//
-// A jump can also be stated in the config (`jumps:`, config/README.md): a
-// JumpOverride replaces what detection found for one sweep.
+// A sweep of the single-mode model passes at most one saddle-node fold
+// (docs/model.md, "Stability and folds"), so it shows at most one jump: a step
+// between consecutive dwells that brackets the fold and splits the sweep into
+// the branch before and after it. A JumpOverride (the config's `jumps:`)
+// replaces what detection found for one sweep.
 #ifndef DWELLFIT_ESTIMATOR_DATA_JUMP_DETECTION_H_
 #define DWELLFIT_ESTIMATOR_DATA_JUMP_DETECTION_H_
 
@@ -18,41 +15,34 @@
 
 namespace dwellfit {
 
-// Jump detection in measured sweeps (docs/performance.md has the data sets
-// behind these defaults).
+// Jump detection in measured sweeps (config/README.md, `jump_detection`, has
+// the data sets behind these defaults).
 struct JumpDetectionOptions {
-  // A jump's step between consecutive dwells must change the amplitude by
-  // more than this ratio, either way (in an amplitude sweep: beyond the
-  // sweep's power-law trend in a_base) ...
+  // A jump's step changes the amplitude by more than this ratio, either way
+  // (in an amplitude sweep: beyond the power-law trend in a_base) ...
   double min_ratio = 1.07;
-  // ... its larger side must reach this fraction of the sweep's largest
+  // ... its larger side reaches this fraction of the sweep's largest
   // amplitude (ignores hops in the noise floor far from resonance) ...
   double min_relative_amplitude = 0.2;
-  // ... and its log ratio must exceed this many robust standard deviations
-  // of the sweep's steps (0: no noise test).
+  // ... and its log ratio exceeds this many robust standard deviations of
+  // the sweep's steps (0: no noise test).
   double noise_multiple = 6.0;
-  // Sweeps with fewer candidate steps (above the amplitude gate) get no
-  // detected jump: too few steps to tell a jump from noise.
+  // Sweeps with fewer candidate steps get no detected jump (too few to tell
+  // a jump from noise).
   int min_candidate_steps = 5;
   bool IsValid(std::string* error) const;
 };
 
 // What DetectJumps weighs in one sweep (for logs, reports and tests).
 //
-// Steps: r_i = ln(a_{i+1} / a_i) between consecutive dwells i, i+1.
-// Candidates: steps whose larger side reaches options.min_relative_amplitude
-// times the sweep's largest amplitude and whose two controls differ (a fold
-// cannot lie between equal controls).
-// Excess: e_i = r_i - p ln(c_{i+1} / c_i). In an amplitude sweep the response
-// grows like a power of the base level, a ~ a_base^p (p = 1 for a linear
-// response, about 1/3 on a hardening backbone), and a_base is stepped
-// linearly, so r_i shrinks along the sweep by itself; p is the median of
-// r_i / ln(c_{i+1} / c_i) over the candidates. A frequency sweep has no such
-// trend (the slope changes sign at the peak): p = 0 and e_i = r_i.
-// Noise: sigma = 1.4826 MAD(e) over the candidates, the robust standard
-// deviation of a step. Over the candidates, not the whole sweep: the noise
-// floor far from resonance is noisier in ln(a) than the response near it.
-// The MAD ignores the jump itself and a smeared transition of a few steps.
+// Steps r_i = ln(a_{i+1} / a_i) between consecutive dwells; candidates: steps
+// whose larger side reaches min_relative_amplitude of the sweep's largest
+// amplitude and whose two controls differ (a fold cannot lie between equal
+// controls). Excess e_i = r_i - p ln(c_{i+1} / c_i): an amplitude sweep's
+// response grows like a_base^p by itself, p the median of r_i / ln(c_{i+1} /
+// c_i) over the candidates; a frequency sweep has p = 0. Noise: 1.4826 MAD(e)
+// over the candidates (not the noisier floor far from resonance); the MAD
+// ignores the jump itself and a smeared transition of a few steps.
 struct JumpEvidence {
   int candidate_steps = 0;
   int step = -1;             // the candidate with the largest |e_i| (-1: none)
@@ -78,12 +68,10 @@ JumpEvidence WeighJumpEvidence(const JumpDetectionOptions& options, const Sweep&
 // hysteresis, or a sharp peak sampled by a handful of dwells, can pass for a
 // jump or hide one; state such sweeps in the config (`jumps:`).
 //
-// Jump into missing data: when no step is accepted, the rows after the last
-// dwell were all recorded as missing (Sweep::missing) and the last dwell
-// reaches min_relative_amplitude of the largest amplitude, the response left
-// the branch it was on and the instrument recorded nothing: a jump down
-// between the last dwell and the first missing row (after it, at another
-// control), marked into_missing_data.
+// Jump into missing data: when no step is accepted, every row after the last
+// dwell is missing (Sweep::missing) and the last dwell reaches
+// min_relative_amplitude of the largest, the response left its branch
+// unrecorded: a jump down to the first missing row at another control.
 //
 // Labels: before a jump down Branch::kUpper and after it kLower; before a jump
 // up kLower and after it kUpper; no jump: every point kOnly. Replaces any
@@ -111,32 +99,22 @@ struct JumpOverride {
 };
 
 // Replaces the jumps of `sweep` with `jump_override` and relabels its branches
-// as DetectJumps would. The bracket must lie between two consecutive dwells:
-// index_before is the last dwell on the `before` side (up to control_before),
-// and the next dwell must lie on the `after` side (from control_after on).
-// Throws InputError naming `config_path` and the sweep when the bracket's
-// control does not match the sweep's kind, runs against the sweep's
-// direction, or does not lie between consecutive dwells.
+// as DetectJumps would. Throws InputError naming `config_path` and the sweep
+// when the bracket's control does not match the sweep's kind, runs against
+// the sweep's direction, or does not lie between two consecutive dwells.
 void ApplyJumpOverride(const JumpOverride& jump_override, const std::string& config_path,
                        Sweep* sweep);
 
-// ApplyJumpOverride for each override, on the sweep it names. Throws
-// InputError naming `config_path` and listing the available sweeps when an
-// override names a sweep not in `sweeps`.
+// ApplyJumpOverride on the sweep each override names; an override of a sweep
+// not in `sweeps` throws InputError listing the available ones.
 void ApplyJumpOverrides(const std::vector<JumpOverride>& overrides, const std::string& config_path,
                         std::vector<Sweep>* sweeps);
 
 // One line per sweep for logs and reports, frequencies in Hz, e.g.
 //   "F/up: jump_down between 42.20 and 42.30 Hz (a 4.7e-3 -> 2.8e-4)"
-//   "A/up: jump_up between a_base 0.0350 and 0.0360 (a 1.2e-3 -> 4.1e-3)"
 //   "F/down: no jump (41 dwells, largest a 1.0e-3)"
-//   "L/up: jump_down between 213.055 and 213.118 Hz into missing data
-//    (a 1.2e-3 -> not measured)"
-// A jump stated in the config ends in " [config]". A jump whose direction
-// does not fit a hardening response (frequency sweeps: a jump up going up or a
-// jump down going down, which fits softening) or the model at all (amplitude
-// sweeps: a jump down as a_base rises, a jump up as it falls) gets a note; it
-// is kept all the same.
+// A jump stated in the config ends in " [config]"; one whose direction fits
+// a softening response, or no response of the model, gets a note.
 std::string DescribeJumps(const Sweep& sweep);
 
 }  // namespace dwellfit

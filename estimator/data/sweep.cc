@@ -1,7 +1,5 @@
 #include "dwellfit/estimator/data/sweep.h"
 
-#include <cmath>
-
 namespace dwellfit {
 
 const char* SweepDirectionName(SweepDirection direction) {
@@ -9,18 +7,10 @@ const char* SweepDirectionName(SweepDirection direction) {
 }
 
 bool SweepDirectionFromName(const std::string& name, SweepDirection* direction) {
-  if (name == "up") {
-    *direction = SweepDirection::kUp;
-    return true;
-  }
-  if (name == "down") {
-    *direction = SweepDirection::kDown;
-    return true;
-  }
-  return false;
+  if (name != "up" && name != "down") return false;
+  *direction = name == "up" ? SweepDirection::kUp : SweepDirection::kDown;
+  return true;
 }
-
-double JumpBracket::half_width() const { return 0.5 * std::abs(control_after - control_before); }
 
 std::string Sweep::Name() const { return id + "/" + SweepDirectionName(direction); }
 

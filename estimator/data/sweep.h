@@ -7,6 +7,7 @@
 #ifndef DWELLFIT_ESTIMATOR_DATA_SWEEP_H_
 #define DWELLFIT_ESTIMATOR_DATA_SWEEP_H_
 
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,7 +48,7 @@ struct JumpBracket {
   bool into_missing_data = false;
 
   double centre() const { return 0.5 * (control_before + control_after); }
-  double half_width() const;
+  double half_width() const { return 0.5 * std::abs(control_after - control_before); }
 };
 
 // A row of the sweep whose amplitude was recorded as a <= 0: no measurement

@@ -3,6 +3,7 @@
 #include <glog/logging.h>
 #include <libfccp/csv.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -69,14 +70,14 @@ struct Range {
   const char* advice;   // what a value outside the range usually means
 };
 
-const Range kFrequencyRange = {kMinFrequencyHz, kMaxFrequencyHz, "the drive frequency [Hz]",
-                               "Omega^4", "freq_hz is in Hz (not rad/s or kHz)"};
-const Range kABaseRange = {kMinMagnitude, kMaxMagnitude, "the base level a_base", "a_base^2",
+const Range kFrequencyRange = {1e-6, 1e9, "the drive frequency [Hz]", "Omega^4",
+                               "freq_hz is in Hz (not rad/s or kHz)"};
+const Range kABaseRange = {1e-20, 1e20, "the base level a_base", "a_base^2",
                            "give a_base in a unit that puts it inside the range"};
 const Range kAmplitudeRange = {
-    kMinMagnitude, kMaxMagnitude, "the amplitude a", "a^6",
+    1e-20, 1e20, "the amplitude a", "a^6",
     "give a in a unit that puts it inside the range, or write 0 for a missing measurement"};
-const Range kSigmaRange = {kMinMagnitude, kMaxMagnitude, "the standard deviation sigma", "sigma^2",
+const Range kSigmaRange = {1e-20, 1e20, "the standard deviation sigma", "sigma^2",
                            "sigma is in the unit of a"};
 
 // Parses the whole of `text` as a finite double, locale-independently.
@@ -343,22 +344,12 @@ void AddRow(const Location& where, const RowValues& row, SweepBuilder* builder) 
   Sweep& sweep = builder->sweep;
   if (!(row.amplitude > 0.0)) {
     ++sweep.dropped_nonpositive;
-    MissingDwell missing;
-    missing.drive_frequency_rad_s = HzToRadPerSecond(row.freq_hz);
-    missing.a_base = row.a_base;
-    missing.points_before = static_cast<int>(sweep.points.size());
-    missing.source_line = row.line;
-    sweep.missing.push_back(missing);
+    sweep.missing.push_back(MissingDwell{HzToRadPerSecond(row.freq_hz), row.a_base,
+                                         static_cast<int>(sweep.points.size()), row.line});
     return;
   }
-  DwellPoint point;
-  point.drive_frequency_rad_s = HzToRadPerSecond(row.freq_hz);
-  point.a_base = row.a_base;
-  point.amplitude = row.amplitude;
-  point.phase_rad = row.phase_rad;
-  point.sigma = row.sigma;
-  point.source_line = row.line;
-  sweep.points.push_back(point);
+  sweep.points.push_back(DwellPoint{HzToRadPerSecond(row.freq_hz), row.a_base, row.amplitude,
+                                    row.phase_rad, row.sigma, Branch::kOnly, row.line});
 }
 
 void WarnAboutDroppedRows(const std::string& path, const std::vector<SweepBuilder>& builders) {
@@ -369,17 +360,16 @@ void WarnAboutDroppedRows(const std::string& path, const std::vector<SweepBuilde
       LOG(WARNING) << path << ": sweep " << sweep.Name() << ": all " << builder.num_rows
                    << " rows have a <= 0 (missing measurements); the sweep is left out";
     } else {
-      int trailing = 0;
-      for (const MissingDwell& row : sweep.missing) {
-        trailing += row.points_before == static_cast<int>(sweep.points.size());
-      }
+      const auto trailing =
+          std::count_if(sweep.missing.begin(), sweep.missing.end(), [&](const MissingDwell& row) {
+            return row.points_before == static_cast<int>(sweep.points.size());
+          });
       LOG(WARNING) << path << ": sweep " << sweep.Name() << ": dropped "
                    << sweep.dropped_nonpositive << " of " << builder.num_rows
                    << " rows with a <= 0 (missing measurements"
                    << (trailing > 0 ? ", " + std::to_string(trailing) +
-                                          " of them after the last "
-                                          "measured row"
-                                    : std::string())
+                                          " of them after the last measured row"
+                                    : "")
                    << ")";
     }
   }
@@ -425,20 +415,14 @@ std::string NotARegularFile(const std::string& path) {
   if (error || !std::filesystem::exists(status) || std::filesystem::is_regular_file(status)) {
     return "";
   }
-  switch (status.type()) {
-    case std::filesystem::file_type::directory:
-      return "is a directory";
-    case std::filesystem::file_type::character:
-      return "is a character device, not a file";
-    case std::filesystem::file_type::block:
-      return "is a block device, not a file";
-    case std::filesystem::file_type::fifo:
-      return "is a named pipe (FIFO), not a file";
-    case std::filesystem::file_type::socket:
-      return "is a socket, not a file";
-    default:
-      return "is not a regular file";
-  }
+  using Type = std::filesystem::file_type;
+  const Type type = status.type();
+  if (type == Type::directory) return "is a directory";
+  if (type == Type::character) return "is a character device, not a file";
+  if (type == Type::block) return "is a block device, not a file";
+  if (type == Type::fifo) return "is a named pipe (FIFO), not a file";
+  if (type == Type::socket) return "is a socket, not a file";
+  return "is not a regular file";
 }
 
 LoadedSweeps LoadSweepsCsv(const std::string& path) {

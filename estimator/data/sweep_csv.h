@@ -50,12 +50,6 @@ struct LoadedSweeps {
   std::vector<std::string> all_dropped;
 };
 
-// The bounds of the format above.
-inline constexpr double kMinFrequencyHz = 1e-6;
-inline constexpr double kMaxFrequencyHz = 1e9;
-inline constexpr double kMinMagnitude = 1e-20;  // a, a_base, sigma (their units)
-inline constexpr double kMaxMagnitude = 1e20;
-
 // Why `path` cannot be read as a data file ("is a directory", "is a character
 // device (such as /dev/null), not a file", ...); "" for a regular file or a
 // path that does not exist.

@@ -1,8 +1,10 @@
 #include "dwellfit/estimator/data/sweep_csv_writer.h"
 
+#include <unistd.h>
+
 #include <charconv>
-#include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -71,15 +73,27 @@ void WriteSweepsCsv(const std::vector<Sweep>& sweeps, std::ostream* out) {
 void WriteSweepsCsvFile(const std::vector<Sweep>& sweeps, const std::string& path) {
   std::ostringstream text;
   WriteSweepsCsv(sweeps, &text);
-  std::ofstream file(path, std::ios::binary | std::ios::trunc);
+  WriteFileAtomically(text.str(), path);
+}
+
+void WriteFileAtomically(const std::string& text, const std::string& path) {
+  // The process id keeps two runs into one folder from sharing a staged file.
+  const std::string staged = path + ".partial." + std::to_string(::getpid());
+  std::ofstream file(staged, std::ios::binary | std::ios::trunc);
   if (!file) {
     throw InputError(path, 0, "",
-                     "cannot open the file for writing; check that its folder "
-                     "exists and is writable");
+                     "cannot open the file for writing; check that its folder exists and is "
+                     "writable");
   }
-  file << text.str();
+  file << text;
   file.close();
-  if (!file) throw InputError(path, 0, "", "writing the file failed (disk full?)");
+  std::error_code error;
+  if (file) std::filesystem::rename(staged, path, error);
+  if (!file || error) {
+    std::filesystem::remove(staged, error);  // no half-written file is left behind
+    throw InputError(path, 0, "",
+                     "cannot write the file (disk full, a size limit, or the folder?)");
+  }
 }
 
 }  // namespace dwellfit

@@ -32,9 +32,12 @@ std::string FormatFrequencyHz(double omega_rad_s);
 // written as a plain CSV field.
 void WriteSweepsCsv(const std::vector<Sweep>& sweeps, std::ostream* out);
 
-// WriteSweepsCsv into the file `path` (created or replaced). Throws InputError
-// when the file cannot be written.
+// WriteSweepsCsv into the file `path` (created or replaced, by WriteFileAtomically).
 void WriteSweepsCsvFile(const std::vector<Sweep>& sweeps, const std::string& path);
+
+// Writes `text` to `path` through a temporary file renamed into place, so a
+// failed write leaves no half-written file. Throws InputError when it cannot.
+void WriteFileAtomically(const std::string& text, const std::string& path);
 
 }  // namespace dwellfit
 

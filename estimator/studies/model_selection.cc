@@ -592,7 +592,7 @@ void PredictionErrors::Add(const PredictionErrors& other) {
 ModelSelectionReport RunModelSelection(const IdentifyConfig& config, int threads) {
   ModelSelectionReport report;
   report.config_path = config.config_path;
-  report.selection = config.model_selection.value_or(ModelSelectionConfig::Defaults());
+  report.selection = config.model_selection.value_or(ModelSelectionConfig());
   std::string message;
   if (!report.selection.IsValid(&message)) {
     throw InputError(config.config_path, 0, "model_selection", message);

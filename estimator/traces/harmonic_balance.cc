@@ -28,10 +28,10 @@ std::vector<double> Synthesize(const std::vector<Complex>& c, int harmonics, dou
   return values;
 }
 
-// Rows of one dwell: its terms' Fourier coefficients, weighted; appended to
-// `jacobian` and `rhs` from `row`.
+// Rows of one dwell: its terms' Fourier coefficients, weighted; written into
+// `system` ([jacobian | rhs]) from `row`.
 void AddDwellRows(const DwellHarmonics& dwell, int harmonics, int points, int row,
-                  Eigen::MatrixXd* jacobian, Eigen::VectorXd* rhs) {
+                  Eigen::MatrixXd* system) {
   const double omega = dwell.drive_frequency_rad_s;
   const std::vector<double> u = Synthesize(dwell.u, harmonics, omega, 0, points);
   const std::vector<double> v = Synthesize(dwell.u, harmonics, omega, 1, points);
@@ -52,21 +52,13 @@ void AddDwellRows(const DwellHarmonics& dwell, int harmonics, int points, int ro
   for (int t = 0; t <= kUnknowns; ++t) {
     std::vector<Complex> spectrum;
     fft.fwd(spectrum, terms[t]);
-    int r = row;
-    for (int n = 0; n <= harmonics; ++n) {
+    for (int n = 0, r = row; n <= harmonics; ++n) {
       // Noise in u enters most through u'' ~ n^2: harmonic n weighs 1/n^2.
       const double harmonic_weight = n <= 1 ? 1.0 : 1.0 / (n * n);
       const Complex c =
           harmonic_weight * spectrum[n] * (n == 0 ? 1.0 : 2.0) / static_cast<double>(points);
-      double* target = t < kUnknowns ? &(*jacobian)(r, t) : &(*rhs)(r);
-      *target = weight * c.real();
-      if (n == 0) {
-        ++r;
-        continue;
-      }
-      target = t < kUnknowns ? &(*jacobian)(r + 1, t) : &(*rhs)(r + 1);
-      *target = weight * c.imag();
-      r += 2;
+      (*system)(r++, t) = weight * c.real();
+      if (n > 0) (*system)(r++, t) = weight * c.imag();
     }
   }
 }
@@ -86,8 +78,7 @@ HarmonicBalanceResult IdentifyHarmonicBalance(const std::vector<DwellHarmonics>&
   }
   int points = 64;
   while (points < 8 * (harmonics + 1)) points *= 2;
-  Eigen::MatrixXd jacobian(rows, kUnknowns);
-  Eigen::VectorXd rhs(rows);
+  Eigen::MatrixXd system(rows, kUnknowns + 1);
   for (std::size_t d = 0; d < dwells.size(); ++d) {
     if (static_cast<int>(dwells[d].u.size()) <= harmonics ||
         static_cast<int>(dwells[d].base.size()) <= harmonics || !(std::abs(dwells[d].u[1]) > 0)) {
@@ -96,9 +87,10 @@ HarmonicBalanceResult IdentifyHarmonicBalance(const std::vector<DwellHarmonics>&
                        "or no response",
                        d, harmonics));
     }
-    AddDwellRows(dwells[d], harmonics, points, static_cast<int>(d) * rows_per_dwell, &jacobian,
-                 &rhs);
+    AddDwellRows(dwells[d], harmonics, points, static_cast<int>(d) * rows_per_dwell, &system);
   }
+  const Eigen::MatrixXd jacobian = system.leftCols(kUnknowns);
+  const Eigen::VectorXd rhs = system.col(kUnknowns);
   const Eigen::VectorXd scale = jacobian.colwise().norm().cwiseInverse().transpose();
   const Eigen::MatrixXd scaled = jacobian * scale.asDiagonal();
   const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(scaled);
@@ -134,18 +126,16 @@ HarmonicBalanceResult IdentifyHarmonicBalance(const std::vector<DwellHarmonics>&
   result.reference_rad_s = reference_rad_s > 0.0 ? reference_rad_s : w;
   const double factor = 2.0 / 3.0 * result.reference_rad_s * result.reference_rad_s;
   result.effective_nonlinearity = theta(kAlphaColumn) - factor * theta(kDeltaColumn);
-  const double var_eff =
-      variance * (scale(kAlphaColumn) * scale(kAlphaColumn) * inverse(kAlphaColumn, kAlphaColumn) +
-                  factor * factor * scale(kDeltaColumn) * scale(kDeltaColumn) *
-                      inverse(kDeltaColumn, kDeltaColumn) -
-                  2.0 * factor * scale(kAlphaColumn) * scale(kDeltaColumn) *
-                      inverse(kAlphaColumn, kDeltaColumn));
+  // Delta method: the gradient of alpha - factor delta in the scaled columns.
+  Eigen::VectorXd gradient = Eigen::VectorXd::Zero(kUnknowns);
+  gradient(kAlphaColumn) = scale(kAlphaColumn);
+  gradient(kDeltaColumn) = -factor * scale(kDeltaColumn);
+  const double var_eff = variance * gradient.dot(inverse * gradient);
   result.effective_nonlinearity_error = std::sqrt(std::max(0.0, var_eff));
   return result;
 }
 
 void WriteHarmonicBalanceYaml(const HarmonicBalanceResult& result, std::ostream* out) {
-  const char* names[] = {"eta_e", "mu1", "mu2", "delta", "alpha", "omega_hz"};
   *out << "method: harmonic_balance\n"
        << StringPrintf("dwells: %d\nequations: %d\nrms_weighted_residual: %.6g\n", result.dwells,
                        result.rows, result.rms_residual)
@@ -154,7 +144,8 @@ void WriteHarmonicBalanceYaml(const HarmonicBalanceResult& result, std::ostream*
     const bool hz = i == kNaturalFrequency;
     const double value = hz ? RadPerSecondToHz(result.estimate[i]) : result.estimate[i];
     const double error = hz ? RadPerSecondToHz(result.standard_error[i]) : result.standard_error[i];
-    *out << StringPrintf("  %s: {value: %.10g, standard_error: %.4g}\n", names[i], value, error);
+    *out << StringPrintf("  %s: {value: %.10g, standard_error: %.4g}\n",
+                         hz ? "omega_hz" : ParameterName(i), value, error);
   }
   *out << StringPrintf(
       "effective_nonlinearity:\n  reference_hz: %.10g\n  value: %.10g\n  standard_error: %.4g\n",

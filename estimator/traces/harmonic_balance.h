@@ -11,11 +11,11 @@
 //     + mu2 C_n[u'|u'|/Omega] - eta_e C_n[2 a_b] = -C_n[u'']
 // (cos and sin parts: two rows per n >= 1, one for n = 0), linear in
 // theta = (w^2, delta, alpha, mu1, mu2, eta_e). The rows of all dwells are
-// stacked, each dwell's divided by Omega^2 |U_1| so that a relative error in u
-// weighs alike at every dwell, and harmonic n's by n^2 (noise in u reaches
-// the balance mostly through u'' ~ n^2 Omega^2 U_n), and solved by column-scaled least squares
-// (Eigen's column-pivoting QR). Standard errors come from the residual
-// variance and (J^T J)^-1; w's by the delta method.
+// stacked, each dwell's divided by Omega^2 |U_1| (a relative error in u weighs
+// alike at every dwell) and harmonic n's by n^2 (noise in u enters mostly
+// through u'' ~ n^2 Omega^2 U_n), and solved by column-scaled least squares
+// (Eigen's column-pivoting QR); standard errors from the residual variance
+// and (J^T J)^-1, w's by the delta method.
 #ifndef DWELLFIT_ESTIMATOR_TRACES_HARMONIC_BALANCE_H_
 #define DWELLFIT_ESTIMATOR_TRACES_HARMONIC_BALANCE_H_
 

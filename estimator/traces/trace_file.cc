@@ -1,9 +1,9 @@
 #include "dwellfit/estimator/traces/trace_file.h"
 
 #include <libfccp/csv.h>
-#include <unistd.h>
 
 #include <boost/crc.hpp>
+#include <boost/endian/conversion.hpp>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -56,40 +56,11 @@ void RequireRegularFile(const std::string& path) {
   }
 }
 
-// A little-endian float32 from/to 4 bytes, whatever the host's byte order.
+// A float32 as 4 little-endian bytes, whatever the host's byte order.
 void PutFloat(float value, std::string* out) {
-  std::uint32_t bits;
-  static_assert(sizeof(bits) == sizeof(value), "float32");
-  std::memcpy(&bits, &value, sizeof(bits));
-  for (int i = 0; i < 4; ++i) out->push_back(static_cast<char>((bits >> (8 * i)) & 0xFF));
-}
-
-float GetFloat(const unsigned char* bytes) {
-  std::uint32_t bits = 0;
-  for (int i = 0; i < 4; ++i) bits |= static_cast<std::uint32_t>(bytes[i]) << (8 * i);
-  float value;
-  std::memcpy(&value, &bits, sizeof(value));
-  return value;
-}
-
-// Writes `text` to `path` through a temporary file renamed into place.
-void WriteAtomically(const std::string& text, const fs::path& path) {
-  // The process id keeps two runs into one folder from sharing a staged file.
-  const fs::path staged = path.string() + ".partial." + std::to_string(::getpid());
-  std::ofstream file(staged, std::ios::binary | std::ios::trunc);
-  if (!file) {
-    throw InputError(staged.string(), 0, "",
-                     "cannot open the file for writing; check that the folder is writable");
-  }
-  file << text;
-  file.close();
-  std::error_code error;
-  if (file) fs::rename(staged, path, error);
-  if (!file || error) {
-    fs::remove(staged, error);  // no half-written file is left behind
-    throw InputError(path.string(), 0, "",
-                     "cannot write the file (disk full, a size limit, or the folder?)");
-  }
+  unsigned char bytes[4];
+  boost::endian::endian_store<float, 4, boost::endian::order::little>(bytes, value);
+  out->append(reinterpret_cast<const char*>(bytes), 4);
 }
 
 double ParsePositive(const std::string& file, int line, const char* field, const char* text) {
@@ -126,11 +97,9 @@ IndexRow ReadIndexRow(const std::string& file, int line, char* const* fields) {
                      "expected up or down, got '" + EscapeForMessage(fields[1]) + "'");
   }
   const std::string kind = fields[2];
-  if (kind == SweepKindName(SweepKind::kFrequency)) {
-    trace.kind = SweepKind::kFrequency;
-  } else if (kind == SweepKindName(SweepKind::kAmplitude)) {
-    trace.kind = SweepKind::kAmplitude;
-  } else {
+  trace.kind =
+      kind == SweepKindName(SweepKind::kAmplitude) ? SweepKind::kAmplitude : SweepKind::kFrequency;
+  if (kind != SweepKindName(trace.kind)) {
     throw InputError(file, line, "kind",
                      "expected frequency or amplitude, got '" + EscapeForMessage(kind) + "'");
   }
@@ -207,8 +176,8 @@ void WriteTraceSet(const std::vector<DwellTrace>& dwells, const std::string& fol
     for (float value : dwell.response) PutFloat(value, &samples);
     index << StringPrintf("%08x", Crc32(samples.data() + first, samples.size() - first)) << '\n';
   }
-  WriteAtomically(samples, fs::path(folder) / kTraceSamplesFile);
-  WriteAtomically(index.str(), fs::path(folder) / kTraceIndexFile);
+  WriteFileAtomically(samples, (fs::path(folder) / kTraceSamplesFile).string());
+  WriteFileAtomically(index.str(), (fs::path(folder) / kTraceIndexFile).string());
 }
 
 std::vector<DwellTrace> ReadTraceSet(const std::string& folder) {
@@ -246,7 +215,10 @@ std::vector<DwellTrace> ReadTraceSet(const std::string& folder) {
     const unsigned char* sample = bytes.data();
     for (std::vector<float>* channel : {&row.trace.base, &row.trace.response}) {
       channel->resize(channel == &row.trace.base ? row.base_samples : row.response_samples);
-      for (float& value : *channel) value = GetFloat(sample), sample += 4;
+      for (float& value : *channel) {
+        value = boost::endian::endian_load<float, 4, boost::endian::order::little>(sample);
+        sample += 4;
+      }
     }
     dwells.push_back(std::move(row.trace));
   }

@@ -20,11 +20,9 @@
 //               dwell in the order of traces.csv, each dwell's base channel
 //               then its response channel (no header, no padding).
 //
-// float32 keeps 7 significant digits, far below any rig's noise, at half the
-// size of double. The reader checks, before it allocates, that both are
-// regular files and that the binary file holds exactly the samples the index
-// announces; then that each dwell's samples match its CRC (so an index and a
-// samples file of two different runs are refused).
+// float32 keeps 7 significant digits, far below any rig's noise. Before it
+// allocates, the reader checks that the binary file holds exactly the samples
+// the index announces; then each dwell's CRC (refusing files of two runs).
 #ifndef DWELLFIT_ESTIMATOR_TRACES_TRACE_FILE_H_
 #define DWELLFIT_ESTIMATOR_TRACES_TRACE_FILE_H_
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numeric>
 #include <utility>
 
 #include "dwellfit/estimator/common/input_error.h"
@@ -161,9 +162,9 @@ std::vector<double> Displacement(const DwellTrace& dwell, const Spectrum& voltag
 // an amplitude of 0 rather than a measurement.
 void CheckDriveComponent(const DwellTrace& dwell, const char* channel,
                          const std::vector<double>& samples, Complex first_harmonic) {
-  double square_sum = 0.0;
-  for (double value : samples) square_sum += value * value;
-  const double rms = std::sqrt(square_sum / static_cast<double>(samples.size()));
+  const double rms =
+      std::sqrt(std::inner_product(samples.begin(), samples.end(), samples.begin(), 0.0) /
+                static_cast<double>(samples.size()));
   // A sine of amplitude A has an RMS of A / sqrt(2).
   if (!(std::abs(first_harmonic) > 1e-6 * std::sqrt(2.0) * rms)) {
     throw InputError("dwell " + dwell.Describe() + ": the " + channel +
@@ -242,12 +243,9 @@ void BuildSweeps(const std::vector<DwellTrace>& dwells, const TraceProcessingOpt
       members.emplace_back();
     }
     const DwellHarmonics& h = out->harmonics[i];
-    DwellPoint point;
-    point.drive_frequency_rad_s = dwells[i].drive_frequency_rad_s;
-    point.a_base = std::abs(h.base[1]);
-    point.amplitude = std::abs(h.u[1]);
-    point.phase_rad = Lag(h);
-    out->sweeps[it->second].points.push_back(point);
+    // Omega, a_base = |A_1|, a = |U_1| and the lag.
+    out->sweeps[it->second].points.push_back(
+        DwellPoint{dwells[i].drive_frequency_rad_s, std::abs(h.base[1]), std::abs(h.u[1]), Lag(h)});
     members[it->second].push_back(i);
   }
   for (std::size_t s = 0; s < out->sweeps.size(); ++s) {

@@ -5,27 +5,23 @@
 // Per dwell, with f the drive frequency and fs the sample rate:
 //   1. checks: both channels present, of one length, finite, and at least one
 //      drive period long (else InputError naming the dwell);
-//   2. the last N = round(P fs / f) samples, P the largest whole number of
-//      periods the record holds to within half a sample (the leftover start
-//      is dropped: it is the part nearest the previous dwell); a window of
-//      whole periods only to within a sample leaks a few 1e-4 of the
-//      amplitude at 50 samples per period;
-//   3. each channel's spectrum with Eigen's FFT; when `correct_channels`, every
-//      bin at frequency f_k is divided by the known one-pole filter
-//      H(f_k) = 1 / (1 + i f_k / f_c) of its channel and the response is moved
-//      back by the skew tau of multiplexed sampling (times exp(-i 2 pi f_k tau));
-//   4. the corrected voltage back in time (inverse FFT), turned into u sample
-//      by sample through (3.7), and u's spectrum;
-//   5. harmonic n of a channel x is X_n = (2/N) FFT[n P] (n >= 1), X_0 = FFT[0]/N,
-//      so that x(t) ~ Re sum_n X_n exp(i n Omega t); a = |U_1|, a_base = |A_1|,
-//      and the lag of the response behind the base gamma = arg A_1 - arg U_1,
-//      wrapped into (-pi, pi] (docs/model.md: u = a cos(Omega t - gamma)).
+//   2. the last N = round(P fs / f) samples, P the most whole periods the
+//      record holds to within half a sample (the start, nearest the previous
+//      dwell, is dropped; a window whole only to within a sample leaks a few
+//      1e-4 of the amplitude at 50 samples per period);
+//   3. each channel's spectrum (Eigen's FFT); when `correct_channels`, bin f_k
+//      is divided by its channel's one-pole filter H(f_k) = 1 / (1 + i f_k / f_c)
+//      and the response moved back by the multiplexing skew tau (times
+//      exp(-i 2 pi f_k tau));
+//   4. the corrected voltage back in time, turned into u sample by sample
+//      through (3.7), and u's spectrum;
+//   5. harmonic n of a channel x: X_n = (2/N) FFT[n P] (n >= 1), X_0 = FFT[0]/N,
+//      x(t) ~ Re sum_n X_n exp(i n Omega t); a = |U_1|, a_base = |A_1|, and the
+//      lag gamma = arg A_1 - arg U_1 in (-pi, pi] (docs/model.md: u = a cos(Omega t - gamma)).
 // Warnings (ProcessedTraces::warnings, one line each, naming the dwell):
-//   unsettled   U_1/A_1 over the first and over the second half of the record
-//               differ by more than `settle_tolerance` relative to its size, and
-//               by more than 5 standard deviations of what the noise alone
-//               gives (the noise per sample is estimated from the spectrum
-//               outside the harmonics: a noisy record hides a slow drift);
+//   unsettled   U_1/A_1 over the record's two halves differs by more than
+//               `settle_tolerance` (relative) and 5 standard deviations of the
+//               noise (from the spectrum outside the harmonics);
 //   harmonics   some |U_n| / |U_1| (n = 2..harmonics) exceeds
 //               `harmonic_warning_ratio`;
 //   level       in a frequency sweep, a dwell's base level differs from the

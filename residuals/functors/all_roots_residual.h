@@ -14,17 +14,13 @@
 // The branch ranges of jumps are enforced through the roots by
 // RootTransitionPenalty (root_transition_penalty.h).
 //
-// Derivatives: the chosen root is lifted to the Jet type by one Newton step
-// in Jet arithmetic (LiftRoot, stable_root.h), whose derivative part is the
-// implicit-function-theorem value da/dp = -(dG/dp) / (dG/da). Where the
-// nearest stable root changes branch (a fold passes a dwell) the residual
-// jumps; the chapter's method has the same discontinuity.
+// Derivatives: the chosen root is lifted to Jets by LiftRoot (stable_root.h).
+// Where the nearest stable root changes branch (a fold passes a dwell) the
+// residual jumps; the chapter's method has the same discontinuity.
 //
 // Parameter block p as in model_parameters.h; Omega_i [rad/s].
 #ifndef DWELLFIT_RESIDUALS_FUNCTORS_ALL_ROOTS_RESIDUAL_H_
 #define DWELLFIT_RESIDUALS_FUNCTORS_ALL_ROOTS_RESIDUAL_H_
-
-#include <cmath>
 
 #include "ceres/autodiff_cost_function.h"
 #include "dwellfit/residuals/functors/vertical_error_residual.h"

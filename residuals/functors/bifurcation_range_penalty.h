@@ -3,11 +3,10 @@
 //
 // Cost (the square of the residual):
 //   weight * u^n,   u = (c_model - c_centre) / c_halfwidth,   n even (10 by default)
-// c is the control of the jump: Omega [rad/s] for a frequency sweep (a_base
-// held), a_base for an amplitude sweep (Omega held); c_centre and
-// c_halfwidth describe the measured bracket; c_model is the model's fold for
-// the bracket's kind (fold_point.h). The residual is sqrt(weight) u^(n/2):
-// zero at the bracket's centre, small inside (u < 1), growing fast outside.
+// c is the jump's control (Omega [rad/s] of a frequency sweep, a_base of an
+// amplitude sweep), c_centre and c_halfwidth the measured bracket's, c_model
+// the model's fold (fold_point.h). The residual is sqrt(weight) u^(n/2): zero
+// at the bracket's centre, small inside (u < 1), growing fast outside.
 //
 // Where the model has no fold to match (say the damping is too high for a
 // jump), u = kNoFoldDistance + s, a large finite penalty whose gradient is

@@ -11,13 +11,11 @@
 //   r_0 = s (G(a_j; Omega_c) - a_base^2) / a_base^2
 //   r_1 = s a_j dG/da(a_j; Omega_c) / a_base^2
 //
-// Both are polynomials in the parameters: smooth and defined everywhere,
-// also where the model has no fold at all, which is where the
-// bifurcation-range penalty (bifurcation_range_penalty.h) has nothing to
-// measure. The algebraic stage adds one per enforced jump so that it lands
-// where every enforced fold exists near its bracket; the vertical stage then
-// places the folds exactly with the penalty. s weighs the jump against the
-// dwells' algebraic residuals (AlgebraicResidual).
+// Both are polynomials in the parameters, defined also where the model has no
+// fold (where bifurcation_range_penalty.h has nothing to measure): the
+// algebraic stage adds one per enforced jump so that every enforced fold
+// exists near its bracket; the vertical stage then places it exactly with the
+// penalty. s weighs the jump against the dwells' AlgebraicResidual.
 //
 // Parameter block p as in model_parameters.h.
 #ifndef DWELLFIT_RESIDUALS_FUNCTORS_FOLD_CONDITION_RESIDUAL_H_

@@ -12,22 +12,17 @@
 // kUpper: largest, kOnly: the stable root nearest a_i), and s_i a weight
 // (1/sigma_i and/or a user weight).
 //
-// Parameter block: p = [eta_e, mu1, mu2, delta, alpha, omega] (model_parameters.h),
-// omega [rad/s]; Omega_i [rad/s].
+// Parameter block p as in model_parameters.h; Omega_i [rad/s].
 //
-// Root: solved in double by a safeguarded Newton iteration from the measured
-// a_i on the bracket of its stable branch (stable_root.h), then lifted to Jet
-// by one Newton step, whose derivative part is da/dp = -(dG/dp) / (dG/da)
-// (implicit function theorem). Where the measured branch does not reach
-// a_base_i at the current parameters, a_model is the turning point where that
+// Root: solved in double on the bracket of its stable branch and lifted to
+// Jets (SolveStableRootNear, LiftRoot: stable_root.h). Where the measured
+// branch does not reach a_base_i, a_model is the turning point where that
 // branch ends (dG/da = 0), so the residual stays continuous as a fold moves
 // past a point.
 //
 // Warm start: on a labelled branch (kLower, kUpper) the Newton iteration
 // starts from this dwell's root at its last evaluation (from a_i at the
-// first). A certificate (stable_root.h) decides that the root is on the
-// dwell's branch; the value agrees with a cold start's to within the last
-// bits (ForgetRoot restarts cold). A kOnly dwell always starts from a_i.
+// first; ForgetRoot restarts cold). A kOnly dwell always starts from a_i.
 #ifndef DWELLFIT_RESIDUALS_FUNCTORS_VERTICAL_ERROR_RESIDUAL_H_
 #define DWELLFIT_RESIDUALS_FUNCTORS_VERTICAL_ERROR_RESIDUAL_H_
 
@@ -48,13 +43,10 @@ inline double MeasuredTerm(double a_measured, ErrorMeasure error, double amplitu
   return error == ErrorMeasure::kAbsolute ? a_measured : std::log(a_measured + amplitude_floor);
 }
 
-// The weighted error of a model amplitude against a measured one, as
-// `error` measures it, `measured_term` being MeasuredTerm of the measured
-// amplitude:
-//   absolute: w (a_i - a_model),  relative: w (ln(a_i + f) - ln(a_model + f)).
-// False where it is undefined: the log of a model amplitude that is not
-// positive, or a value that is not finite (a root that overflowed at an
-// extreme trial step).
+// The weighted error w (measured_term - a_model), or w (measured_term -
+// ln(a_model + f)) for the relative error, measured_term = MeasuredTerm(a_i).
+// False where undefined: the log of a model amplitude <= 0, or a value that
+// is not finite (a root that overflowed at an extreme trial step).
 template <typename T>
 bool AmplitudeError(double measured_term, const T& a_model, ErrorMeasure error, double weight,
                     double amplitude_floor, T* residual) {

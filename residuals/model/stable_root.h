@@ -30,15 +30,8 @@ namespace dwellfit {
 enum class Branch { kLower, kUpper, kOnly };
 
 inline const char* BranchName(Branch branch) {
-  switch (branch) {
-    case Branch::kLower:
-      return "lower";
-    case Branch::kUpper:
-      return "upper";
-    case Branch::kOnly:
-      return "only";
-  }
-  return "only";
+  constexpr const char* kNames[] = {"lower", "upper", "only"};
+  return kNames[static_cast<int>(branch)];
 }
 
 // Turning points of G(a) on a > 0 at one drive frequency.
@@ -142,48 +135,24 @@ inline StableRoot SolveStableRoot(const ResponseCoefficients<double>& k, double 
   // point was not found is never asked for).
   const bool lower_exists = branch != Branch::kUpper && k.G(tp.a_lower_end) > target;
   const bool upper_exists = branch != Branch::kLower && k.G(tp.a_upper_end) < target;
-  auto lower = [&]() {
-    StableRoot r;
-    r.branch = Branch::kLower;
-    if (lower_exists) {
-      r.a = BracketedNewton(residual, 0.0, tp.a_lower_end, guess);
-      r.status = RootStatus::kOnBranch;
-    } else {
-      r.a = tp.a_lower_end;
-      r.status = RootStatus::kBranchEnd;
-    }
-    return r;
+  // The root on branch `on` (kLower or kUpper), or the turning point where it ends.
+  auto solve = [&](Branch on) {
+    const bool upper = on == Branch::kUpper;
+    const double end = upper ? tp.a_upper_end : tp.a_lower_end;
+    if (!(upper ? upper_exists : lower_exists)) return StableRoot{end, RootStatus::kBranchEnd, on};
+    const double hi = upper ? upper_bracket_end(std::max(2.0 * end, guess)) : end;
+    if (!std::isfinite(hi)) return StableRoot{0.0, RootStatus::kFailed, on};
+    return StableRoot{BracketedNewton(residual, upper ? end : 0.0, hi, guess),
+                      RootStatus::kOnBranch, on};
   };
-  auto upper = [&]() {
-    StableRoot r;
-    r.branch = Branch::kUpper;
-    if (upper_exists) {
-      const double hi = upper_bracket_end(std::max(2.0 * tp.a_upper_end, guess));
-      if (!std::isfinite(hi)) return r;
-      r.a = BracketedNewton(residual, tp.a_upper_end, hi, guess);
-      r.status = RootStatus::kOnBranch;
-    } else {
-      r.a = tp.a_upper_end;
-      r.status = RootStatus::kBranchEnd;
-    }
-    return r;
-  };
-  switch (branch) {
-    case Branch::kLower:
-      root = lower();
-      break;
-    case Branch::kUpper:
-      root = upper();
-      break;
-    case Branch::kOnly:
-      if (lower_exists && upper_exists) {
-        const StableRoot l = lower();
-        const StableRoot u = upper();
-        root = std::abs(l.a - a_guess) <= std::abs(u.a - a_guess) ? l : u;
-      } else {
-        root = lower_exists ? lower() : upper();
-      }
-      break;
+  if (branch != Branch::kOnly) {
+    root = solve(branch);
+  } else if (lower_exists && upper_exists) {
+    const StableRoot l = solve(Branch::kLower);
+    const StableRoot u = solve(Branch::kUpper);
+    root = std::abs(l.a - a_guess) <= std::abs(u.a - a_guess) ? l : u;
+  } else {
+    root = solve(lower_exists ? Branch::kLower : Branch::kUpper);
   }
   if (!std::isfinite(root.a)) root.status = RootStatus::kFailed;
   return root;
@@ -244,13 +213,7 @@ inline StableRoot SolveStableRootNear(const ResponseCoefficients<double>& k, dou
       a -= step;
       if (!(a > 0.0) || !std::isfinite(a)) break;
       if (std::abs(step) <= 4.0 * std::numeric_limits<double>::epsilon() * a) {
-        if (internal::CertifiedOnBranch(k, a, branch)) {
-          StableRoot root;
-          root.a = a;
-          root.status = RootStatus::kOnBranch;
-          root.branch = branch;
-          return root;
-        }
+        if (internal::CertifiedOnBranch(k, a, branch)) return {a, RootStatus::kOnBranch, branch};
         break;
       }
     }
