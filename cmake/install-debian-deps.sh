@@ -29,6 +29,12 @@ packages=(
   python3
   # The browser test of report.html (tests/run/report_in_browser.py).
   chromium
+  # The Python module (python/, -DDWELLFIT_PYTHON=ON), its tests and example.
+  pybind11-dev
+  python3-dev
+  python3-numpy
+  python3-pytest
+  python3-matplotlib
   # The fuzzers (tests/fuzz): Clang with its libFuzzer and sanitizer runtimes.
   clang-14
   libclang-rt-14-dev

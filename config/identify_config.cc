@@ -582,23 +582,34 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
   return config;
 }
 
-}  // namespace
-
-IdentifyConfig LoadIdentifyConfig(const std::string& path,
-                                  const std::vector<ConfigOverride>& overrides) {
-  ConfigSource source = ConfigSource::Load(path);
+IdentifyConfig ReadSource(ConfigSource source, const std::string& name, const fs::path& config_path,
+                          const std::vector<ConfigOverride>& overrides) {
   source.Apply(overrides);
-  const fs::path config_path = fs::absolute(path).lexically_normal();
   IdentifyConfig config;
   try {
     config = ReadIdentifyConfig(source, config_path.parent_path());
   } catch (const YAML::Exception& e) {
     // The readers check types before converting; this is a safety net.
-    throw InputError(path, e.mark.is_null() ? 0 : e.mark.line + 1, "", e.what());
+    throw InputError(name, e.mark.is_null() ? 0 : e.mark.line + 1, "", e.what());
   }
   config.config_path = config_path.string();
   config.overrides = overrides;
   return config;
+}
+
+}  // namespace
+
+IdentifyConfig LoadIdentifyConfig(const std::string& path,
+                                  const std::vector<ConfigOverride>& overrides) {
+  return ReadSource(ConfigSource::Load(path), path, fs::absolute(path).lexically_normal(),
+                    overrides);
+}
+
+IdentifyConfig ParseIdentifyConfig(const std::string& name, const std::string& yaml_text,
+                                   const std::string& base_dir,
+                                   const std::vector<ConfigOverride>& overrides) {
+  return ReadSource(ConfigSource::Parse(name, yaml_text), name,
+                    (fs::absolute(base_dir) / name).lexically_normal(), overrides);
 }
 
 }  // namespace dwellfit

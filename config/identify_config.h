@@ -72,6 +72,12 @@ struct IdentifyConfig {
 IdentifyConfig LoadIdentifyConfig(const std::string& path,
                                   const std::vector<ConfigOverride>& overrides = {});
 
+// The same for YAML text (JSON is YAML too) named `name` in errors, its
+// relative paths taken from `base_dir` (the Python module's dict configs).
+IdentifyConfig ParseIdentifyConfig(const std::string& name, const std::string& yaml_text,
+                                   const std::string& base_dir,
+                                   const std::vector<ConfigOverride>& overrides = {});
+
 // Which keys ConfigToYaml writes.
 enum class ConfigKeys {
   // Every key, after a comment naming the source file and the overrides.

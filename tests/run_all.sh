@@ -23,7 +23,9 @@ step "dependencies"
 bash cmake/install-debian-deps.sh
 
 step "Release build and tests"
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+# Debian's interpreter, whose NumPy and pytest the dependencies install.
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DDWELLFIT_PYTHON=ON \
+  -DPython3_EXECUTABLE=/usr/bin/python3
 cmake --build build -j"${jobs}"
 ctest --test-dir build --output-on-failure -j"${jobs}"
 

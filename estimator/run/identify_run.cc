@@ -122,10 +122,9 @@ int ExitStatusFor(FitStatus status, bool accept_no_convergence) {
   return kExitFailure;
 }
 
-std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::ostream& out,
-                                             const IdentifyRunOptions& run_options) {
+std::unique_ptr<IdentifyOutcome> ComputeIdentify(const IdentifyConfig& config, std::ostream& out,
+                                                 const IdentifyRunOptions& run_options) {
   out << "# config in effect\n" << ConfigToYaml(config) << "\n";
-  CheckOutputDirectory(config.output_dir, "output_dir");
   auto outcome = std::make_unique<IdentifyOutcome>();
   outcome->run = ResolveRun(config);
   const ResolvedRun& run = outcome->run;
@@ -174,9 +173,17 @@ std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::
   const std::string figures_note = AppendCurvesAndFigures(report, config, std::move(curves), &files,
                                                           out, run_options.render_figures);
   files.emplace_back(kHtmlReportName, ReportToHtml(report, files, figures_note, config.units));
-  WriteFilesAtomically(config.output_dir, files);
+  outcome->files = std::move(files);
+  return outcome;
+}
+
+std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::ostream& out,
+                                             const IdentifyRunOptions& run_options) {
+  CheckOutputDirectory(config.output_dir, "output_dir");
+  std::unique_ptr<IdentifyOutcome> outcome = ComputeIdentify(config, out, run_options);
+  WriteFilesAtomically(config.output_dir, outcome->files);
   out << "\nwrote into " << config.output_dir << ":";
-  for (const NamedFile& file : files) out << " " << file.first;
+  for (const NamedFile& file : outcome->files) out << " " << file.first;
   out << " (listed in " << kManifestFileName << ")\n";
   return outcome;
 }

@@ -9,6 +9,7 @@
 
 #include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/analysis/identification_report.h"
+#include "dwellfit/estimator/curves/figures.h"
 #include "dwellfit/estimator/run/resolved_run.h"
 
 namespace dwellfit {
@@ -17,6 +18,7 @@ namespace dwellfit {
 struct IdentifyOutcome {
   ResolvedRun run;
   IdentificationReport report;
+  std::vector<NamedFile> files;  // what the run writes: name and content
 };
 
 struct IdentifyRunOptions {
@@ -30,6 +32,11 @@ struct IdentifyRunOptions {
 // be made at all; nothing is written then.
 std::unique_ptr<IdentifyOutcome> RunIdentify(const IdentifyConfig& config, std::ostream& out,
                                              const IdentifyRunOptions& options = {});
+
+// RunIdentify without writing: the outcome with the files it would write,
+// byte for byte (the Python module's identify).
+std::unique_ptr<IdentifyOutcome> ComputeIdentify(const IdentifyConfig& config, std::ostream& out,
+                                                 const IdentifyRunOptions& options = {});
 
 // identify's exit status (README, "Exit status"):
 inline constexpr int kExitConverged = 0;       // a converged, identifiable fit

@@ -1,0 +1,241 @@
+// The Python module's native part, `dwellfit._dwellfit` (pybind11): the
+// library's own pipeline, called as the tools call it, with its results as
+// plain Python objects and NumPy arrays. python/dwellfit/__init__.py is the
+// interface users import; docs/python.md describes it.
+//
+// The GIL is released while the library computes (the fit, the curves, the
+// simulation); InputError becomes dwellfit.InputError (a ValueError) with
+// the library's message, which names the file or dict, the line and the field.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "dwellfit/config/dwell_plan_reader.h"
+#include "dwellfit/config/identify_config.h"
+#include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/version.h"
+#include "dwellfit/estimator/curves/response_curve.h"
+#include "dwellfit/estimator/data/sweep_csv.h"
+#include "dwellfit/estimator/run/identify_run.h"
+#include "dwellfit/estimator/simulation/dwell_simulator.h"
+
+namespace py = pybind11;
+
+namespace dwellfit {
+namespace {
+
+using Overrides = std::vector<std::pair<std::string, std::string>>;
+
+std::vector<ConfigOverride> ToOverrides(const Overrides& pairs) {
+  std::vector<ConfigOverride> overrides;
+  for (const auto& [key, value] : pairs) overrides.push_back({key, value, "overrides"});
+  return overrides;
+}
+
+py::dict ByParameter(const ParameterVector& values) {
+  py::dict out;
+  for (int i = 0; i < kNumParameters; ++i) out[ParameterName(i)] = values[i];
+  return out;
+}
+
+// The dwells of `sweeps` as columns: names as lists, numbers as arrays.
+py::dict SweepColumns(const std::vector<const Sweep*>& sweeps) {
+  std::vector<std::string> id, direction, kind;
+  std::vector<double> freq_hz, a_base, a;
+  for (const Sweep* sweep : sweeps) {
+    for (const DwellPoint& point : sweep->points) {
+      id.push_back(sweep->id);
+      direction.push_back(SweepDirectionName(sweep->direction));
+      kind.push_back(SweepKindName(sweep->kind));
+      freq_hz.push_back(RadPerSecondToHz(point.drive_frequency_rad_s));
+      a_base.push_back(point.a_base);
+      a.push_back(point.amplitude);
+    }
+  }
+  py::dict out;
+  out["sweep"] = id;
+  out["direction"] = direction;
+  out["kind"] = kind;
+  out["freq_hz"] = py::array(py::cast(freq_hz));
+  out["a_base"] = py::array(py::cast(a_base));
+  out["a"] = py::array(py::cast(a));
+  return out;
+}
+
+py::dict PredictionColumns(const IdentificationReport& report) {
+  std::vector<const Sweep*> sweeps;
+  std::vector<double> a_model;
+  std::vector<std::string> role, branch;
+  for (const SweepPrediction& prediction : report.predictions) {
+    sweeps.push_back(prediction.sweep);
+    for (size_t i = 0; i < prediction.model.size(); ++i) {
+      a_model.push_back(prediction.model[i].a);
+      role.push_back(prediction.fitted ? "fitted" : "validation");
+      branch.push_back(BranchName(prediction.sweep->points[i].branch));
+    }
+  }
+  py::dict out = SweepColumns(sweeps);
+  out["role"] = role;
+  out["branch"] = branch;
+  out["a_model"] = py::array(py::cast(a_model));
+  return out;
+}
+
+py::dict UncertaintyDict(const ParameterUncertainty& u) {
+  py::dict out;
+  out["available"] = u.available;
+  out["message"] = u.message;
+  out["interval_kind"] = u.interval_kind;
+  out["standard_error"] = ByParameter(u.standard_error);
+  out["ci95_low"] = ByParameter(u.ci95_low);
+  out["ci95_high"] = ByParameter(u.ci95_high);
+  out["warnings"] = u.warnings;
+  out["effective_nonlinearity"] = u.effective_nonlinearity;
+  out["effective_nonlinearity_ci95"] =
+      py::make_tuple(u.effective_nonlinearity_ci95_low, u.effective_nonlinearity_ci95_high);
+  return out;
+}
+
+// An identify run as a dict; `files` are the run's files (result.yaml, the
+// CSVs, report.html and the figures) by name, as bytes.
+py::dict OutcomeDict(const IdentifyOutcome& outcome, const std::string& printed) {
+  const IdentificationReport& report = outcome.report;
+  py::dict out;
+  out["status"] = FitStatusName(report.result.status);
+  out["message"] = report.result.message;
+  out["parameters"] = ByParameter(report.result.parameters);
+  out["fixed"] = std::vector<bool>(report.options.fixed.begin(), report.options.fixed.end());
+  out["final_cost"] = report.result.final_cost;
+  out["uncertainty"] = UncertaintyDict(report.uncertainty);
+  out["predictions"] = PredictionColumns(report);
+  out["printed"] = printed;
+  py::dict files;
+  for (const auto& [name, content] : outcome.files) files[py::str(name)] = py::bytes(content);
+  out["files"] = files;
+  return out;
+}
+
+IdentifyConfig LoadConfig(const std::string& path, const std::string& text,
+                          const std::string& base_dir, const Overrides& overrides) {
+  return text.empty() ? LoadIdentifyConfig(path, ToOverrides(overrides))
+                      : ParseIdentifyConfig(path, text, base_dir, ToOverrides(overrides));
+}
+
+// identify on a config file (`text` empty) or on YAML text named `path`;
+// writes into the config's output_dir when `write`.
+py::dict PyIdentify(const std::string& path, const std::string& text, const std::string& base_dir,
+                    const Overrides& overrides, bool write, bool figures) {
+  std::unique_ptr<IdentifyOutcome> outcome;
+  std::ostringstream printed;
+  {
+    py::gil_scoped_release release;
+    const IdentifyConfig config = LoadConfig(path, text, base_dir, overrides);
+    IdentifyRunOptions options;
+    options.render_figures = figures;
+    outcome =
+        write ? RunIdentify(config, printed, options) : ComputeIdentify(config, printed, options);
+  }
+  return OutcomeDict(*outcome, printed.str());
+}
+
+py::dict PyLoadSweeps(const std::string& path) {
+  LoadedSweeps loaded;
+  {
+    py::gil_scoped_release release;
+    loaded = LoadSweepsCsv(path);
+  }
+  std::vector<const Sweep*> sweeps;
+  for (const Sweep& sweep : loaded.sweeps) sweeps.push_back(&sweep);
+  return SweepColumns(sweeps);
+}
+
+// The model's response curve at `parameters` (omega in rad/s): a frequency
+// sweep at base level `held` over [low_hz, high_hz], or an amplitude sweep at
+// `held` Hz over base levels [low, high].
+py::dict PyCurve(const std::map<std::string, double>& parameters, const std::string& kind,
+                 double held, double low, double high, int points_per_side) {
+  ParameterVector p{};
+  for (int i = 0; i < kNumParameters; ++i) {
+    const auto it = parameters.find(ParameterName(i));
+    if (it == parameters.end()) {
+      throw InputError("parameters", 0, ParameterName(i), "give every parameter");
+    }
+    p[i] = it->second;
+  }
+  CurveSpec spec;
+  spec.name = "curve";
+  if (kind != "frequency" && kind != "amplitude") {
+    throw InputError("kind", 0, "kind", "give 'frequency' or 'amplitude', not '" + kind + "'");
+  }
+  spec.kind = kind == "frequency" ? SweepKind::kFrequency : SweepKind::kAmplitude;
+  const bool frequency = spec.kind == SweepKind::kFrequency;
+  spec.a_base = frequency ? held : 0.0;
+  spec.omega_rad_s = frequency ? 0.0 : HzToRadPerSecond(held);
+  spec.control_low = frequency ? HzToRadPerSecond(low) : low;
+  spec.control_high = frequency ? HzToRadPerSecond(high) : high;
+  spec.points_per_side = points_per_side;
+  ResponseCurve curve;
+  {
+    py::gil_scoped_release release;
+    curve = TraceResponseCurve(p, spec);
+  }
+  std::vector<double> freq_hz, a_base, a, phase_rad;
+  std::vector<bool> stable, fold;
+  for (const CurvePoint& point : curve.points) {
+    freq_hz.push_back(RadPerSecondToHz(point.omega_rad_s));
+    a_base.push_back(point.a_base);
+    a.push_back(point.a);
+    phase_rad.push_back(point.phase_rad);
+    stable.push_back(point.stable);
+    fold.push_back(point.fold);
+  }
+  py::dict out;
+  out["freq_hz"] = py::array(py::cast(freq_hz));
+  out["a_base"] = py::array(py::cast(a_base));
+  out["a"] = py::array(py::cast(a));
+  out["phase_rad"] = py::array(py::cast(phase_rad));
+  out["stable"] = py::array(py::cast(stable));
+  out["fold"] = py::array(py::cast(fold));
+  return out;
+}
+
+// The dwells a plan (plan YAML text, or a file when `text` is empty) makes.
+py::dict PySimulate(const std::string& path, const std::string& text) {
+  std::vector<Sweep> sweeps;
+  {
+    py::gil_scoped_release release;
+    sweeps = SimulateDwells(text.empty() ? ReadDwellPlan(path) : ParseDwellPlan(text, path));
+  }
+  std::vector<const Sweep*> pointers;
+  for (const Sweep& sweep : sweeps) pointers.push_back(&sweep);
+  return SweepColumns(pointers);
+}
+
+}  // namespace
+}  // namespace dwellfit
+
+PYBIND11_MODULE(_dwellfit, m) {
+  m.doc() = "dwellfit's native part; import dwellfit instead.";
+  static py::exception<dwellfit::InputError> input_error(m, "InputError", PyExc_ValueError);
+  py::register_exception_translator([](std::exception_ptr error) {
+    try {
+      if (error) std::rethrow_exception(error);
+    } catch (const dwellfit::InputError& e) {
+      input_error(e.what());
+    }
+  });
+  m.def("identify", &dwellfit::PyIdentify, py::arg("path"), py::arg("text"), py::arg("base_dir"),
+        py::arg("overrides"), py::arg("write"), py::arg("figures"));
+  m.def("load_sweeps", &dwellfit::PyLoadSweeps, py::arg("path"));
+  m.def("curve", &dwellfit::PyCurve, py::arg("parameters"), py::arg("kind"), py::arg("held"),
+        py::arg("low"), py::arg("high"), py::arg("points_per_side"));
+  m.def("simulate", &dwellfit::PySimulate, py::arg("path"), py::arg("text"));
+  m.attr("__version__") = dwellfit::DwellfitVersion();
+}
