@@ -30,22 +30,24 @@ std::string Label(std::string_view text) {
   return trimmed == "NONE" ? std::string() : std::string(trimmed);
 }
 
-// The characters [first, first + width) of `line`, counting a well-formed
-// UTF-8 sequence as one character and any other byte as one.
+// The length of the character at `i` of `text`: a well-formed UTF-8
+// sequence, or any other single byte.
+std::size_t CharacterLength(std::string_view text, std::size_t i) {
+  const unsigned char c = static_cast<unsigned char>(text[i]);
+  const std::size_t length = c >= 0xF5 ? 1 : c >= 0xF0 ? 4 : c >= 0xE0 ? 3 : c >= 0xC2 ? 2 : 1;
+  for (std::size_t k = 1; k < length; ++k) {
+    if (i + k >= text.size() || (static_cast<unsigned char>(text[i + k]) & 0xC0) != 0x80) return 1;
+  }
+  return length;
+}
+
+// The characters [first, first + width) of `line` (UTF-8 labels such as
+// "m/s²" count one column per character).
 std::string_view Column(std::string_view line, std::size_t first, std::size_t width) {
   std::size_t begin = line.size(), character = 0, i = 0;
-  while (i < line.size() && character < first + width) {
+  for (; i < line.size() && character < first + width; ++character) {
     if (character == first) begin = i;
-    const unsigned char c = static_cast<unsigned char>(line[i]);
-    std::size_t length = c >= 0xF0 && c < 0xF5 ? 4 : c >= 0xE0 ? 3 : c >= 0xC2 && c < 0xE0 ? 2 : 1;
-    if (c >= 0xF5) length = 1;
-    for (std::size_t k = 1; k < length; ++k) {
-      if (i + k >= line.size() || (static_cast<unsigned char>(line[i + k]) & 0xC0) != 0x80) {
-        length = 1;
-      }
-    }
-    i += length;
-    ++character;
+    i += CharacterLength(line, i);
   }
   if (begin >= line.size()) return {};
   return line.substr(begin, i - begin);
@@ -284,10 +286,12 @@ void ReadBinaryValues(Cursor& c, const BinaryLayout& layout, Uff58Record* r) {
 void ReadAsciiValues(Cursor& c, Uff58Record* r) {
   const std::size_t width = r->ordinate_data_type == 2 ? 13 : 20;
   if (static_cast<std::uint64_t>(r->value_count) > c.left() / width) {
-    c.Fail("number of values (record 7)",
-           StringPrintf("announces %lld values, more than the %zu bytes left hold; give the "
-                        "whole file as exported",
-                        static_cast<long long>(r->value_count), c.left()));
+    // Named at record 7, the set number's line + 7.
+    throw InputError(
+        c.name(), r->line + 7, "number of values (record 7)",
+        StringPrintf("announces %lld values, more than the %zu bytes left hold; give the "
+                     "whole file as exported",
+                     static_cast<long long>(r->value_count), c.left()));
   }
   r->values.reserve(static_cast<std::size_t>(r->value_count));
   while (r->values.size() < static_cast<std::size_t>(r->value_count)) {
@@ -301,11 +305,15 @@ void ReadAsciiValues(Cursor& c, Uff58Record* r) {
     for (std::size_t first = 0; first < line.size(); first += width) {
       double value = 0.0;
       const std::string_view field = line.substr(first, width);
-      if (r->values.size() == static_cast<std::size_t>(r->value_count) || !ToReal(field, &value)) {
-        c.Fail("value " + std::to_string(r->values.size() + 1),
-               "expected a finite number in columns " + std::to_string(first + 1) + "-" +
-                   std::to_string(first + width) + " (at most the announced count), got '" +
-                   EscapeForMessage(Trim(field)) + "'");
+      const std::string at = "value " + std::to_string(r->values.size() + 1);
+      if (r->values.size() == static_cast<std::size_t>(r->value_count)) {
+        c.Fail(at, StringPrintf("more values than the %lld record 7 announces; check the export",
+                                static_cast<long long>(r->value_count)));
+      }
+      if (!ToReal(field, &value)) {
+        c.Fail(at, StringPrintf("expected a finite number in columns %zu-%zu, got '", first + 1,
+                                first + width) +
+                       EscapeForMessage(Trim(field)) + "'");
       }
       r->values.push_back(value);
     }
@@ -408,12 +416,18 @@ std::vector<Uff58Record> ReadUff58File(const std::string& path) {
 
 namespace {
 
-std::string NoneIfEmpty(const std::string& text) { return text.empty() ? "NONE" : text; }
+// `text` ("NONE" when empty) cut or padded with blanks to `width` characters.
+std::string Fit(const std::string& text, std::size_t width) {
+  std::string fitted(Column(text.empty() ? "NONE" : text, 0, width));
+  std::size_t characters = 0;
+  for (std::size_t i = 0; i < fitted.size(); i += CharacterLength(fitted, i)) ++characters;
+  return fitted + std::string(width - characters, ' ');
+}
 
 void AppendAxis(const Uff58Axis& axis, std::string* out) {
-  *out += StringPrintf("%10d%5d%5d%5d %-20.20s %-20.20s\n", axis.specific_data_type,
-                       axis.length_exponent, axis.force_exponent, axis.temperature_exponent,
-                       NoneIfEmpty(axis.label).c_str(), NoneIfEmpty(axis.units).c_str());
+  *out += StringPrintf("%10d%5d%5d%5d ", axis.specific_data_type, axis.length_exponent,
+                       axis.force_exponent, axis.temperature_exponent) +
+          Fit(axis.label, 20) + " " + Fit(axis.units, 20) + "\n";
 }
 
 // Record 12 in the layout the header announces.
@@ -450,11 +464,12 @@ void AppendUff58(const Uff58Record& r, bool binary, std::string* out) {
   *out += binary ? StringPrintf("%6d%c%6d%6d%12d%12zu%6d%6d%12d%12d\n", 58, 'b', 1, 2, 11, bytes, 0,
                                 0, 0, 0)
                  : std::string("    58\n");
-  for (const std::string& id : r.id_lines) *out += NoneIfEmpty(id) + "\n";
-  *out += StringPrintf(
-      "%5d%10d%5d%10d %-10.10s%10d%4d %-10.10s%10d%4d\n", r.function_type, r.function_id, r.version,
-      r.load_case, NoneIfEmpty(r.response_entity).c_str(), r.response_node, r.response_direction,
-      NoneIfEmpty(r.reference_entity).c_str(), r.reference_node, r.reference_direction);
+  for (const std::string& id : r.id_lines) *out += (id.empty() ? "NONE" : id) + "\n";
+  *out += StringPrintf("%5d%10d%5d%10d ", r.function_type, r.function_id, r.version, r.load_case) +
+          Fit(r.response_entity, 10) +
+          StringPrintf("%10d%4d ", r.response_node, r.response_direction) +
+          Fit(r.reference_entity, 10) +
+          StringPrintf("%10d%4d\n", r.reference_node, r.reference_direction);
   *out += StringPrintf("%10d%10zu%10d%13.5E%13.5E%13.5E\n", r.ordinate_data_type, r.values.size(),
                        1, r.abscissa_min, r.abscissa_increment, r.z_axis_value);
   for (const Uff58Axis* axis : {&r.abscissa, &r.ordinate, &r.denominator, &r.z_axis}) {

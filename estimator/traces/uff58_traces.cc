@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 
 #include "dwellfit/estimator/common/input_error.h"
@@ -108,6 +109,12 @@ std::vector<float> Channel(const RowPlace& at, const char* field, const Uff58Rec
          EscapeForMessage(units) + "' (base_unit for the base, V for the response)");
   }
   *rate_hz = SampleRateFromIncrement(r.abscissa_increment);
+  for (std::size_t i = 0; i < r.values.size(); ++i) {
+    if (std::abs(r.values[i]) > std::numeric_limits<float>::max()) {
+      fail(StringPrintf("has value %zu = %g, beyond single precision; check the export", i + 1,
+                        r.values[i]));
+    }
+  }
   return std::vector<float>(r.values.begin(), r.values.end());
 }
 
