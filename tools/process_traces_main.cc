@@ -7,6 +7,10 @@
 //                  --out datasets/virtual-beam/sweeps.csv \
 //                  [--harmonic_balance=hb.yaml [--reference_hz=41.5]]
 //
+// or, from UFF data set 58 time histories (estimator/traces/uff58_traces.h),
+// --uff datasets/virtual-beam/traces-uff/virtual-beam-58b.csv in place of
+// --traces.
+//
 // Warnings (unsettled dwells, strong harmonics, base levels off the sweep's
 // mean) are printed. With an unsettled dwell nothing is written and the exit
 // code is 3, unless --allow_unsettled; bad input exits 1.
@@ -27,12 +31,14 @@
 #include "dwellfit/estimator/data/sweep_csv_writer.h"
 #include "dwellfit/estimator/traces/harmonic_balance.h"
 #include "dwellfit/estimator/traces/trace_processing.h"
+#include "dwellfit/estimator/traces/uff58_traces.h"
 #include "dwellfit/tools/tool_main.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 
 DEFINE_string(rig, "", "YAML rig: channels, beam and gauge, processing (required).");
-DEFINE_string(traces, "", "Folder holding traces.csv and traces.f32 (required).");
+DEFINE_string(traces, "", "Folder holding traces.csv and traces.f32 (or give --uff).");
+DEFINE_string(uff, "", "UFF index CSV naming each dwell's data sets 58 (instead of --traces).");
 DEFINE_string(out, "", "Sweeps CSV to write (sweep,direction,freq_hz,a_base,a,phase_rad).");
 DEFINE_string(harmonic_balance, "", "If set, also identify by harmonic balance into this YAML.");
 DEFINE_double(reference_hz, 0.0, "Omega_ref [Hz] of the effective nonlinearity (0: identified w).");
@@ -69,8 +75,11 @@ void CheckFlags() {
                                "give a frequency >= 0 in Hz (0: the identified omega)");
   }
   const std::filesystem::path traces(FLAGS_traces);
-  const std::vector<std::string> inputs = {FLAGS_rig, (traces / "traces.csv").string(),
-                                           (traces / "traces.f32").string()};
+  std::vector<std::string> inputs = {FLAGS_rig, FLAGS_uff};
+  if (!FLAGS_traces.empty()) {
+    inputs.push_back((traces / "traces.csv").string());
+    inputs.push_back((traces / "traces.f32").string());
+  }
   dwellfit::CheckOutputFile(FLAGS_out, "--out", inputs);
   if (FLAGS_harmonic_balance.empty()) return;
   dwellfit::CheckOutputFile(FLAGS_harmonic_balance, "--harmonic_balance", inputs);
@@ -85,7 +94,8 @@ void CheckFlags() {
 int ProcessAndWrite(std::vector<std::string>* staged) {
   CheckFlags();
   const dwellfit::RigConfig rig = dwellfit::ReadRigConfig(FLAGS_rig);
-  const auto dwells = dwellfit::ReadTraceSet(FLAGS_traces);
+  const auto dwells = FLAGS_uff.empty() ? dwellfit::ReadTraceSet(FLAGS_traces)
+                                        : dwellfit::ReadUffTraceSet(FLAGS_uff);
   const dwellfit::ProcessedTraces processed = dwellfit::ProcessTraces(dwells, rig.processing);
   for (const std::string& warning : processed.warnings) {
     std::cerr << "warning: " << warning << "\n";
@@ -124,11 +134,11 @@ int main(int argc, char** argv) {
   const dwellfit::ToolSpec tool = {
       "process_traces",
       "Dwell points (and optionally harmonic-balance estimates) from sine-dwell time traces.\n"
-      "Usage: process_traces --rig rig.yaml --traces folder --out sweeps.csv",
+      "Usage: process_traces --rig rig.yaml (--traces folder | --uff index.csv) --out sweeps.csv",
       __FILE__};
   return dwellfit::RunTool(argc, argv, tool, [] {
-    if (FLAGS_rig.empty() || FLAGS_traces.empty() || FLAGS_out.empty()) {
-      std::cerr << "process_traces: give --rig, --traces and --out; see --help\n";
+    if (FLAGS_rig.empty() || FLAGS_traces.empty() == FLAGS_uff.empty() || FLAGS_out.empty()) {
+      std::cerr << "process_traces: give --rig, --out and one of --traces or --uff; see --help\n";
       return dwellfit::kToolExitUsage;
     }
     std::vector<std::string> staged;

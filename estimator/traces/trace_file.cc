@@ -150,7 +150,8 @@ std::vector<IndexRow> ReadIndex(const std::string& path) {
 std::string DwellTrace::Describe() const {
   std::string text = sweep + "/" + SweepDirectionName(direction) + " @ " +
                      FormatFrequencyHz(drive_frequency_rad_s) + " Hz";
-  if (source_line > 0) text += StringPrintf(" (%s:%d)", kTraceIndexFile, source_line);
+  const std::string file = source_file.empty() ? kTraceIndexFile : source_file;
+  if (source_line > 0) text += StringPrintf(" (%s:%d)", file.c_str(), source_line);
   return text;
 }
 

@@ -43,6 +43,7 @@ struct DwellTrace {
   std::vector<float> base;             // base acceleration [B]
   std::vector<float> response;         // strain-gauge voltage [V]
   int source_line = 0;                 // line of traces.csv (0: not read from disk)
+  std::string source_file;             // the index read ("": traces.csv)
 
   // "F0.01/up @ 41.3 Hz (traces.csv:12)": names the dwell in messages.
   std::string Describe() const;

@@ -14,6 +14,7 @@ const std::vector<FuzzTarget>& AllFuzzTargets() {
       {"rig_config", &RigConfigBody, ".yaml"},
       {"result_parameters", &ResultParametersBody, ""},
       {"shard_merge", &ShardMergeBody, ""},
+      {"uff58", &Uff58Body, ""},
   };
   return targets;
 }

@@ -46,6 +46,10 @@ void ResultParametersBody(const std::uint8_t* data, std::size_t size);
 // byte, fits.csv after it (MergeShards); a merged study holds each of its
 // fits once, in order.
 void ShardMergeBody(const std::uint8_t* data, std::size_t size);
+// The input as a UFF file (ParseUff58); every data set 58 read holds the
+// values its header announces, all finite, and reads back the same after
+// AppendUff58.
+void Uff58Body(const std::uint8_t* data, std::size_t size);
 
 struct FuzzTarget {
   std::string name;  // tests/fuzz/corpus/<name>, tests/fuzz/regressions/<name>

@@ -6,7 +6,7 @@
 #
 # SECONDS per target; 0 only replays the seeds and regression inputs once.
 # TARGETs: sweep_csv identify_config set_flag dwell_plan trace_set rig_config
-# result_parameters shard_merge (default: all).
+# result_parameters shard_merge uff58 (default: all).
 # The fuzzers are taken from $FUZZ_BUILD_DIR (default build-fuzz), a build
 # configured with -DDWELLFIT_BUILD_FUZZERS=ON and built with --target fuzzers.
 # Inputs: tests/fuzz/corpus/<target> and tests/fuzz/regressions/<target>
@@ -26,7 +26,7 @@ seconds=$1
 shift
 targets=("$@")
 ((${#targets[@]} > 0)) || targets=(sweep_csv identify_config set_flag dwell_plan trace_set
-  rig_config result_parameters shard_merge)
+  rig_config result_parameters shard_merge uff58)
 build_dir=${FUZZ_BUILD_DIR:-build-fuzz}
 
 # Files under datasets/ that seed each target.
@@ -77,6 +77,7 @@ run_target() {
   local inputs=("${work}" "tests/fuzz/corpus/${name}" "tests/fuzz/regressions/${name}" "${seeds}")
   local dict=tests/fuzz/dict/yaml.dict
   [[ "${name}" != sweep_csv && "${name}" != trace_set ]] || dict=tests/fuzz/dict/csv.dict
+  [[ "${name}" != uff58 ]] || dict=tests/fuzz/dict/uff.dict
   local options=(-timeout=10 -rss_limit_mb=2048 -max_len=8192 -print_final_stats=1
     -dict="${dict}" -artifact_prefix="${findings}/")
   local asan_options status
