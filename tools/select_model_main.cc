@@ -21,6 +21,7 @@
 #include "dwellfit/estimator/common/memory_policy.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/studies/model_selection.h"
+#include "dwellfit/estimator/studies/study_pages.h"
 #include "dwellfit/tools/tool_main.h"
 #include "gflags/gflags.h"
 #include "glog/logging.h"
@@ -56,12 +57,13 @@ int main(int argc, char** argv) {
     std::vector<std::pair<std::string, std::string>> files = {
         {"model_selection.csv", dwellfit::ModelSelectionCsv(report)},
         {"model_selection.md", markdown},
-        {"model_selection_levels.csv", dwellfit::ModelSelectionLevelsCsv(report)}};
+        {"model_selection_levels.csv", dwellfit::ModelSelectionLevelsCsv(report)},
+        {"report.html", dwellfit::ModelSelectionToHtml(report, markdown)}};
     const std::string recommended = dwellfit::RecommendedConfigYaml(config, report);
     if (!recommended.empty()) files.push_back({"recommended.yaml", recommended});
     dwellfit::WriteFilesAtomically(directory, files);
     std::cout << markdown << "\nwrote " << directory
-              << "/model_selection.{csv,md}, model_selection_levels.csv";
+              << "/model_selection.{csv,md}, model_selection_levels.csv, report.html";
     if (!recommended.empty()) {
       std::cout << " and " << directory << "/recommended.yaml (run it: identify --config "
                 << directory << "/recommended.yaml)";

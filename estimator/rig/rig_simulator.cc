@@ -1,13 +1,9 @@
 #include "dwellfit/estimator/rig/rig_simulator.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <complex>
-#include <cstdio>
-#include <fstream>
 #include <random>
 #include <sstream>
 
@@ -339,14 +335,7 @@ void WriteRigTruthCsv(const RigRun& run, const std::string& path) {
            << (truth.settled ? "true" : "false") << ',' << truth.settle_periods << '\n';
     }
   }
-  const std::string staged = path + ".partial." + std::to_string(::getpid());
-  std::ofstream file(staged, std::ios::binary | std::ios::trunc);
-  file << text.str();
-  file.close();
-  if (!file || std::rename(staged.c_str(), path.c_str()) != 0) {
-    std::remove(staged.c_str());  // no half-written file is left behind
-    throw InputError(path, 0, "", "cannot write the truth file; check that its folder is writable");
-  }
+  WriteFileAtomically(text.str(), path);
 }
 
 }  // namespace dwellfit

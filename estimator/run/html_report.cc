@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/common/version.h"
@@ -137,23 +136,6 @@ std::string ValidationSection(const ValidationIntervals& v) {
   return html + "</p>\n";
 }
 
-// <figure>s of the SVG images among `files` whose name starts (`overview`)
-// or does not start with kOverviewFigureStem, without their XML declaration.
-std::string InlineFigures(const std::vector<NamedFile>& files, bool overview) {
-  std::string html;
-  for (const auto& [name, svg] : files) {
-    const bool is_svg = name.size() > 4 && name.compare(name.size() - 4, 4, ".svg") == 0;
-    const size_t start = svg.find("<svg");
-    if (!is_svg || (name.rfind(kOverviewFigureStem, 0) == 0) != overview ||
-        start == std::string::npos) {
-      continue;
-    }
-    html += "<figure>\n" + svg.substr(start) + "<figcaption>" + HtmlEscape(name) +
-            "</figcaption>\n</figure>\n";
-  }
-  return html;
-}
-
 }  // namespace
 
 std::string HtmlEscape(const std::string& text) {
@@ -183,6 +165,44 @@ std::string HtmlEscape(const std::string& text) {
   return out;
 }
 
+std::string HtmlPage(const std::string& title, const std::string& body) {
+  return "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" +
+         HtmlEscape(title) + "</title>\n<style>" + kStyle + "</style>\n</head>\n<body>\n<h1>" +
+         HtmlEscape(title) + "</h1>\n" + body + "<p>dwellfit " + HtmlEscape(DwellfitVersion()) +
+         "</p>\n</body>\n</html>\n";
+}
+
+std::string HtmlTable(const std::string& id, const std::vector<std::string>& header,
+                      const std::vector<std::vector<std::string>>& rows) {
+  std::string html = "<table id=\"" + HtmlEscape(id) + "\">\n" + Header(header);
+  for (const std::vector<std::string>& row : rows) {
+    html += "<tr>";
+    for (const std::string& cell : row) html += Cell(cell);
+    html += "</tr>\n";
+  }
+  return html + "</table>\n";
+}
+
+std::string InlineSvgFigures(const std::vector<NamedFile>& files, const std::string& first_stem) {
+  std::vector<const NamedFile*> svgs;
+  for (const NamedFile& file : files) {
+    const std::string& name = file.first;
+    if (name.size() > 4 && name.compare(name.size() - 4, 4, ".svg") == 0 &&
+        file.second.find("<svg") != std::string::npos) {
+      svgs.push_back(&file);
+    }
+  }
+  std::stable_partition(svgs.begin(), svgs.end(), [&](const NamedFile* file) {
+    return !first_stem.empty() && file->first.rfind(first_stem, 0) == 0;
+  });
+  std::string html;
+  for (const NamedFile* file : svgs) {
+    html += "<figure>\n" + file->second.substr(file->second.find("<svg")) + "<figcaption>" +
+            HtmlEscape(file->first) + "</figcaption>\n</figure>\n";
+  }
+  return html;
+}
+
 std::string ParameterUnit(int index, const DataUnits& units) {
   const std::string a = units.a.empty() ? "[A]" : units.a;
   const std::string b = units.a_base.empty() ? "[B]" : units.a_base;
@@ -204,23 +224,20 @@ std::string ParameterUnit(int index, const DataUnits& units) {
 
 std::string ReportToHtml(const IdentificationReport& report, const std::vector<NamedFile>& figures,
                          const std::string& figures_note, const DataUnits& units) {
-  std::ostringstream html;
-  html << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>dwellfit "
-          "identify: "
-       << HtmlEscape(report.config_path) << "</title>\n<style>" << kStyle
-       << "</style>\n</head>\n<body>\n<h1>dwellfit identify</h1>\n<p>Config: <code>"
-       << HtmlEscape(report.config_path) << "</code>; dwellfit " << HtmlEscape(DwellfitVersion())
-       << "</p>\n";
-  const std::string overview = InlineFigures(figures, /*overview=*/true);
-  html << StatusSection(report) << EstimatesSection(report, units)
-       << (overview.empty() ? "" : "<h2>Where the sweeps jump</h2>\n" + overview)
-       << WarningsSection(report) << SweepsSection(report)
-       << ValidationSection(report.validation_intervals) << "<h2>Figures</h2>\n"
-       << (figures_note.empty() ? "" : "<p>" + HtmlEscape("No figures: " + figures_note) + "</p>\n")
-       << InlineFigures(figures, /*overview=*/false);
-  html << "<h2>Configuration in effect</h2>\n<pre id=\"config\">"
-       << HtmlEscape(report.config_in_effect) << "</pre>\n</body>\n</html>\n";
-  return html.str();
+  std::vector<NamedFile> overview, others;
+  for (const NamedFile& file : figures) {
+    (file.first.rfind(kOverviewFigureStem, 0) == 0 ? overview : others).push_back(file);
+  }
+  const std::string overview_html = InlineSvgFigures(overview);
+  std::string body = "<p>Config: <code>" + HtmlEscape(report.config_path) + "</code></p>\n" +
+                     StatusSection(report) + EstimatesSection(report, units);
+  if (!overview_html.empty()) body += "<h2>Where the sweeps jump</h2>\n" + overview_html;
+  body += WarningsSection(report) + SweepsSection(report) +
+          ValidationSection(report.validation_intervals) + "<h2>Figures</h2>\n";
+  if (!figures_note.empty()) body += "<p>" + HtmlEscape("No figures: " + figures_note) + "</p>\n";
+  body += InlineSvgFigures(others) + "<h2>Configuration in effect</h2>\n<pre id=\"config\">" +
+          HtmlEscape(report.config_in_effect) + "</pre>\n";
+  return HtmlPage("dwellfit identify: " + report.config_path, body);
 }
 
 }  // namespace dwellfit

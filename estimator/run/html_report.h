@@ -31,6 +31,16 @@ std::string ParameterUnit(int index, const DataUnits& units);
 // `text` with &, <, >, " and ' written as HTML entities.
 std::string HtmlEscape(const std::string& text);
 
+// The pieces every dwellfit page is made of (identify's, select_model's and
+// sensitivity's): a whole self-contained page of `title` around `body`
+// (HTML); a table (text cells, escaped here); the SVG images among `files`
+// inline, each with its name as caption, those named `first_stem`* first.
+std::string HtmlPage(const std::string& title, const std::string& body);
+std::string HtmlTable(const std::string& id, const std::vector<std::string>& header,
+                      const std::vector<std::vector<std::string>>& rows);
+std::string InlineSvgFigures(const std::vector<NamedFile>& files,
+                             const std::string& first_stem = "");
+
 }  // namespace dwellfit
 
 #endif  // DWELLFIT_ESTIMATOR_RUN_HTML_REPORT_H_

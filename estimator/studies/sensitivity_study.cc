@@ -24,6 +24,7 @@
 #include "dwellfit/estimator/fit/staged_solve.h"
 #include "dwellfit/estimator/run/resolved_run.h"
 #include "dwellfit/estimator/studies/replica_run.h"
+#include "dwellfit/estimator/studies/study_pages.h"
 #include "tbb/parallel_for.h"
 #include "tbb/task_arena.h"
 #include "yaml-cpp/yaml.h"
@@ -99,6 +100,11 @@ void FillEstimates(const IdentifyConfig& config, const ResolvedRun& run,
   row->status = FitStatusName(result.status);
   row->cost = result.final_cost;
   row->iterations = result.iterations;
+  if (!result.stages.empty()) {
+    row->dof =
+        result.stages.back().residual_blocks -
+        static_cast<int>(std::count(run.options.fixed.begin(), run.options.fixed.end(), false));
+  }
   row->estimate = result.parameters;
   row->estimate[kNaturalFrequency] = RadPerSecondToHz(result.parameters[kNaturalFrequency]);
   if (!u.available) return;
@@ -263,7 +269,7 @@ void ReadFitRows(const std::string& path, const SensitivityStudy& shape,
   std::string line;
   std::getline(csv, line);
   const size_t keys = shape.axis_keys.size();
-  const size_t columns = 4 + keys + 3 + 2 * kNumParameters;
+  const size_t columns = 4 + keys + 3 + 2 * kNumParameters + 1;
   for (int number = 2; std::getline(csv, line); ++number) {
     if (!line.empty() && line.back() == '\r') line.pop_back();  // a CRLF file
     const std::vector<std::string> f = SplitCsvLine(line);
@@ -284,6 +290,7 @@ void ReadFitRows(const std::string& path, const SensitivityStudy& shape,
       row.estimate[i] = ParseNumber(f[7 + keys + 2 * i], path, number);
       row.standard_error[i] = ParseNumber(f[8 + keys + 2 * i], path, number);
     }
+    row.dof = ParseCount(f.back(), path, number);
     rows->push_back(row);
   }
 }
@@ -305,6 +312,46 @@ std::string StudyToYaml(const SensitivityStudy& study) {
     yaml << "]\n";
   }
   return yaml.str();
+}
+
+// The profile (one axis): the cost and every estimate against the axis value;
+// converged fits as filled dots, fits stopped at their iteration limit as
+// open ones, failed fits as red crosses at the best fit's value. The cost
+// panel's line is the 95 % profile threshold F_min (1 + 3.84 / dof) of the
+// best usable fit: by Wilks, 2 dF / s^2 <= chi^2_1(0.95) = 3.84 with
+// s^2 = 2 F_min / dof (docs/uncertainty.md).
+std::string ProfileFigureScript(const SensitivityStudy& study) {
+  const FitRow* best = nullptr;
+  for (const FitRow& row : study.rows) {
+    if (Usable(row) && (best == nullptr || row.cost < best->cost)) best = &row;
+  }
+  std::ostringstream gp;
+  gp << "# Profile: cost and estimates against " << study.axis_keys[0] << "\n"
+     << "set output \"profile.\".fmt\nset multiplot layout 2,4 title \"profile over "
+     << study.axis_keys[0] << "\"\nset xlabel \"" << study.axis_keys[0] << "\"\n"
+     << "converged(x) = strcol('status') eq \"converged\"\n"
+     << "stopped(x) = strcol('status') eq \"no_convergence\"\n"
+     << "set key bottom right font \",8\"\n";
+  for (int i = -1; i < kNumParameters; ++i) {
+    const std::string column = i < 0 ? "cost" : ParameterColumn(i);
+    const double at_best = best == nullptr ? 0.0 : (i < 0 ? best->cost : best->estimate[i]);
+    gp << "set title \"" << column << "\"\nplot 'fits.csv' using (converged(0) ? column(5) : "
+       << "NaN):'" << column << "' with points pt 7 title \"converged\", \\\n"
+       << "  'fits.csv' using (stopped(0) ? column(5) : NaN):'" << column
+       << "' with points pt 6 lc rgb \"#ff7f0e\" title \"iteration limit\", \\\n"
+       << StringPrintf("  'fits.csv' using (converged(0) || stopped(0) ? NaN : column(5)):(%.17g) ",
+                       at_best)
+       << "with points pt 2 ps 1.5 lc rgb \"#d62728\" title \"failed\"";
+    if (i < 0 && best != nullptr && best->dof > 0) {
+      gp << StringPrintf(
+          ", \\\n  %.17g with lines dt 2 lc rgb \"#555555\" title "
+          "\"95 %% threshold\"",
+          best->cost * (1.0 + 3.841458820694124 / best->dof));
+    }
+    gp << "\nunset key\n";
+  }
+  gp << "unset multiplot\nunset output\n";
+  return gp.str();
 }
 
 // figures.gp: the histogram of every estimate and, with one axis, the
@@ -337,19 +384,7 @@ std::string StudyFigureScript(const SensitivityStudy& study) {
        << "') / w + 0.5) : NaN):(1.0) smooth frequency with boxes notitle\n";
   }
   gp << "unset multiplot\nunset output\nunset arrow 1\n";
-  if (study.axis_keys.size() == 1) {
-    gp << "# Profile: cost and estimates against " << study.axis_keys[0] << "\n"
-       << "set output \"profile.\".fmt\nset multiplot layout 2,4 title \"profile over "
-       << study.axis_keys[0] << "\"\nset xlabel \"" << study.axis_keys[0] << "\"\n"
-       << "set title \"cost\"\nplot 'fits.csv' using (ok(0) ? column(5) : NaN):'cost' with "
-          "points pt 7 notitle\n";
-    for (int i = 0; i < kNumParameters; ++i) {
-      gp << "set title \"" << ParameterColumn(i)
-         << "\"\nplot 'fits.csv' using (ok(0) ? column(5) : NaN):'" << ParameterColumn(i)
-         << "' with points pt 7 notitle\n";
-    }
-    gp << "unset multiplot\nunset output\n";
-  }
+  if (study.axis_keys.size() == 1) gp << ProfileFigureScript(study);
   return gp.str();
 }
 
@@ -488,7 +523,7 @@ std::string FitsToCsv(const SensitivityStudy& study) {
   for (int i = 0; i < kNumParameters; ++i) {
     csv << ',' << ParameterColumn(i) << ',' << ParameterColumn(i) << "_se";
   }
-  csv << '\n';
+  csv << ",dof\n";
   for (const FitRow& row : study.rows) {
     csv << row.fit << ',' << row.case_index << ',' << row.replica << ',' << row.seed;
     for (const std::string& value : row.settings) csv << ',' << CsvField(value);
@@ -497,7 +532,7 @@ std::string FitsToCsv(const SensitivityStudy& study) {
       csv << ',' << FormatRoundTrip(row.estimate[i]) << ','
           << FormatRoundTrip(row.standard_error[i]);
     }
-    csv << '\n';
+    csv << ',' << row.dof << '\n';
   }
   return csv.str();
 }
@@ -568,14 +603,16 @@ std::vector<std::pair<std::string, std::string>> StudyFiles(const SensitivityStu
   std::vector<NamedFile> files = {{"fits.csv", FitsToCsv(study)},
                                   {"summary.yaml", SummaryToYaml(study)},
                                   {"study.yaml", StudyToYaml(study)}};
-  if (!figures) return files;
-  files.emplace_back(kFigureScriptName, StudyFigureScript(study));
-  const RenderedFigures rendered = RenderFigures({files[0], files.back()});
-  if (!rendered.rendered) {
-    warnings << "warning: " << rendered.warning << "\n";
-    return files;
+  if (figures) {
+    files.emplace_back(kFigureScriptName, StudyFigureScript(study));
+    const RenderedFigures rendered = RenderFigures({files[0], files.back()});
+    if (rendered.rendered) {
+      files.insert(files.end(), rendered.images.begin(), rendered.images.end());
+    } else {
+      warnings << "warning: " << rendered.warning << "\n";
+    }
   }
-  files.insert(files.end(), rendered.images.begin(), rendered.images.end());
+  files.emplace_back("report.html", StudyToHtml(study, files));
   return files;
 }
 

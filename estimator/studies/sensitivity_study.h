@@ -56,6 +56,7 @@ struct FitRow {
   std::string status;                 // FitStatusName
   double cost = 0.0;
   int iterations = 0;
+  int dof = 0;                       // n - k: dwells fitted less free parameters (0: no fit)
   ParameterVector estimate{};        // omega in Hz
   ParameterVector standard_error{};  // 0 where unavailable or fixed (omega in Hz)
 };

@@ -1,11 +1,12 @@
 // The convergence family's transformations keep the physics: a member in
 // another amplitude unit responds with the same amplitudes times lambda, one
 // in another time unit jumps at the same frequencies times s.
+#include "dwellfit/estimator/studies/convergence_family.h"
+
 #include <cmath>
 #include <string>
 #include <vector>
 
-#include "dwellfit/estimator/studies/convergence_family.h"
 #include "gtest/gtest.h"
 
 namespace dwellfit {

@@ -1,5 +1,6 @@
 #include "dwellfit/estimator/studies/sensitivity_study.h"
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -49,6 +50,46 @@ TEST(SensitivityStudy, FitsCsvIsTheSameForOneAndTwoThreads) {
   }
   // Replicas differ (each its own noise).
   EXPECT_NE(one.rows[0].estimate[kAlpha], one.rows[1].estimate[kAlpha]);
+}
+
+// A one-axis study: each fit's dof is the dwells fitted less the free
+// parameters (the thesis plan's dwells; omega fixed, five free), the profile
+// figure draws the 95 % threshold F_min (1 + 3.84 / dof) of the best fit and
+// marks fits by status, and report.html holds the summary and the figures.
+TEST(SensitivityStudy, TheProfileDrawsTheThresholdAndTheReportTheSummary) {
+  SensitivityOptions options = NoiseStudy(2);
+  options.threads = 2;
+  options.vary = ParseVaryFlag("initial_guess.delta=8000|12000", "--vary");
+  const SensitivityStudy study = RunSensitivityStudy(options);
+  int fitted = 0;  // the dwells of the config's fit sweeps, F0.01 and A41.5
+  for (const SweepPlan& sweep : options.plan->sweeps) {
+    if (sweep.id == "F0.01" || sweep.id == "A41.5") {
+      fitted += static_cast<int>(sweep.directions.size()) * (sweep.NumSteps() + 1);
+    }
+  }
+  const FitRow* best = &study.rows[0];
+  for (const FitRow& row : study.rows) {
+    EXPECT_EQ(row.status, "converged");
+    if (row.cost < best->cost) best = &row;
+  }
+  std::ostringstream warnings;
+  const std::vector<std::pair<std::string, std::string>> files = StudyFiles(study, true, warnings);
+  std::string script, html;
+  for (const auto& [name, content] : files) {
+    if (name == "figures.gp") script = content;
+    if (name == "report.html") html = content;
+  }
+  for (const FitRow& row : study.rows) EXPECT_EQ(row.dof, fitted - 5);  // k = 5: omega fixed
+  char threshold[64];
+  std::snprintf(threshold, sizeof(threshold), "%.17g with lines",
+                best->cost * (1.0 + 3.841458820694124 / best->dof));
+  EXPECT_THAT(script, ::testing::HasSubstr(threshold));
+  EXPECT_THAT(script, ::testing::HasSubstr("title \"95 % threshold\""));
+  EXPECT_THAT(script, ::testing::HasSubstr("title \"failed\""));
+  EXPECT_THAT(html, ::testing::HasSubstr("<table id=\"summary\">"));
+  EXPECT_THAT(html, ::testing::HasSubstr("initial_guess.delta = 12000"));
+  EXPECT_THAT(html, ::testing::HasSubstr("<figcaption>profile.svg</figcaption>"));
+  EXPECT_THAT(html, ::testing::HasSubstr("<figcaption>histograms.svg</figcaption>"));
 }
 
 TEST(SensitivityStudy, FourMergedShardsEqualOneRun) {
