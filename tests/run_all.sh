@@ -7,7 +7,7 @@
 #      UndefinedBehaviorSanitizer (build-sanitize/, DWELLFIT_SANITIZE=ON);
 #   4. the libFuzzer targets built with Clang (build-fuzz/): each replays the
 #      committed seeds and regression inputs, then fuzzes for
-#      $DWELLFIT_FUZZ_SECONDS seconds (default 20; 0: replay only).
+#      $DWELLFIT_FUZZ_SECONDS seconds (default 12; 0: replay only).
 #
 #   bash tests/run_all.sh      (what .ci/run does)
 #
@@ -15,7 +15,7 @@
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 jobs=${DWELLFIT_JOBS:-2}
-fuzz_seconds=${DWELLFIT_FUZZ_SECONDS:-20}
+fuzz_seconds=${DWELLFIT_FUZZ_SECONDS:-12}
 
 step() { echo "=== run_all: $* ($(date +%T))"; }
 
