@@ -468,6 +468,26 @@ void PrintLevelRefits(const IdentificationReport& report, std::ostream& out) {
   for (const std::string& warning : r.warnings) out << "warning: " << warning << "\n";
 }
 
+// omega(a) [Hz] and zeta(a) with their 95 % bands (linearised), one flow
+// map per amplitude.
+void EmitModalProperties(const ModalProperties& modal, YAML::Emitter* out) {
+  *out << YAML::Key << "modal_properties" << YAML::Value << YAML::BeginMap;
+  *out << YAML::Key << "band" << YAML::Value << (modal.bands ? "linearised_95" : "none");
+  *out << YAML::Key << "points" << YAML::Value << YAML::BeginSeq;
+  for (const ModalPoint& p : modal.points) {
+    *out << YAML::Flow << YAML::BeginMap;
+    EmitNumber("a", p.a, out);
+    EmitNumber("omega_hz", p.omega_hz, out);
+    *out << YAML::Key << "omega_hz_ci95" << YAML::Value << YAML::Flow << YAML::BeginSeq
+         << p.omega_hz_low << p.omega_hz_high << YAML::EndSeq;
+    EmitNumber("zeta", p.zeta, out);
+    *out << YAML::Key << "zeta_ci95" << YAML::Value << YAML::Flow << YAML::BeginSeq
+         << p.zeta_low << p.zeta_high << YAML::EndSeq
+         << YAML::EndMap;
+  }
+  *out << YAML::EndSeq << YAML::EndMap;
+}
+
 }  // namespace
 
 std::string ReportToYaml(const IdentificationReport& report) {
@@ -496,6 +516,7 @@ std::string ReportToYaml(const IdentificationReport& report) {
     EmitValidationIntervals(report.validation_intervals, &out);
   }
   if (!report.level_refits.message.empty()) EmitLevelRefits(report.level_refits, &out);
+  if (!report.modal.points.empty()) EmitModalProperties(report.modal, &out);
   out << YAML::EndMap;
   std::string yaml = std::string(out.c_str()) + "\n";
   if (!report.config_in_effect.empty()) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "dwellfit/estimator/analysis/level_refits.h"
+#include "dwellfit/estimator/analysis/modal_properties.h"
 #include "dwellfit/estimator/analysis/parameter_uncertainty.h"
 #include "dwellfit/estimator/analysis/prediction_intervals.h"
 #include "dwellfit/estimator/analysis/sweep_prediction.h"
@@ -33,6 +34,8 @@ struct IdentificationReport {
   // Model error (docs/uncertainty.md), set by AddModelError.
   ValidationIntervals validation_intervals;
   LevelRefits level_refits;
+  // omega(a) and zeta(a) over the fitted amplitudes (modal_properties.h).
+  ModalProperties modal;
 };
 
 // Fills report->validation_intervals and report->level_refits.

@@ -235,6 +235,30 @@ std::string OverviewFigure(const FigureSet& figures, SweepKind sweep_kind) {
   return gp + "plot " + boost::algorithm::join(parts, ", \\\n  ") + "\nunset output\nset offsets\n";
 }
 
+// omega(a) and zeta(a) of the identified model, each over its 95 % band.
+std::string ModalFigure(const FigureSet& figures) {
+  std::string gp = "# Amplitude-dependent natural frequency and damping ratio\n$modal << EOD\n";
+  for (const auto& row : figures.modal) {
+    for (size_t i = 0; i < row.size(); ++i) gp += StringPrintf(i == 0 ? "%.9g" : " %.9g", row[i]);
+    gp += "\n";
+  }
+  gp += StringPrintf("EOD\nset output \"%s.\".fmt\n", kModalFigureStem);
+  gp +=
+      "set origin 0, 0\nset size 1, 1\nset multiplot layout 2,1 title \"The identified "
+      "model's natural frequency and damping ratio against the amplitude (95 % bands)\"\n"
+      "unset logscale\nset key inside top left\nset format x \"% h\"\nset xlabel " +
+      Quoted("amplitude a [" + figures.amplitude_unit + "]") + "\n";
+  for (const auto& [column, label] :
+       {std::pair{2, "natural frequency omega(a) [Hz]"}, std::pair{5, "damping ratio zeta(a)"}}) {
+    gp += StringPrintf(
+        "set ylabel \"%s\"\nplot $modal using 1:%d:%d with filledcurves fc rgb \"#c6dbef\" "
+        "title \"95 %% band\", $modal using 1:%d with lines lw 2 lc rgb \"#1f77b4\" title "
+        "\"identified\"\n",
+        label, column + 1, column + 2, column);
+  }
+  return gp + "unset multiplot\nunset output\n";
+}
+
 }  // namespace
 
 std::string FigureFileStem(const FigureSweep& sweep) {
@@ -250,6 +274,7 @@ std::string GnuplotFigureScript(const FigureSet& figures) {
   for (size_t i = 0; i < figures.sweeps.size(); ++i) {
     script += SweepFigure(figures, figures.sweeps[i], i);
   }
+  if (!figures.modal.empty()) script += ModalFigure(figures);
   for (SweepKind kind : {SweepKind::kFrequency, SweepKind::kAmplitude}) {
     if (HeldValues(figures.overview, kind) >= 2) return script + OverviewFigure(figures, kind);
   }

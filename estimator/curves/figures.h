@@ -13,6 +13,7 @@
 #ifndef DWELLFIT_ESTIMATOR_CURVES_FIGURES_H_
 #define DWELLFIT_ESTIMATOR_CURVES_FIGURES_H_
 
+#include <array>
 #include <string>
 #include <utility>
 #include <vector>
@@ -67,9 +68,14 @@ struct FigureSet {
   std::string control_unit;    // unit of a_base, for an amplitude sweep's x axis
   std::string residual_label;  // the fit's error measure, for the residual axis
   bool log_amplitude = false;  // the amplitude axis logarithmic
+  // Drawn as figure_modal_properties when not empty: per amplitude a, the
+  // natural frequency [Hz] and the damping ratio with their 95 % bands,
+  // {a, omega_hz, low, high, zeta, low, high}.
+  std::vector<std::array<double, 7>> modal;
 };
 
 inline constexpr char kOverviewFigureStem[] = "figure_overview_jumps";
+inline constexpr char kModalFigureStem[] = "figure_modal_properties";
 
 // "figure_<role>_<id>" with characters outside [A-Za-z0-9._-] replaced by '_'.
 std::string FigureFileStem(const FigureSweep& sweep);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -104,6 +105,22 @@ void ComputeAfterFit(const ResolvedRun& run, const IdentificationResult& result,
   }
 }
 
+// omega(a) and zeta(a) over the fitted dwells' amplitudes, with bands from
+// the fit's covariance when it has one.
+ModalProperties FitModalProperties(const std::vector<const Sweep*>& fitted,
+                                   const IdentificationReport& report) {
+  double a_min = std::numeric_limits<double>::infinity(), a_max = 0.0;
+  for (const Sweep* sweep : fitted) {
+    for (const DwellPoint& point : sweep->points) {
+      a_min = std::min(a_min, point.amplitude);
+      a_max = std::max(a_max, point.amplitude);
+    }
+  }
+  const ParameterUncertainty& u = report.uncertainty;
+  return ComputeModalProperties(report.result.parameters, u.available ? &u.covariance : nullptr,
+                                a_min, a_max);
+}
+
 }  // namespace
 
 int ExitStatusFor(FitStatus status, bool accept_no_convergence) {
@@ -167,9 +184,11 @@ std::unique_ptr<IdentifyOutcome> ComputeIdentify(const IdentifyConfig& config, s
                 ResolveThreadCount(run.options.solve.solver.num_threads), &report);
   report.config_in_effect = ConfigToYaml(config, ConfigKeys::kAffectingTheResult);
   MarkUnidentifiable(&report);
+  report.modal = FitModalProperties(run.fitted, report);
   PrintReport(report, out);
   std::vector<NamedFile> files = {{"result.yaml", ReportToYaml(report)},
-                                  {"predictions.csv", std::move(predictions_csv)}};
+                                  {"predictions.csv", std::move(predictions_csv)},
+                                  {"modal_properties.csv", ModalPropertiesCsv(report.modal)}};
   const std::string figures_note = AppendCurvesAndFigures(report, config, std::move(curves), &files,
                                                           out, run_options.render_figures);
   files.emplace_back(kHtmlReportName, ReportToHtml(report, files, figures_note, config.units));

@@ -218,6 +218,10 @@ std::string AppendCurvesAndFigures(const IdentificationReport& report, const Ide
   FigureSet figures;
   figures.corner_lines = EstimateLines(report);
   figures.overview = OverviewJumps(report);
+  for (const ModalPoint& p : report.modal.points) {
+    figures.modal.push_back(
+        {p.a, p.omega_hz, p.omega_hz_low, p.omega_hz_high, p.zeta, p.zeta_low, p.zeta_high});
+  }
   figures.amplitude_unit = config.units.a.empty() ? "data's unit" : config.units.a;
   figures.control_unit = config.units.a_base.empty() ? "data's unit" : config.units.a_base;
   figures.log_amplitude = config.log_amplitude;

@@ -47,8 +47,9 @@ TEST(RunIdentify, WithoutRenderingWritesTheScriptButNoImage) {
   const YAML::Node manifest = YAML::LoadFile(out_dir + "/manifest.yaml");
   std::vector<std::string> names;
   for (const YAML::Node& file : manifest["files"]) names.push_back(file["name"].as<std::string>());
-  EXPECT_EQ(names, (std::vector<std::string>{"result.yaml", "predictions.csv", "curves.csv",
-                                             "figures.gp", "report.html"}));
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"result.yaml", "predictions.csv", "modal_properties.csv",
+                                      "curves.csv", "figures.gp", "report.html"}));
   const YAML::Node result = YAML::LoadFile(out_dir + "/result.yaml");
   EXPECT_EQ(result["status"].as<std::string>(), "converged");
   EXPECT_FALSE(result["dwellfit_version"].as<std::string>().empty());
@@ -141,11 +142,11 @@ TEST(RunIdentify, WritesResultYamlAndPredictionsForTheThesisCase) {
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 2 * 81 + 6 * 49);
 
   const YAML::Node manifest = YAML::LoadFile(out_dir + "/manifest.yaml");
-  // result.yaml, predictions.csv, curves.csv, figures.gp, report.html, and a
-  // PNG and an SVG for each of the four sweep ids and for the overview (three
-  // amplitude sweeps at three frequencies; gnuplot is installed by the deps
-  // script).
-  ASSERT_EQ(manifest["files"].size(), 15u);
+  // result.yaml, predictions.csv, modal_properties.csv, curves.csv,
+  // figures.gp, report.html, and a PNG and an SVG for each of the four sweep
+  // ids, for the modal properties and for the overview (three amplitude sweeps
+  // at three frequencies; gnuplot is installed by the deps script).
+  ASSERT_EQ(manifest["files"].size(), 18u);
   EXPECT_EQ(manifest["files"][1]["bytes"].as<std::size_t>(), csv.size());
 }
 

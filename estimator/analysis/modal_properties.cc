@@ -1,0 +1,84 @@
+#include "dwellfit/estimator/analysis/modal_properties.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "dwellfit/estimator/common/string_printf.h"
+#include "dwellfit/residuals/model/response_model.h"
+
+namespace dwellfit {
+namespace {
+
+constexpr double kZ95 = 1.959963984540054;
+
+// q +/- z sqrt(g^T C g), g by central differences over the parameters C has.
+template <typename Quantity>
+void Band(const ParameterVector& p, const ParameterMatrix& covariance, Quantity q, double value,
+          double* low, double* high) {
+  Eigen::Matrix<double, kNumParameters, 1> gradient =
+      Eigen::Matrix<double, kNumParameters, 1>::Zero();
+  for (int j = 0; j < kNumParameters; ++j) {
+    if (covariance(j, j) <= 0.0) continue;
+    const double step = p[j] != 0.0 ? 1e-6 * std::abs(p[j]) : 1e-6 * std::sqrt(covariance(j, j));
+    ParameterVector up = p, down = p;
+    up[j] += step;
+    down[j] -= step;
+    gradient[j] = (q(up) - q(down)) / (2.0 * step);
+  }
+  const double half = kZ95 * std::sqrt(std::max(0.0, gradient.dot(covariance * gradient)));
+  *low = value - half;
+  *high = value + half;
+}
+
+}  // namespace
+
+double ModalFrequency(const ParameterVector& p, double a) {
+  const double w = p[kNaturalFrequency];
+  const double squared = (4.0 * w * w + 3.0 * p[kAlpha] * a * a) / (4.0 + 2.0 * p[kDelta] * a * a);
+  return squared > 0.0 ? std::sqrt(squared) : std::numeric_limits<double>::quiet_NaN();
+}
+
+double ModalDampingRatio(const ParameterVector& p, double a) {
+  const double damping = p[kMu1] + 4.0 * p[kMu2] * a / (3.0 * kPi);
+  return damping / ((1.0 + 0.5 * p[kDelta] * a * a) * ModalFrequency(p, a));
+}
+
+ModalProperties ComputeModalProperties(const ParameterVector& parameters,
+                                       const ParameterMatrix* covariance, double a_min,
+                                       double a_max, int points) {
+  ModalProperties modal;
+  if (!(a_min > 0.0) || !(a_max >= a_min) || points < 2) {
+    modal.why = "no measured amplitude range";
+    return modal;
+  }
+  modal.bands = covariance != nullptr;
+  for (int i = 0; i < points; ++i) {
+    ModalPoint point;
+    point.a = a_min + (a_max - a_min) * i / (points - 1);
+    const auto omega_hz = [&point](const ParameterVector& p) {
+      return RadPerSecondToHz(ModalFrequency(p, point.a));
+    };
+    const auto zeta = [&point](const ParameterVector& p) { return ModalDampingRatio(p, point.a); };
+    point.omega_hz = point.omega_hz_low = point.omega_hz_high = omega_hz(parameters);
+    point.zeta = point.zeta_low = point.zeta_high = zeta(parameters);
+    if (covariance != nullptr) {
+      Band(parameters, *covariance, omega_hz, point.omega_hz, &point.omega_hz_low,
+           &point.omega_hz_high);
+      Band(parameters, *covariance, zeta, point.zeta, &point.zeta_low, &point.zeta_high);
+    }
+    modal.points.push_back(point);
+  }
+  return modal;
+}
+
+std::string ModalPropertiesCsv(const ModalProperties& modal) {
+  std::string csv = "a,omega_hz,omega_hz_low,omega_hz_high,zeta,zeta_low,zeta_high\n";
+  for (const ModalPoint& p : modal.points) {
+    csv += StringPrintf("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", p.a, p.omega_hz,
+                        p.omega_hz_low, p.omega_hz_high, p.zeta, p.zeta_low, p.zeta_high);
+  }
+  return csv;
+}
+
+}  // namespace dwellfit

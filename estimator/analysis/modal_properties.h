@@ -1,0 +1,51 @@
+// The identified model's amplitude-dependent natural frequency and damping
+// ratio, the quantities test engineers compare across methods (docs/model.md,
+// "Amplitude-dependent modal properties"). Matching the averaged equations
+// near resonance to a linear oscillator of mass m, stiffness k and damping c
+// (Q = (k - m Omega^2) a, P = c Omega a, eq. 3.3) at each amplitude a:
+//
+//   omega(a)^2 = k / m = (4 w^2 + 3 alpha a^2) / (4 + 2 delta a^2)   (the backbone)
+//   zeta(a)    = c / (2 sqrt(k m)) = (mu1 + 4 mu2 a / (3 pi)) / ((1 + delta a^2 / 2) omega(a))
+//
+// The 95 % bands are linearised: q +/- 1.95996 sqrt(g^T C g), g = dq/dp by
+// central differences (relative step 1e-6), C the fit's covariance.
+#ifndef DWELLFIT_ESTIMATOR_ANALYSIS_MODAL_PROPERTIES_H_
+#define DWELLFIT_ESTIMATOR_ANALYSIS_MODAL_PROPERTIES_H_
+
+#include <string>
+#include <vector>
+
+#include "dwellfit/estimator/analysis/parameter_uncertainty.h"
+
+namespace dwellfit {
+
+struct ModalPoint {
+  double a = 0.0;                             // response amplitude (data's unit)
+  double omega_hz = 0.0, omega_hz_low = 0.0;  // natural frequency [Hz] and its band
+  double omega_hz_high = 0.0;
+  double zeta = 0.0, zeta_low = 0.0, zeta_high = 0.0;  // damping ratio and its band
+};
+
+struct ModalProperties {
+  std::vector<ModalPoint> points;  // ascending in a; empty: not computed (`why`)
+  bool bands = false;              // false: no covariance, the bands are the values
+  std::string why;
+};
+
+// omega(a) [rad/s] and zeta(a) at `parameters` (omega in rad/s); NaN where
+// the backbone has no real frequency.
+double ModalFrequency(const ParameterVector& parameters, double a);
+double ModalDampingRatio(const ParameterVector& parameters, double a);
+
+// `points` amplitudes evenly over [a_min, a_max], with bands from
+// `covariance` (physical units, omega in rad/s) when given.
+ModalProperties ComputeModalProperties(const ParameterVector& parameters,
+                                       const ParameterMatrix* covariance, double a_min,
+                                       double a_max, int points = 25);
+
+// modal_properties.csv: a,omega_hz,omega_hz_low,omega_hz_high,zeta,zeta_low,zeta_high.
+std::string ModalPropertiesCsv(const ModalProperties& modal);
+
+}  // namespace dwellfit
+
+#endif  // DWELLFIT_ESTIMATOR_ANALYSIS_MODAL_PROPERTIES_H_
