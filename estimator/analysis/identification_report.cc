@@ -384,12 +384,11 @@ void PrintJumps(const IdentificationReport& report, std::ostream& out) {
       const std::string model =
           jump.exists
               ? StringPrintf("%.6g%s%s", ControlInFileUnit(sweep, jump.control), unit,
-                             jump.measured
-                                 ? StringPrintf(" (%s, %+.3g %% from the bracket centre)",
-                                                jump.inside ? "inside" : "outside",
-                                                100.0 * (jump.control / jump.bracket.centre() - 1))
-                                       .c_str()
-                                 : "")
+                             jump.measured ? StringPrintf(" (%s, %+.3g %% from the bracket centre)",
+                                                          jump.inside ? "inside" : "outside",
+                                                          jump.ErrorPercent())
+                                                 .c_str()
+                                           : "")
               : "no fold";
       out << StringPrintf("%-20s %-10s %-30s %s\n", sweep.Name().c_str(), JumpKindName(jump.kind),
                           measured.c_str(), model.c_str());
@@ -481,9 +480,8 @@ void EmitModalProperties(const ModalProperties& modal, YAML::Emitter* out) {
     *out << YAML::Key << "omega_hz_ci95" << YAML::Value << YAML::Flow << YAML::BeginSeq
          << p.omega_hz_low << p.omega_hz_high << YAML::EndSeq;
     EmitNumber("zeta", p.zeta, out);
-    *out << YAML::Key << "zeta_ci95" << YAML::Value << YAML::Flow << YAML::BeginSeq
-         << p.zeta_low << p.zeta_high << YAML::EndSeq
-         << YAML::EndMap;
+    *out << YAML::Key << "zeta_ci95" << YAML::Value << YAML::Flow << YAML::BeginSeq << p.zeta_low
+         << p.zeta_high << YAML::EndSeq << YAML::EndMap;
   }
   *out << YAML::EndSeq << YAML::EndMap;
 }

@@ -26,6 +26,9 @@ struct PredictedJump {
   bool exists = false;   // the model has this fold
   double control = 0.0;  // the model's jump: Omega [rad/s] or a_base
   bool inside = false;   // measured and exists: the fold lies inside the bracket
+  // 100 (control - centre) / centre: the model's jump against the measured
+  // bracket's centre, in % (measured and exists).
+  double ErrorPercent() const { return 100.0 * (control - bracket.centre()) / bracket.centre(); }
 };
 
 // For every measured jump, the model's fold nearest the bracket; without

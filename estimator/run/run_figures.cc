@@ -10,6 +10,7 @@
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/curves/sweep_curves.h"
+#include "dwellfit/residuals/functors/vertical_error_residual.h"
 #include "glog/logging.h"
 
 namespace dwellfit {
@@ -58,10 +59,9 @@ void AddDwells(const SweepPrediction& prediction, const ResidualOptions& measure
     const double x = FigureX(sweep.kind, point.drive_frequency_rad_s, point.a_base);
     const double a = point.amplitude;
     const double model = prediction.model[i].a;
-    const double residual =
-        measure.error == ErrorMeasure::kAbsolute
-            ? a - model
-            : std::log(a + measure.amplitude_floor) - std::log(model + measure.amplitude_floor);
+    double residual = std::numeric_limits<double>::quiet_NaN();  // none without a model amplitude
+    AmplitudeError(MeasuredTerm(a, measure.error, measure.amplitude_floor), model, measure.error,
+                   1.0, measure.amplitude_floor, &residual);
     (up ? figure->up : figure->down).push_back({x, a});
     (up ? figure->up_residual : figure->down_residual).push_back({x, residual});
   }
@@ -189,7 +189,7 @@ std::string JumpNote(const Sweep& sweep, const PredictedJump& jump) {
   const double centre = shown(jump.bracket.centre());
   const double error = shown(jump.control) - centre;
   return note + StringPrintf("%.5g%s (%+.3g%s, %+.3g %% from the bracket centre%s)",
-                             shown(jump.control), unit, error, unit, 100.0 * error / centre,
+                             shown(jump.control), unit, error, unit, jump.ErrorPercent(),
                              jump.inside ? ", inside" : "");
 }
 
