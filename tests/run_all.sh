@@ -7,7 +7,7 @@
 #      UndefinedBehaviorSanitizer (build-sanitize/, DWELLFIT_SANITIZE=ON);
 #   4. the libFuzzer targets built with Clang (build-fuzz/): each replays the
 #      committed seeds and regression inputs, then fuzzes for
-#      $DWELLFIT_FUZZ_SECONDS seconds (default 12; 0: replay only).
+#      $DWELLFIT_FUZZ_SECONDS seconds (default 8; 0: replay only).
 #
 #   bash tests/run_all.sh      (what .ci/run does)
 #
@@ -15,7 +15,7 @@
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 jobs=${DWELLFIT_JOBS:-2}
-fuzz_seconds=${DWELLFIT_FUZZ_SECONDS:-12}
+fuzz_seconds=${DWELLFIT_FUZZ_SECONDS:-8}
 
 step() { echo "=== run_all: $* ($(date +%T))"; }
 
@@ -40,13 +40,17 @@ cmake --build build-sanitize -j"${jobs}"
 # Tests that repeat, over the whole measured beam or hundreds of replicas, code
 # that lighter tests run under the sanitizers too (the beam fit on one and three
 # threads, the profile of beam-selected.yaml, coverage on a few replicas,
-# select_model's quiet run, the model-selection unit tests), and the packaging
+# select_model's verbose run, the model-selection unit tests, the coverage study
+# without guesses, two hundred random starts, four merged sensitivity shards:
+# each has a one-replica or one-shard sibling that runs here), and the packaging
 # tests (outside projects built against the install) and the browser tests
 # (report.html in Chromium, whose writing the identify tests run) run in the
 # Release step only. Under ASan the two largest took 229 s and 175 s, the rest some 300 s.
 heavy='MeasuredBeamFilesAreByteIdenticalOnOneAndTwoThreads|clamped-beam-27C/beam\.yaml|'
 heavy+='UncertaintyCoverage\.|IdentifyOnTheMeasuredBeamReportsProfileIntervals|'
 heavy+='ModelSelectionBeam\.|method_comparison_reproducible|select_model_verbose_shows_ceres'
+heavy+='|WithNoInitialGuessesEveryReplicaConverges|TwoHundredRandomStartsReachTheTruth|'
+heavy+='FourMergedShardsEqualOneRun'
 UBSAN_OPTIONS=print_stacktrace=1 ctest --test-dir build-sanitize --output-on-failure -j"${jobs}" \
   -E "${heavy}" -LE "packaging|browser"
 
