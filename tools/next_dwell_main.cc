@@ -26,8 +26,9 @@ DEFINE_string(target, "d_optimal",
               "what to learn: d_optimal (all free parameters), a parameter (eta_e, mu1, mu2, "
               "delta, alpha, omega), alpha_e, omega_at=<amplitude> or jump_up_hz|jump_down_hz="
               "<level>");
-DEFINE_double(settle_time_constants, 5.0,
-              "k of the settling time (k + ln(1 + relative amplitude step)) / mu1 [s]");
+DEFINE_double(
+    settle_time_constants, 5.0,
+    "k of the settling time (k + ln(1 + relative amplitude step)) / (mu1 + (2/pi) mu2 a) [s]");
 DEFINE_double(recording_seconds, 2.0, "recording time of one dwell [s]");
 DEFINE_double(noise_sigma, 0.0,
               "noise of a new dwell in the residual's unit (0: the fit's own residual noise)");

@@ -50,9 +50,10 @@ double QuantityValue(const ParameterVector& p, const DesignTarget& target, doubl
 }
 
 // Settling time [s] of a step to amplitude a_new from a_now (cost model above).
-double SettleSeconds(double mu1, double k, double a_now, double a_new) {
+double SettleSeconds(const ParameterVector& p, double k, double a_now, double a_new) {
   const double d = std::abs(a_new - a_now) / a_new;
-  return (k + std::log1p(d)) / mu1;
+  const double rate_per_s = p[kMu1] + (2.0 / M_PI) * p[kMu2] * a_new;
+  return (k + std::log1p(d)) / rate_per_s;
 }
 
 // The gain of the dwell whose row is g: see the header.
@@ -261,10 +262,15 @@ Recommendation RecommendNextDwell(const DesignBasis& given, const RigState& stat
   const StableRoot now = ModelAmplitude(basis.estimate, HzToRadPerSecond(state.frequency_hz),
                                         state.level, state.branch, 0.0);
   out.present_amplitude = now.a;
-  if (now.status == RootStatus::kFailed || !(basis.estimate[kMu1] > 0.0)) {
+  if (now.status == RootStatus::kFailed) {
     throw InputError(
-        "the estimate has no stable response at the present state, or mu1 <= 0 "
-        "(no settling time): check the fit's status and --state");
+        "the estimate has no stable response at the present state: check the "
+        "fit's status and --state");
+  }
+  if (!(basis.estimate[kMu1] + basis.estimate[kMu2] > 0.0)) {
+    throw InputError(
+        "the estimate has no damping (mu1 = mu2 = 0), so no settling time: fit "
+        "more dwells, or fix mu1 at a value from a decay test");
   }
   const std::vector<double> fs =
       AxisGrid(state.frequency_hz, limits.frequency_step_min_hz, limits.frequency_step_max_hz,
@@ -278,7 +284,6 @@ Recommendation RecommendNextDwell(const DesignBasis& given, const RigState& stat
                      fs.size() * ls.size(), options.max_candidates));
   }
   const double s2 = basis.noise_sigma * basis.noise_sigma;
-  const double mu1 = basis.estimate[kMu1];
   const bool d_optimal = options.target.kind == TargetKind::kDOptimal;
   for (double f : fs) {
     for (double level : ls) {
@@ -293,7 +298,7 @@ Recommendation RecommendNextDwell(const DesignBasis& given, const RigState& stat
         continue;
       }
       cand.settle_seconds =
-          SettleSeconds(mu1, options.settle_time_constants, now.a, cand.amplitude);
+          SettleSeconds(basis.estimate, options.settle_time_constants, now.a, cand.amplitude);
       cand.record_seconds = options.recording_seconds;
       cand.gain = Gain(basis, g, c, s2, d_optimal);
       cand.gain_per_second = cand.gain / (cand.settle_seconds + cand.record_seconds);

@@ -18,13 +18,16 @@
 //
 // Test time of a candidate (seconds): settle + record, with
 //
-//   settle = (k + ln(1 + d)) / mu1,   d = |a_new - a_now| / a_new,
+//   settle = (k + ln(1 + d)) / lambda,   d = |a_new - a_now| / a_new,
+//   lambda = mu1 + (2/pi) mu2 a_new,
 //
-// 1/mu1 the time constant of the linear decay (u'' + 2 mu1 u' + ...: free
-// vibration decays as exp(-mu1 t)), k the time constants a unit relative step
-// needs, and ln(1 + d) the extra ones a transient that starts d times the new
-// amplitude away needs to fall to the same e^-k share (a step onto the other
-// branch, d ~ 10, adds 2.4 time constants).
+// lambda the decay rate of a disturbance of the new steady state: half the
+// slow flow's trace nu (2 k1 + 3 k2 a) at a = a_new (docs/model.md, "Stability
+// and folds"), which is mu1, the linear decay (free vibration decays as
+// exp(-mu1 t)), where the amplitude is small. k is the time constants a unit
+// relative step needs, and ln(1 + d) the extra ones a transient that starts d
+// times the new amplitude away needs to fall to the same e^-k share (a step
+// onto the other branch, d ~ 10, adds 2.4 time constants).
 //
 // Landing branch: at (Omega, a_b) with two stable roots (the hysteresis
 // range) a dwell stays on the branch it comes from when that branch still

@@ -52,9 +52,16 @@ double SmallestStep(std::vector<double> values) {
   return std::isfinite(step) ? step : 0.0;
 }
 
+// "value +/- half-width%", or the half-width itself for a value of 0.
 std::string Interval(double value, double half) {
-  return StringPrintf("%.5g +/- %.3g%%", value,
-                      value != 0.0 ? 100.0 * half / std::abs(value) : 0.0);
+  if (value == 0.0) return StringPrintf("%.5g +/- %.3g", value, half);
+  return StringPrintf("%.5g +/- %.3g%%", value, 100.0 * half / std::abs(value));
+}
+
+// The half-width after a dwell, as Interval gives it.
+std::string HalfWidth(double value, double half) {
+  if (value == 0.0) return StringPrintf("%.3g", half);
+  return StringPrintf("%.3g%%", 100.0 * half / std::abs(value));
 }
 
 }  // namespace
@@ -213,9 +220,8 @@ void PrintRecommendation(const Recommendation& rec, int top, std::ostream& out) 
     out << StringPrintf("  %-22s %-26s", row.name.c_str(),
                         Interval(row.value, q * std::sqrt(c.dot(basis.covariance * c))).c_str());
     for (int i = 0; i < n; ++i) {
-      out << StringPrintf(
-          " #%d %.3g%%", i + 1,
-          100.0 * q * std::sqrt(std::max(c.dot(after[i] * c), 0.0)) / std::abs(row.value));
+      out << " #" << i + 1 << " "
+          << HalfWidth(row.value, q * std::sqrt(std::max(c.dot(after[i] * c), 0.0)));
     }
     out << "\n";
   }
