@@ -39,8 +39,13 @@ void BM_NextDwellRank(benchmark::State& state) {
   const IdentifyConfig config = ThesisConfig();
   const ResolvedRun run = ResolveRun(config);
   const IdentificationResult fit = FitRun(run).best;
-  const DesignBasis basis = DesignBasisFromFit(run.fitted, run.options, fit.parameters,
-                                               config.omega_ref_rad_s.value_or(0.0));
+  DesignBasis basis;
+  std::string why;
+  if (!DesignBasisFromFit(run.fitted, run.options, fit.parameters,
+                          config.omega_ref_rad_s.value_or(0.0), &basis, &why)) {
+    state.SkipWithError(why.c_str());
+    return;
+  }
   const RigLimits limits = LimitsFromSweeps(run.fitted);
   const NextDwellRequest request = Request();
   std::size_t candidates = 0;

@@ -79,20 +79,25 @@ int main(int argc, char** argv) {
     const dwellfit::NextDwellOutcome outcome =
         dwellfit::ComputeNextDwell(config, request, std::cout);
     const dwellfit::FitStatus status = outcome.fit.status;
+    const int exit_status = dwellfit::ExitStatusFor(status, false);
     if (status != dwellfit::FitStatus::kConverged &&
         status != dwellfit::FitStatus::kNoConvergence) {
-      std::cerr << "next_dwell: the fit of the dwells so far ended with status "
-                << dwellfit::FitStatusName(status) << ": " << outcome.fit.message
-                << "; no recommendation\n";
-      return dwellfit::ExitStatusFor(status, false);
+      std::cerr << "next_dwell: status " << dwellfit::FitStatusName(status) << " (exit "
+                << exit_status << "): " << outcome.fit.message << "; no recommendation\n";
+      return exit_status;
     }
     dwellfit::WriteFilesAtomically(FLAGS_output_dir, outcome.files);
     std::cout << "wrote " << FLAGS_output_dir << "/" << dwellfit::kNextDwellCsvName << " ("
               << outcome.recommendation.ranked.size() << " candidates)\n";
     if (outcome.recommendation.ranked.empty()) {
-      std::cerr << "next_dwell: no candidate within the limits has a stable response\n";
+      std::cerr << "next_dwell: no candidate within the limits has a stable response; widen "
+                   "--limits\n";
       return dwellfit::kExitFailure;
     }
-    return 0;
+    if (status == dwellfit::FitStatus::kNoConvergence) {
+      std::cerr << "next_dwell: status no_convergence (exit 3): the fit stopped at its iteration "
+                   "limit, so the ranking is from an estimate that is not a proven minimum\n";
+    }
+    return exit_status;
   });
 }

@@ -143,23 +143,23 @@ RigLimits OverrideLimits(RigLimits limits, const std::string& text, const std::s
   return limits;
 }
 
-DesignBasis DesignBasisFromFit(const std::vector<const Sweep*>& fitted,
-                               const IdentificationOptions& options,
-                               const ParameterVector& estimate, double omega_ref_rad_s) {
+bool DesignBasisFromFit(const std::vector<const Sweep*>& fitted,
+                        const IdentificationOptions& options, const ParameterVector& estimate,
+                        double omega_ref_rad_s, DesignBasis* basis, std::string* why) {
   const ParameterUncertainty u = EstimateUncertainty(fitted, options, estimate, omega_ref_rad_s,
                                                      nullptr, IntervalMethod::kDataOnly);
   if (!u.available) {
-    throw InputError("the fit gives no covariance to design from: " + u.message);
+    *why = "the fit gives no covariance to design from: " + u.message;
+    return false;
   }
-  DesignBasis basis;
-  basis.estimate = estimate;
-  basis.fixed = options.fixed;
-  basis.covariance = u.covariance;
-  basis.noise_sigma = u.noise_sigma;
-  basis.interval_quantile = u.interval_quantile;
-  basis.residual = options.solve.residual;
-  basis.omega_ref_rad_s = u.omega_ref_rad_s;
-  return basis;
+  basis->estimate = estimate;
+  basis->fixed = options.fixed;
+  basis->covariance = u.covariance;
+  basis->noise_sigma = u.noise_sigma;
+  basis->interval_quantile = u.interval_quantile;
+  basis->residual = options.solve.residual;
+  basis->omega_ref_rad_s = u.omega_ref_rad_s;
+  return true;
 }
 
 namespace {
@@ -289,7 +289,11 @@ NextDwellOutcome ComputeNextDwell(const IdentifyConfig& config, const NextDwellR
   }
   const double omega_ref =
       config.omega_ref_rad_s.value_or(outcome.fit.parameters[kNaturalFrequency]);
-  outcome.basis = DesignBasisFromFit(run.fitted, run.options, outcome.fit.parameters, omega_ref);
+  if (!DesignBasisFromFit(run.fitted, run.options, outcome.fit.parameters, omega_ref,
+                          &outcome.basis, &outcome.fit.message)) {
+    outcome.fit.status = FitStatus::kUnidentifiable;
+    return outcome;
+  }
   outcome.recommendation =
       RecommendNextDwell(outcome.basis, request.state, outcome.limits, request.options);
   const Recommendation& rec = outcome.recommendation;

@@ -36,11 +36,12 @@ RigLimits LimitsFromSweeps(const std::vector<const Sweep*>& sweeps);
 RigLimits OverrideLimits(RigLimits limits, const std::string& text, const std::string& flag);
 
 // The basis of a finished fit of `fitted`: its linearised data-only
-// covariance (EstimateUncertainty, IntervalMethod::kDataOnly). Throws
-// InputError when the fit gives no covariance (the message says why).
-DesignBasis DesignBasisFromFit(const std::vector<const Sweep*>& fitted,
-                               const IdentificationOptions& options,
-                               const ParameterVector& estimate, double omega_ref_rad_s);
+// covariance (EstimateUncertainty, IntervalMethod::kDataOnly). False, with
+// the reason in `why`, when the fit gives no covariance (the data cannot tell
+// the free parameters apart).
+bool DesignBasisFromFit(const std::vector<const Sweep*>& fitted,
+                        const IdentificationOptions& options, const ParameterVector& estimate,
+                        double omega_ref_rad_s, DesignBasis* basis, std::string* why);
 
 struct NextDwellRequest {
   RigState state;
@@ -58,8 +59,9 @@ struct NextDwellOutcome {
 };
 
 // Fits the config's sweeps, ranks the next dwells and prints the top ones to
-// `out`. Throws InputError on bad input; a fit that did not converge is
-// returned with its status and no candidates.
+// `out`. Throws InputError on bad input. A fit that failed is returned with
+// its status and no candidates; one without a covariance likewise, with
+// status kUnidentifiable and the reason as its message.
 NextDwellOutcome ComputeNextDwell(const IdentifyConfig& config, const NextDwellRequest& request,
                                   std::ostream& out);
 
