@@ -234,6 +234,66 @@ TEST(RecommendNextDwell, QuantityGainIsTheVarianceDropOfTheUpdatedInformation) {
   EXPECT_NEAR(rec.quantity, 9e8 - (2.0 / 3.0) * 1e4 * std::pow(kTwoPi * 41.5, 2), 1.0);
 }
 
+// The backbone omega(a) = sqrt((4 w^2 + 3 alpha a^2) / (4 + 2 delta a^2))
+// (docs/model.md) and the jump-down frequency of a frequency sweep at level
+// 0.01, whose gradient follows from the implicit function theorem on the
+// fold: G(a*; Omega*) = a_b^2 with dG/da = 0 there, so dOmega*/dp =
+// -(dG/dp) / (dG/dOmega) at fixed a*. Both from the hand-written G.
+TEST(QuantityGradient, BackboneAndJumpFrequencyMatchTheirFormulas) {
+  DesignBasis basis;
+  basis.estimate = Truth();
+  basis.fixed = {false, false, false, false, false, true};
+  const auto backbone_hz = [](const ParameterVector& p, double a) {
+    return std::sqrt((4.0 * p[5] * p[5] + 3.0 * p[4] * a * a) / (4.0 + 2.0 * p[3] * a * a)) /
+           kTwoPi;
+  };
+  DesignTarget target;
+  std::string error;
+  ASSERT_TRUE(ParseDesignTarget("omega_at=0.004", &target, &error));
+  double value;
+  ParameterGradient c;
+  ASSERT_TRUE(QuantityGradient(basis, target, &value, &c));
+  EXPECT_NEAR(value, backbone_hz(basis.estimate, 0.004), 1e-9);
+  for (int j = 0; j < 5; ++j) {
+    ParameterVector plus = basis.estimate, minus = basis.estimate;
+    const double h = 1e-4 * std::max(std::abs(plus[j]), 1.0);
+    plus[j] += h;
+    minus[j] -= h;
+    const double expected = (backbone_hz(plus, 0.004) - backbone_hz(minus, 0.004)) / (2.0 * h);
+    EXPECT_NEAR(c(j), expected, 1e-5 * std::abs(expected) + 1e-15) << j;
+  }
+  // The jump-down at level 0.01: the bundled up sweep drops between 42.2 and 42.3 Hz.
+  ASSERT_TRUE(ParseDesignTarget("jump_down_hz=0.01", &target, &error));
+  ASSERT_TRUE(QuantityGradient(basis, target, &value, &c));
+  EXPECT_GT(value, 42.2);
+  EXPECT_LT(value, 42.3);
+  // a*: the local minimum of G at Omega*, by golden-section search.
+  const ParameterVector& p = basis.estimate;
+  const double omega = kTwoPi * value;
+  double lo = 0.004, hi = 0.006;  // around the measured 0.0047 before the jump
+  for (int k = 0; k < 200; ++k) {
+    const double m1 = hi - 0.618 * (hi - lo), m2 = lo + 0.618 * (hi - lo);
+    if (HandG(p, omega, m1) < HandG(p, omega, m2)) {
+      hi = m2;
+    } else {
+      lo = m1;
+    }
+  }
+  const double a_star = 0.5 * (lo + hi);
+  EXPECT_NEAR(HandG(p, omega, a_star), 1e-4, 1e-8);  // on the level
+  const double dw = 1e-6 * omega;
+  const double dg_domega = (HandG(p, omega + dw, a_star) - HandG(p, omega - dw, a_star)) / (2 * dw);
+  for (int j = 0; j < 5; ++j) {
+    ParameterVector plus = p, minus = p;
+    const double h = 1e-6 * p[j];
+    plus[j] += h;
+    minus[j] -= h;
+    const double dg_dp = (HandG(plus, omega, a_star) - HandG(minus, omega, a_star)) / (2.0 * h);
+    const double expected = -dg_dp / dg_domega / kTwoPi;  // Hz per unit of p_j
+    EXPECT_NEAR(c(j), expected, 1e-3 * std::abs(expected)) << j;
+  }
+}
+
 TEST(DesignTarget, NamesRoundTripAndBadNamesAreRefused) {
   for (const char* name :
        {"d_optimal", "mu2", "alpha_e", "omega_at=0.003", "jump_down_hz=0.01", "jump_up_hz=0.02"}) {
