@@ -40,14 +40,17 @@ double Number(const std::string& text, const std::string& flag, const std::strin
   return value;
 }
 
-// The smallest spacing > 0 (relative 1e-9 of the span) of sorted `values`.
-double SmallestStep(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const double span = values.back() - values.front();
+// The smallest step of the stepped control between consecutive dwells of
+// the sweeps of `kind` (frequency [Hz] or level); 0 when there is none.
+double SmallestStep(const std::vector<const Sweep*>& sweeps, SweepKind kind) {
   double step = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 1; i < values.size(); ++i) {
-    const double d = values[i] - values[i - 1];
-    if (d > 1e-9 * span) step = std::min(step, d);
+  for (const Sweep* sweep : sweeps) {
+    if (sweep->kind != kind) continue;
+    for (std::size_t i = 1; i < sweep->points.size(); ++i) {
+      double d = std::abs(sweep->Control(sweep->points[i]) - sweep->Control(sweep->points[i - 1]));
+      if (kind == SweepKind::kFrequency) d = RadPerSecondToHz(d);
+      if (d > 0.0) step = std::min(step, d);
+    }
   }
   return std::isfinite(step) ? step : 0.0;
 }
@@ -107,11 +110,12 @@ RigLimits LimitsFromSweeps(const std::vector<const Sweep*>& sweeps) {
   limits.frequency_max_hz = *std::max_element(fs.begin(), fs.end());
   limits.level_min = *std::min_element(ls.begin(), ls.end());
   limits.level_max = *std::max_element(ls.begin(), ls.end());
-  limits.frequency_step_min_hz = SmallestStep(fs);
-  limits.level_step_min = SmallestStep(ls);
+  limits.frequency_step_min_hz = SmallestStep(sweeps, SweepKind::kFrequency);
+  limits.level_step_min = SmallestStep(sweeps, SweepKind::kAmplitude);
   limits.frequency_step_max_hz = limits.frequency_max_hz - limits.frequency_min_hz;
   limits.level_step_max = limits.level_max - limits.level_min;
-  // One level (or one frequency) in the data: a step of a tenth of the value.
+  // No sweep of that kind: a tenth of the smallest level, a hundredth of the
+  // lowest frequency.
   if (limits.level_step_min == 0.0) limits.level_step_min = 0.1 * limits.level_min;
   if (limits.frequency_step_min_hz == 0.0)
     limits.frequency_step_min_hz = 0.01 * limits.frequency_min_hz;

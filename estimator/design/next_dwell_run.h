@@ -26,8 +26,10 @@ inline constexpr char kNextDwellFigureStem[] = "figure_next_dwell";
 RigState ParseRigState(const std::string& text, const std::string& flag);
 
 // The sweeps' own span: frequencies and levels from their smallest to
-// largest, the smallest steps their smallest nonzero spacing, the largest
-// steps the whole span.
+// largest, the whole span as the largest step, and as the smallest the
+// smallest step between consecutive dwells of the frequency sweeps (of the
+// amplitude sweeps for the level; a tenth of the smallest level, a hundredth
+// of the lowest frequency, without such sweeps).
 RigLimits LimitsFromSweeps(const std::vector<const Sweep*>& sweeps);
 
 // `limits` with the keys of "f_min_hz=38,f_max_hz=46,f_step_min_hz=0.1,
