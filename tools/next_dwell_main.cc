@@ -33,6 +33,9 @@ DEFINE_double(recording_seconds, 2.0, "recording time of one dwell [s]");
 DEFINE_double(noise_sigma, 0.0,
               "noise of a new dwell in the residual's unit (0: the fit's own residual noise)");
 DEFINE_int32(top, 5, "candidates printed with their expected intervals");
+DEFINE_int32(segment_dwells, 1,
+             "n >= 2: also rank segments of n dwells stepping along one axis, up or down "
+             "(1: single dwells only; at most 20)");
 DEFINE_string(set, "", "config overrides, as identify's --set");
 DEFINE_string(output_dir, ".", "folder for next_dwell.csv, next_dwell.gp and the figure");
 DEFINE_bool(figures, true, "render the figure with gnuplot");
@@ -52,6 +55,7 @@ dwellfit::NextDwellRequest RequestFromFlags() {
   request.options.recording_seconds = FLAGS_recording_seconds;
   request.options.noise_sigma = FLAGS_noise_sigma;
   request.options.top = FLAGS_top;
+  request.options.segment_dwells = FLAGS_segment_dwells;
   if (!request.options.IsValid(&error)) throw InputError("next_dwell flags", 0, "", error);
   request.render_figures = FLAGS_figures;
   return request;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 
+#include "Eigen/Dense"
 #include "ceres/cost_function.h"
 #include "dwellfit/estimator/analysis/modal_properties.h"
 #include "dwellfit/estimator/common/input_error.h"
@@ -56,14 +57,63 @@ double SettleSeconds(const ParameterVector& p, double k, double a_now, double a_
   return (k + std::log1p(d)) / rate_per_s;
 }
 
-// The gain of the dwell whose row is g: see the header.
-double Gain(const DesignBasis& basis, const ParameterGradient& g, const ParameterGradient& c,
+// The gain of the dwells whose rows are G: see the header.
+double Gain(const DesignBasis& basis, const CandidateRows& rows, const ParameterGradient& c,
             double s2, bool d_optimal) {
-  const ParameterGradient u = basis.covariance * g;
-  const double gcg = g.dot(u);
-  if (d_optimal) return std::log1p(gcg / s2);
-  const double cu = c.dot(u);
-  return cu * cu / (s2 + gcg);
+  const CandidateRows u = rows * basis.covariance;  // G C (C symmetric)
+  const Eigen::MatrixXd gcg = u * rows.transpose();
+  const int n = static_cast<int>(rows.rows());
+  if (d_optimal) {
+    const Eigen::MatrixXd a = Eigen::MatrixXd::Identity(n, n) + gcg / s2;
+    return Eigen::LDLT<Eigen::MatrixXd>(a).vectorD().array().log().sum();
+  }
+  const Eigen::VectorXd w = u * c;
+  const Eigen::MatrixXd m = s2 * Eigen::MatrixXd::Identity(n, n) + gcg;
+  return w.dot(Eigen::LDLT<Eigen::MatrixXd>(m).solve(w));
+}
+
+// Single dwells at every grid point but the present one, then (with
+// segment_dwells n >= 2) the segments of n dwells stepping along one axis by
+// +/- m smallest steps, their last dwell within the range and the largest step.
+std::vector<Candidate> CandidateShapes(const RigState& state, const RigLimits& limits,
+                                       const DesignOptions& options) {
+  const std::vector<double> fs =
+      AxisGrid(state.frequency_hz, limits.frequency_step_min_hz, limits.frequency_step_max_hz,
+               limits.frequency_min_hz, limits.frequency_max_hz);
+  const std::vector<double> ls = AxisGrid(state.level, limits.level_step_min, limits.level_step_max,
+                                          limits.level_min, limits.level_max);
+  if (static_cast<double>(fs.size()) * ls.size() > options.max_candidates) {
+    throw InputError(
+        StringPrintf("the limits' grid holds %zu candidates, more than %d; give "
+                     "larger smallest steps or smaller largest steps",
+                     fs.size() * ls.size(), options.max_candidates));
+  }
+  std::vector<Candidate> shapes;
+  for (double f : fs) {
+    for (double level : ls) {
+      if (f != state.frequency_hz || level != state.level) shapes.push_back({f, level});
+    }
+  }
+  const int n = options.segment_dwells;
+  for (int axis = 0; n >= 2 && axis < 2; ++axis) {
+    const bool frequency = axis == 0;
+    const double smallest = frequency ? limits.frequency_step_min_hz : limits.level_step_min;
+    const double largest = frequency ? limits.frequency_step_max_hz : limits.level_step_max;
+    const double now = frequency ? state.frequency_hz : state.level;
+    const double low = frequency ? limits.frequency_min_hz : limits.level_min;
+    const double high = frequency ? limits.frequency_max_hz : limits.level_max;
+    for (int m = 1; n * m * smallest <= largest * (1.0 + 1e-9); ++m) {
+      for (const double step : {m * smallest, -m * smallest}) {
+        const double last = now + n * step;
+        if (last < low * (1.0 - 1e-12) || last > high * (1.0 + 1e-12)) continue;
+        Candidate c{state.frequency_hz, state.level, n};
+        (frequency ? c.frequency_step_hz : c.level_step) = step;
+        (frequency ? c.frequency_hz : c.level) += step;
+        shapes.push_back(c);
+      }
+    }
+  }
+  return shapes;
 }
 
 }  // namespace
@@ -162,6 +212,8 @@ bool DesignOptions::IsValid(std::string* error) const {
     *error = "noise_sigma must be a number >= 0 (0: the fit's own)";
   } else if (top < 1 || max_candidates < 1) {
     *error = "top and max_candidates must be at least 1";
+  } else if (segment_dwells < 1 || segment_dwells > 20) {
+    *error = "segment_dwells must lie in [1, 20]";
   } else {
     return true;
   }
@@ -230,10 +282,43 @@ bool QuantityGradient(const DesignBasis& basis, const DesignTarget& target, doub
   return c->allFinite();
 }
 
-ParameterMatrix CovarianceAfter(const ParameterMatrix& covariance, const ParameterGradient& g,
+bool WalkCandidate(const DesignBasis& basis, Branch from, double a_now,
+                   const DesignOptions& options, Candidate* candidate, CandidateRows* rows) {
+  rows->resize(candidate->dwells, kNumParameters);
+  candidate->settle_seconds = 0.0;
+  for (int k = 0; k < candidate->dwells; ++k) {
+    const double f = candidate->frequency_hz + k * candidate->frequency_step_hz;
+    const double level = candidate->level + k * candidate->level_step;
+    Branch branch;
+    double a;
+    bool jumps;
+    ParameterGradient g;
+    if (!LandingPoint(basis.estimate, from, a_now, f, level, &branch, &a, &jumps) ||
+        !ResidualGradient(basis, f, level, branch, a, &g)) {
+      return false;
+    }
+    if (k == 0) {
+      candidate->branch = branch;
+      candidate->amplitude = a;
+      candidate->jumps = jumps;
+    }
+    rows->row(k) = g.transpose();
+    candidate->settle_seconds +=
+        SettleSeconds(basis.estimate, options.settle_time_constants, a_now, a);
+    from = branch;  // kOnly: the next dwell lands on the stable root nearer a
+    a_now = a;
+  }
+  candidate->record_seconds = candidate->dwells * options.recording_seconds;
+  return true;
+}
+
+ParameterMatrix CovarianceAfter(const ParameterMatrix& covariance, const CandidateRows& rows,
                                 double noise_sigma) {
-  const ParameterGradient u = covariance * g;
-  return covariance - u * u.transpose() / (noise_sigma * noise_sigma + g.dot(u));
+  const CandidateRows u = rows * covariance;
+  const int n = static_cast<int>(rows.rows());
+  const Eigen::MatrixXd m =
+      noise_sigma * noise_sigma * Eigen::MatrixXd::Identity(n, n) + u * rows.transpose();
+  return covariance - u.transpose() * Eigen::LDLT<Eigen::MatrixXd>(m).solve(u);
 }
 
 Recommendation RecommendNextDwell(const DesignBasis& given, const RigState& state,
@@ -261,6 +346,7 @@ Recommendation RecommendNextDwell(const DesignBasis& given, const RigState& stat
   out.quantity_variance = c.dot(basis.covariance * c);
   const StableRoot now = ModelAmplitude(basis.estimate, HzToRadPerSecond(state.frequency_hz),
                                         state.level, state.branch, 0.0);
+  out.state = state;
   out.present_amplitude = now.a;
   if (now.status == RootStatus::kFailed) {
     throw InputError(
@@ -272,38 +358,15 @@ Recommendation RecommendNextDwell(const DesignBasis& given, const RigState& stat
         "the estimate has no damping (mu1 = mu2 = 0), so no settling time: fit "
         "more dwells, or fix mu1 at a value from a decay test");
   }
-  const std::vector<double> fs =
-      AxisGrid(state.frequency_hz, limits.frequency_step_min_hz, limits.frequency_step_max_hz,
-               limits.frequency_min_hz, limits.frequency_max_hz);
-  const std::vector<double> ls = AxisGrid(state.level, limits.level_step_min, limits.level_step_max,
-                                          limits.level_min, limits.level_max);
-  if (static_cast<double>(fs.size()) * ls.size() > options.max_candidates) {
-    throw InputError(
-        StringPrintf("the limits' grid holds %zu candidates, more than %d; give "
-                     "larger smallest steps or smaller largest steps",
-                     fs.size() * ls.size(), options.max_candidates));
-  }
   const double s2 = basis.noise_sigma * basis.noise_sigma;
   const bool d_optimal = options.target.kind == TargetKind::kDOptimal;
-  for (double f : fs) {
-    for (double level : ls) {
-      if (f == state.frequency_hz && level == state.level) continue;  // not a step
-      Candidate cand;
-      cand.frequency_hz = f;
-      cand.level = level;
-      ParameterGradient g;
-      if (!LandingPoint(basis.estimate, state.branch, now.a, f, level, &cand.branch,
-                        &cand.amplitude, &cand.jumps) ||
-          !ResidualGradient(basis, f, level, cand.branch, cand.amplitude, &g)) {
-        continue;
-      }
-      cand.settle_seconds =
-          SettleSeconds(basis.estimate, options.settle_time_constants, now.a, cand.amplitude);
-      cand.record_seconds = options.recording_seconds;
-      cand.gain = Gain(basis, g, c, s2, d_optimal);
-      cand.gain_per_second = cand.gain / (cand.settle_seconds + cand.record_seconds);
-      out.ranked.push_back(cand);
-    }
+  CandidateRows rows;
+  for (Candidate candidate : CandidateShapes(state, limits, options)) {
+    if (!WalkCandidate(basis, state.branch, now.a, options, &candidate, &rows)) continue;
+    candidate.gain = Gain(basis, rows, c, s2, d_optimal);
+    candidate.gain_per_second =
+        candidate.gain / (candidate.settle_seconds + candidate.record_seconds);
+    out.ranked.push_back(candidate);
   }
   std::stable_sort(
       out.ranked.begin(), out.ranked.end(),

@@ -16,6 +16,12 @@
 //                   C' = C - u u^T / (s^2 + g^T u)              [Sherman-Morrison]
 //                   c = dq/dtheta at theta
 //
+// A segment of n dwells (a short stepped sweep in one direction) adds the
+// rows G (n x k) at once; with M = s^2 I_n + G C G^T the same formulas read
+// gain = log det(I_n + G C G^T / s^2) and gain = (G C c)^T M^-1 (G C c)
+// [Woodbury], C' = C - (G C)^T M^-1 (G C); its test time is the sum of its
+// dwells', each settling from the one before.
+//
 // Test time of a candidate (seconds): settle + record, with
 //
 //   settle = (k + ln(1 + d)) / lambda,   d = |a_new - a_now| / a_new,
@@ -101,7 +107,10 @@ struct DesignOptions {
   // s of a new dwell in the residual's unit; 0: the fit's own s. A fit whose
   // dwells were divided by their point sigmas (s = 1) needs it given.
   double noise_sigma = 0.0;
-  int top = 5;                   // candidates printed with their intervals
+  int top = 5;  // candidates printed with their intervals
+  // n >= 2: also rank segments of n dwells stepping along one axis, up or
+  // down, by a multiple of its smallest step (1: single dwells only; <= 20).
+  int segment_dwells = 1;
   int max_candidates = 1000000;  // the grid may hold at most this many
   bool IsValid(std::string* error) const;
 };
@@ -118,15 +127,24 @@ struct DesignBasis {
   double omega_ref_rad_s = 0.0;     // Omega_ref of alpha_e
 };
 
+// A single dwell, or a segment of `dwells` dwells: the first at
+// (frequency_hz, level), each next one step further. The branch, jump and
+// amplitude are the first dwell's; the times and the gain the whole
+// segment's.
 struct Candidate {
   double frequency_hz = 0.0, level = 0.0;
-  Branch branch = Branch::kOnly;  // the branch it lands on
-  bool jumps = false;             // leaves the present branch for the other
-  double amplitude = 0.0;         // predicted a at the estimate
+  int dwells = 1;
+  double frequency_step_hz = 0.0, level_step = 0.0;  // between a segment's dwells
+  Branch branch = Branch::kOnly;                     // the branch the first dwell lands on
+  bool jumps = false;                                // it leaves the present branch for the other
+  double amplitude = 0.0;                            // its predicted a at the estimate
   double settle_seconds = 0.0, record_seconds = 0.0;
   double gain = 0.0;  // nats (D-optimal) or the variance reduction in q's unit^2
   double gain_per_second = 0.0;
 };
+
+// The rows g of a candidate's dwells, one per dwell.
+using CandidateRows = Eigen::Matrix<double, Eigen::Dynamic, kNumParameters>;
 
 struct Recommendation {
   // The basis used: the given one, its covariance rescaled by
@@ -136,7 +154,8 @@ struct Recommendation {
   DesignTarget target;
   double quantity = 0.0;           // q at the estimate (not for kDOptimal)
   double quantity_variance = 0.0;  // c^T C c now
-  double present_amplitude = 0.0;  // the model's amplitude at the present state
+  RigState state;                  // the present state
+  double present_amplitude = 0.0;  // the model's amplitude there
 };
 
 // The model's amplitude and branch after a step from the branch `from` at
@@ -156,8 +175,15 @@ bool ResidualGradient(const DesignBasis& basis, double frequency_hz, double leve
 bool QuantityGradient(const DesignBasis& basis, const DesignTarget& target, double* value,
                       ParameterGradient* c);
 
-// The covariance after adding the dwell whose row is g (Sherman-Morrison).
-ParameterMatrix CovarianceAfter(const ParameterMatrix& covariance, const ParameterGradient& g,
+// Walks a candidate's dwells from the present branch and amplitude: sets
+// its branch, jump, amplitude and settling and recording times (`options`'
+// cost model) and returns its rows. False where a dwell has no stable root or
+// its row is undefined.
+bool WalkCandidate(const DesignBasis& basis, Branch from, double a_now,
+                   const DesignOptions& options, Candidate* candidate, CandidateRows* rows);
+
+// The covariance after adding the dwells whose rows are G (Woodbury).
+ParameterMatrix CovarianceAfter(const ParameterMatrix& covariance, const CandidateRows& rows,
                                 double noise_sigma);
 
 // Ranks every candidate of the limits' grid from `state`. Options and limits

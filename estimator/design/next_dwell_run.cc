@@ -201,20 +201,30 @@ std::vector<IntervalRow> IntervalRows(const Recommendation& rec) {
 
 }  // namespace
 
+// "-" for a single dwell, else "4 x +0.1 Hz" or "4 x -0.001".
+std::string SegmentText(const Candidate& c) {
+  if (c.dwells == 1) return "-";
+  if (c.frequency_step_hz != 0.0)
+    return StringPrintf("%d x %+.4g Hz", c.dwells, c.frequency_step_hz);
+  return StringPrintf("%d x %+.4g", c.dwells, c.level_step);
+}
+
 void PrintRecommendation(const Recommendation& rec, int top, std::ostream& out) {
   const DesignBasis& basis = rec.basis;
   const int n = std::min<int>(top, rec.ranked.size());
-  out << StringPrintf("%-4s %9s %10s %6s %4s %11s %9s %8s %11s %11s\n", "rank", "f_hz", "level",
-                      "branch", "jump", "a", "settle_s", "record_s", "gain", "gain_per_s");
+  out << StringPrintf("%-4s %9s %10s %6s %4s %11s %14s %9s %8s %11s %11s\n", "rank", "f_hz",
+                      "level", "branch", "jump", "a", "segment", "settle_s", "record_s", "gain",
+                      "gain_per_s");
   std::vector<ParameterMatrix> after;
   for (int i = 0; i < n; ++i) {
-    const Candidate& c = rec.ranked[i];
-    out << StringPrintf("%-4d %9.4f %10.5g %6s %4s %11.5g %9.3g %8.3g %11.4g %11.4g\n", i + 1,
+    Candidate c = rec.ranked[i];
+    out << StringPrintf("%-4d %9.4f %10.5g %6s %4s %11.5g %14s %9.3g %8.3g %11.4g %11.4g\n", i + 1,
                         c.frequency_hz, c.level, BranchName(c.branch), c.jumps ? "yes" : "no",
-                        c.amplitude, c.settle_seconds, c.record_seconds, c.gain, c.gain_per_second);
-    ParameterGradient g;
-    ResidualGradient(basis, c.frequency_hz, c.level, c.branch, c.amplitude, &g);
-    after.push_back(CovarianceAfter(basis.covariance, g, basis.noise_sigma));
+                        c.amplitude, SegmentText(c).c_str(), c.settle_seconds, c.record_seconds,
+                        c.gain, c.gain_per_second);
+    CandidateRows rows;
+    WalkCandidate(basis, rec.state.branch, rec.present_amplitude, DesignOptions(), &c, &rows);
+    after.push_back(CovarianceAfter(basis.covariance, rows, basis.noise_sigma));
   }
   out << "\nexpected 95 % intervals: estimate +/- half-width in % now, then the half-width\n"
          "after the candidate of each rank alone:\n";
@@ -232,12 +242,15 @@ void PrintRecommendation(const Recommendation& rec, int top, std::ostream& out) 
 }
 
 std::string NextDwellCsv(const Recommendation& rec) {
-  std::string csv = "rank,f_hz,level,branch,jumps,amplitude,settle_s,record_s,gain,gain_per_s\n";
+  std::string csv =
+      "rank,f_hz,level,branch,jumps,amplitude,settle_s,record_s,gain,gain_per_s,dwells,"
+      "f_step_hz,level_step\n";
   for (std::size_t i = 0; i < rec.ranked.size(); ++i) {
     const Candidate& c = rec.ranked[i];
-    csv += StringPrintf("%zu,%.10g,%.10g,%s,%d,%.10g,%.6g,%.6g,%.10g,%.10g\n", i + 1,
+    csv += StringPrintf("%zu,%.10g,%.10g,%s,%d,%.10g,%.6g,%.6g,%.10g,%.10g,%d,%.10g,%.10g\n", i + 1,
                         c.frequency_hz, c.level, BranchName(c.branch), c.jumps ? 1 : 0, c.amplitude,
-                        c.settle_seconds, c.record_seconds, c.gain, c.gain_per_second);
+                        c.settle_seconds, c.record_seconds, c.gain, c.gain_per_second, c.dwells,
+                        c.frequency_step_hz, c.level_step);
   }
   return csv;
 }
@@ -262,8 +275,8 @@ std::string NextDwellGnuplot(const RigState& state, const Recommendation& rec) {
       "set cblabel \"gain per second of test time\"\nset grid\nset key outside bottom\n"
       "set palette rgb 33,13,10\n";
   gp +=
-      "plot \"next_dwell.csv\" skip 1 using 2:3:10 with points pointtype 5 pointsize 0.8 "
-      "palette title \"candidates\"";
+      "plot \"next_dwell.csv\" skip 1 using 2:3:($11 == 1 ? $10 : 1/0) with points pointtype 5 "
+      "pointsize 0.8 palette title \"single dwells\"";
   gp += StringPrintf(
       ", \\\n  \"+\" using (%.10g):(%.10g) every ::0::0 with points pointtype 6 "
       "pointsize 3 lc rgb \"black\" title \"present\"",

@@ -148,8 +148,9 @@ TEST(RecommendNextDwell, OnlyEtaFreeMatchesTheAnalyticGainAndRanking) {
 
 // Five parameters free, the relative error: the Fisher information of a
 // small grid of dwells by central differences of ln a, inverted here, and
-// each candidate's D-optimal gain log(1 + g^T I^-1 g / s^2) from the same
-// differences: the ranking agrees.
+// each candidate's D-optimal gain log det(1 + G I^-1 G^T / s^2) from the same
+// differences (G one row g for a single dwell, three for a segment of three):
+// the gains, test times and ranking agree.
 TEST(RecommendNextDwell, FiniteDifferenceFisherInformationGivesTheSameRanking) {
   const ParameterVector p = Truth();
   const double s = 0.01;
@@ -190,16 +191,45 @@ TEST(RecommendNextDwell, FiniteDifferenceFisherInformationGivesTheSameRanking) {
   RigLimits limits = Limits();
   limits.frequency_step_min_hz = 1.0;
   limits.level_step_min = 0.012;
-  const Recommendation rec = RecommendNextDwell(basis, Upper(), limits, DesignOptions());
+  DesignOptions options;
+  options.segment_dwells = 3;
+  const Recommendation rec = RecommendNextDwell(basis, Upper(), limits, options);
   ASSERT_GT(rec.ranked.size(), 20u);
   std::vector<double> independent;
-  const double a_now = HandAmplitude(p, 41.5, 0.01, Branch::kUpper);
+  int segments = 0;
   for (const Candidate& c : rec.ranked) {
-    const auto g = row(c.frequency_hz, c.level, c.branch);
-    const double gain = std::log1p(g.dot(covariance * g) / (s * s));
-    EXPECT_NEAR(c.gain, gain, 1e-3 * gain + 1e-9) << c.frequency_hz << " Hz, " << c.level;
-    independent.push_back(gain / (Settle(p, a_now, c.amplitude) + 2.0));
+    // Walk the candidate's dwells by the landing rule, written out here: with
+    // three roots the branch it comes from (from `only`, the root nearer the
+    // last amplitude), with one root `only`.
+    Branch from = Branch::kUpper;
+    double a_prev = HandAmplitude(p, 41.5, 0.01, Branch::kUpper), seconds = 0.0;
+    Eigen::MatrixXd rows(c.dwells, 5);
+    for (int k = 0; k < c.dwells; ++k) {
+      const double f = c.frequency_hz + k * c.frequency_step_hz;
+      const double level = c.level + k * c.level_step;
+      const std::vector<double> roots = HandRoots(p, kTwoPi * f, level);
+      Branch on = Branch::kOnly;
+      if (roots.size() == 3 && from != Branch::kOnly) on = from;
+      if (roots.size() == 3 && from == Branch::kOnly) {
+        on = std::abs(roots.front() - a_prev) <= std::abs(roots.back() - a_prev) ? Branch::kLower
+                                                                                 : Branch::kUpper;
+      }
+      const double a = HandAmplitude(p, f, level, on);
+      rows.row(k) = row(f, level, on).transpose();
+      seconds += Settle(p, a_prev, a) + 2.0;
+      from = on;
+      a_prev = a;
+    }
+    segments += c.dwells == 3;
+    const Eigen::MatrixXd gcg = rows * covariance * rows.transpose() / (s * s);
+    const double gain =
+        std::log((Eigen::MatrixXd::Identity(c.dwells, c.dwells) + gcg).determinant());
+    EXPECT_NEAR(c.gain, gain, 1e-3 * gain + 1e-9)
+        << c.frequency_hz << " Hz, " << c.level << ", " << c.dwells << " dwells";
+    EXPECT_NEAR(c.settle_seconds + c.record_seconds, seconds, 1e-6 * seconds);
+    independent.push_back(gain / seconds);
   }
+  EXPECT_EQ(segments, 3);  // 3 x +/-1 Hz and 3 x +0.012; the others leave the limits
   for (std::size_t i = 1; i < independent.size(); ++i) {
     EXPECT_GE(independent[i - 1], independent[i] * (1.0 - 1e-3)) << "rank " << i;
   }
