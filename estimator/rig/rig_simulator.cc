@@ -56,19 +56,13 @@ struct RigEquation {
   }
 };
 
-struct PhysicalState {
-  double u = 0.0, v = 0.0, y_base = 0.0, y_response = 0.0;
-  double phase = 0.0;      // the drive's phase now
-  double amplitude = 0.0;  // last first-harmonic amplitude
-};
-
 using Stepper = odeint::controlled_runge_kutta<odeint::runge_kutta_dopri5<State>>;
 
 // One dwell: settle, then record. Updates `state`.
 class DwellRun {
  public:
   DwellRun(const ParameterVector& p, const RigOptions& options, const StrainGauge& gauge,
-           double omega, double a_base, PhysicalState* state)
+           double omega, double a_base, RigMotion* state)
       : options_(options), state_(state), period_(kTwoPi / omega) {
     const double w = p[kNaturalFrequency];
     const double linear =
@@ -98,7 +92,7 @@ class DwellRun {
   }
 
   const RigOptions& options_;
-  PhysicalState* state_;
+  RigMotion* state_;
   double period_;
   double t_ = 0.0;
   RigEquation equation_;
@@ -192,11 +186,24 @@ void AddNoise(const RigOptions& options, const StrainGauge& gauge, double a_base
   for (float& y : trace->response) y += static_cast<float>(volt_amplitude * normal(*random));
 }
 
+constexpr double kMinSamplesPerPeriod = 8.0;  // 3 harmonics and their mirrors
+
+// Throws InputError when the sample rate gives fewer than kMinSamplesPerPeriod
+// samples per period at max_hz, `which` drive frequency that is.
+void CheckSampleRate(const RigOptions& options, double max_hz, const char* which) {
+  if (options.sample_rate_hz < kMinSamplesPerPeriod * max_hz) {
+    throw InputError(StringPrintf(
+        "rig: sample_rate_hz %g gives %.3g samples per period at %s, %g Hz; give at least %g "
+        "(sample_rate_hz >= %g)",
+        options.sample_rate_hz, options.sample_rate_hz / max_hz, which, max_hz,
+        kMinSamplesPerPeriod, kMinSamplesPerPeriod * max_hz));
+  }
+}
+
 // Throws InputError unless every dwell's record has enough samples per drive
 // period for the processing's harmonics (kMinSamplesPerPeriod) and all the
 // records fit in kMaxTraceBytes.
 void CheckSampling(const DwellPlan& plan, const RigOptions& options) {
-  constexpr double kMinSamplesPerPeriod = 8.0;  // 3 harmonics and their mirrors
   constexpr double kMaxTraceBytes = 4.0 * (1u << 30);
   double max_hz = 0.0;
   double samples = 0.0;  // both channels, every dwell
@@ -209,13 +216,7 @@ void CheckSampling(const DwellPlan& plan, const RigOptions& options) {
       }
     }
   }
-  if (options.sample_rate_hz < kMinSamplesPerPeriod * max_hz) {
-    throw InputError(StringPrintf(
-        "rig: sample_rate_hz %g gives %.3g samples per period at the plan's highest drive "
-        "frequency, %g Hz; give at least %g (sample_rate_hz >= %g)",
-        options.sample_rate_hz, options.sample_rate_hz / max_hz, max_hz, kMinSamplesPerPeriod,
-        kMinSamplesPerPeriod * max_hz));
-  }
+  CheckSampleRate(options, max_hz, "the plan's highest drive frequency");
   if (4.0 * samples > kMaxTraceBytes) {
     throw InputError(StringPrintf(
         "rig: the records would hold %.3g samples (%.3g GiB as float32), more than 4 GiB; give "
@@ -285,34 +286,52 @@ bool RigOptions::IsValid(std::string* error) const {
   return true;
 }
 
+VirtualRig::VirtualRig(const ParameterVector& truth, const RigOptions& options)
+    : truth_(truth), options_(options), gauge_(options.gauge), random_(options.noise_seed) {
+  std::string error;
+  if (!options.IsValid(&error)) throw InputError("rig: " + error);
+}
+
+RigDwell VirtualRig::Dwell(double f_hz, double a_base, const std::string& sweep_id,
+                           SweepDirection direction) {
+  CheckSampleRate(options_, f_hz, "the dwell's drive frequency");
+  const double omega = HzToRadPerSecond(f_hz);
+  RigDwell out;
+  DwellRun dwell(truth_, options_, gauge_, omega, a_base, &motion_);
+  out.truth = dwell.Settle();
+  out.trace =
+      DwellTrace{sweep_id, direction, SweepKind::kFrequency, omega, options_.sample_rate_hz};
+  dwell.Record(&out.trace);
+  AddNoise(options_, gauge_, a_base, out.truth, f_hz, &random_, &out.trace);
+  CheckRecorded(out.trace);
+  out.settle_seconds = out.truth.settle_periods / f_hz;
+  out.record_seconds = options_.record_periods / f_hz;
+  elapsed_seconds_ += out.settle_seconds + out.record_seconds;
+  return out;
+}
+
 RigRun SimulateRig(const DwellPlan& plan, const RigOptions& options, const RigProgress& progress) {
   CheckPlan(plan, options);
-  const StrainGauge gauge(options.gauge);
-  std::mt19937_64 random(options.noise_seed);
+  VirtualRig rig(plan.truth, options);
   int total = 0;
   for (const SweepPlan& sweep : plan.sweeps) {
     total += (sweep.NumSteps() + 1) * static_cast<int>(sweep.directions.size());
   }
   RigRun run;
   for (const SweepPlan& sweep : plan.sweeps) {
-    PhysicalState state;  // every sweep starts from rest
+    rig.Rest();  // every sweep starts from rest
     for (SweepDirection direction : sweep.directions) {
       Sweep truth{sweep.id, direction, sweep.kind};
       for (double control : ControlGrid(sweep, direction)) {
         const bool frequency = sweep.kind == SweepKind::kFrequency;
         const double f_hz = frequency ? control : sweep.held_frequency_hz;
         const double a_base = frequency ? sweep.held_a_base : control;
-        DwellRun dwell(plan.truth, options, gauge, HzToRadPerSecond(f_hz), a_base, &state);
-        const RigDwellTruth dwell_truth = dwell.Settle();
-        DwellTrace trace{sweep.id, direction, sweep.kind, HzToRadPerSecond(f_hz),
-                         options.sample_rate_hz};
-        dwell.Record(&trace);
-        AddNoise(options, gauge, a_base, dwell_truth, f_hz, &random, &trace);
-        CheckRecorded(trace);
+        RigDwell dwell = rig.Dwell(f_hz, a_base, sweep.id, direction);
+        dwell.trace.kind = sweep.kind;
         truth.points.push_back(
-            {HzToRadPerSecond(f_hz), a_base, dwell_truth.amplitude, dwell_truth.lag_rad});
-        run.traces.push_back(std::move(trace));
-        run.dwell_truth.push_back(dwell_truth);
+            {HzToRadPerSecond(f_hz), a_base, dwell.truth.amplitude, dwell.truth.lag_rad});
+        run.traces.push_back(std::move(dwell.trace));
+        run.dwell_truth.push_back(dwell.truth);
         if (progress) progress(static_cast<int>(run.traces.size()), total);
       }
       run.truth.push_back(std::move(truth));

@@ -35,6 +35,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -76,6 +77,53 @@ struct RigRun {
   // response, a_base as set; kind, id, direction as planned.
   std::vector<Sweep> truth;
   std::vector<RigDwellTruth> dwell_truth;  // one per dwell, as traces
+};
+
+// The beam and the channels between dwells: the state the next dwell starts
+// from.
+struct RigMotion {
+  double u = 0.0, v = 0.0;                // displacement [m] and velocity [m/s]
+  double y_base = 0.0, y_response = 0.0;  // the channel filters' outputs
+  double phase = 0.0;                     // the drive's phase now [rad]
+  double amplitude = 0.0;                 // the last dwell's first-harmonic amplitude [m]
+};
+
+// One dwell of a VirtualRig, with the test time it took.
+struct RigDwell {
+  DwellTrace trace;
+  RigDwellTruth truth;
+  double settle_seconds = 0.0;  // settle_periods / f
+  double record_seconds = 0.0;  // record_periods / f
+};
+
+// The rig one dwell at a time, for a loop that chooses each dwell from the
+// ones before (docs/next-dwell.md): every dwell starts from the motion the
+// previous one ended in, with the drive's phase continuous, as the dwells of
+// a sweep in SimulateRig do; Rest() stops the beam. The noise is one stream
+// over all dwells, seeded by the options.
+class VirtualRig {
+ public:
+  // Throws InputError when the options are not valid.
+  VirtualRig(const ParameterVector& truth, const RigOptions& options);
+
+  // Settles and records one dwell at f_hz and base level a_base; the trace
+  // carries `sweep_id` and `direction`. Throws InputError when the sample
+  // rate gives fewer than 8 samples per period at f_hz or the record is not
+  // usable (a channel not finite or constant).
+  RigDwell Dwell(double f_hz, double a_base, const std::string& sweep_id = "dwell",
+                 SweepDirection direction = SweepDirection::kUp);
+  void Rest() { motion_ = RigMotion(); }
+  const RigMotion& motion() const { return motion_; }
+  // Settling and recording time of every dwell so far [s].
+  double elapsed_seconds() const { return elapsed_seconds_; }
+
+ private:
+  ParameterVector truth_;
+  RigOptions options_;
+  StrainGauge gauge_;
+  std::mt19937_64 random_;
+  RigMotion motion_;
+  double elapsed_seconds_ = 0.0;
 };
 
 // Called after every dwell with (dwells done, dwells in all).
