@@ -1,0 +1,48 @@
+// forcing_calibration: held-out errors of a config's validation sweeps with
+// and without the per-sweep forcing calibration (estimator/fit/
+// forcing_calibration.h), as Markdown on stdout or into --output.
+#include <iostream>
+#include <string>
+
+#include "dwellfit/config/identify_config.h"
+#include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/run/output_files.h"
+#include "dwellfit/estimator/studies/forcing_calibration_study.h"
+#include "dwellfit/tools/tool_main.h"
+#include "gflags/gflags.h"
+
+DEFINE_string(config, "", "Identify config whose validation sweeps are predicted");
+DEFINE_double(prior_sigma, 0.05, "Standard deviation of each sweep's forcing scale around 1");
+DEFINE_string(held_out_dwells, "before_jump",
+              "A held-out sweep's dwells its scale is calibrated on: before_jump (up to its first "
+              "jump) or below_half_peak (of those, below half their largest amplitude)");
+DEFINE_string(output, "", "Markdown file to write (empty: stdout)");
+
+int main(int argc, char** argv) {
+  const dwellfit::ToolSpec tool = {
+      "forcing_calibration",
+      "held-out errors with and without per-sweep forcing calibration.\n"
+      "  forcing_calibration --config CFG [--prior_sigma S --held_out_dwells before_jump|"
+      "below_half_peak --output FILE]",
+      __FILE__};
+  return dwellfit::RunTool(argc, argv, tool, [] {
+    if (!FLAGS_output.empty()) dwellfit::CheckOutputFile(FLAGS_output, "--output", {FLAGS_config});
+    dwellfit::ForcingCalibrationOptions calibration;
+    calibration.prior_sigma = FLAGS_prior_sigma;
+    if (!dwellfit::HeldOutDwellsFromName(FLAGS_held_out_dwells, &calibration.held_out_dwells)) {
+      throw dwellfit::InputError(
+          "--held_out_dwells", 0, "",
+          "give before_jump or below_half_peak, got '" + FLAGS_held_out_dwells + "'");
+    }
+    const std::string markdown =
+        dwellfit::ForcingCalibrationMarkdown(dwellfit::CompareForcingCalibration(
+            dwellfit::LoadIdentifyConfig(FLAGS_config), calibration));
+    if (FLAGS_output.empty()) {
+      std::cout << markdown;
+    } else {
+      dwellfit::WriteReportAtomically(FLAGS_output, markdown);
+      std::cout << "wrote " << FLAGS_output << "\n";
+    }
+    return 0;
+  });
+}
