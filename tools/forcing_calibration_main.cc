@@ -12,10 +12,14 @@
 #include "gflags/gflags.h"
 
 DEFINE_string(config, "", "Identify config whose validation sweeps are predicted");
-DEFINE_double(prior_sigma, 0.05, "Standard deviation of each sweep's forcing scale around 1");
-DEFINE_string(held_out_dwells, "before_jump",
-              "A held-out sweep's dwells its scale is calibrated on: before_jump (up to its first "
-              "jump) or below_half_peak (of those, below half their largest amplitude)");
+DEFINE_double(prior_sigma, 0.05,
+              "Standard deviation of each sweep's forcing scale around 1 (overrides the config's "
+              "forcing_calibration.prior_sigma)");
+DEFINE_string(
+    held_out_dwells, "before_jump",
+    "A held-out sweep's dwells its scale is calibrated on: before_jump (up to its first "
+    "jump) or below_half_peak (of those, below half their largest amplitude); overrides the "
+    "config's");
 DEFINE_string(output, "", "Markdown file to write (empty: stdout)");
 
 int main(int argc, char** argv) {
