@@ -480,10 +480,11 @@ void TraceFindings(const Comparison& c, const TraceCase& traces, std::ostream& o
              PercentError(newton.result.parameters[kEtaE], traces.truth[kEtaE]),
              Median(hb_fit.held_out_jump_down_errors), Median(newton.held_out_jump_down_errors))
       << "- **What it needs:** the time traces of both channels (the harmonics of u and of the "
-         "base, not only a and the lag) and dwells at several drive frequencies: at one frequency "
-         "w^2 and eta_e cannot be told apart and `IdentifyHarmonicBalance` refuses the rank-"
-         "deficient columns. It needs no start, no iterations and no jump labels, and w comes "
-         "out with the rest; it enforces no measured jump.\n"
+         "base, not only a and the lag) and dwells at several drive frequencies and levels: at "
+         "one frequency delta and alpha enter the first harmonic only as alpha - (2/3) delta "
+         "Omega^2, and `IdentifyHarmonicBalance` refuses columns that cannot separate the six "
+         "parameters. It needs no start, no iterations and no jump labels, and w comes out with "
+         "the rest; it enforces no measured jump.\n"
       << StringPrintf(
              "- **Its bias with noise:** every column is built from the measured u (u^3, "
              "u u'^2 + u^2 u'', ...), so the noise sits in the regressors as well as in the "
