@@ -15,6 +15,7 @@ namespace dwellfit {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kMissingPercent = 100.0;
 
 // The errors of `sweep`'s jump-down and upper-branch amplitude at `p`.
 HeldOutSweepErrors ErrorsOf(const Sweep& sweep, const ParameterVector& p, double scale,
@@ -22,10 +23,13 @@ HeldOutSweepErrors ErrorsOf(const Sweep& sweep, const ParameterVector& p, double
   HeldOutSweepErrors errors{sweep.Name(), scale, kNaN, kNaN};
   const bool usable = std::isfinite(scale);
   for (const HeldOutPrediction& prediction : PredictHeldOut(sweep, p, usable, nullptr, fixed)) {
+    // Measured but not predicted (no fold, no usable fit): 100 %, as in method_comparison.
+    const double error =
+        std::isfinite(prediction.predicted) ? prediction.ErrorPercent() : kMissingPercent;
     if (prediction.quantity == HeldOutQuantity::kJumpDown) {
-      errors.jump_down_percent = prediction.ErrorPercent();
+      errors.jump_down_percent = error;
     } else if (prediction.quantity == HeldOutQuantity::kUpperBranchAmplitude) {
-      errors.upper_branch_percent = prediction.ErrorPercent();
+      errors.upper_branch_percent = error;
     }
   }
   return errors;
@@ -118,6 +122,11 @@ std::string ForcingCalibrationMarkdown(const ForcingCalibrationComparison& c) {
       "| **median \\|error\\|** | | %.3g | %.3g | %.3g | %.3g |\n\n",
       MedianAbsoluteError(c.errors_without, true), MedianAbsoluteError(c.errors_with, true),
       MedianAbsoluteError(c.errors_without, false), MedianAbsoluteError(c.errors_with, false));
+  if (c.held_out_dwells == HeldOutDwells::kBeforeJump) {
+    out << "With the calibration, an up-sweep's upper-branch dwells are among those its scale is "
+           "calibrated on: their amplitude is fitted there, not predicted (below_half_peak "
+           "keeps it a prediction).\n\n";
+  }
   for (const std::string& note : c.notes) out << "- " << note << "\n";
   return out.str();
 }

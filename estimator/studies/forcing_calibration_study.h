@@ -16,7 +16,8 @@
 namespace dwellfit {
 
 // One validation sweep's predictions: signed errors [%], NaN where the sweep
-// measures no such quantity or the model lacks it.
+// measures no such quantity, 100 where it does and the model lacks it (no
+// fold) or the fit is not usable.
 struct HeldOutSweepErrors {
   std::string sweep;
   double scale = 1.0;  // s_v (1 without calibration; NaN when it failed)
