@@ -234,8 +234,8 @@ TEST(LoadIdentifyConfig, ForcingCalibrationIsReadAndShown) {
   EXPECT_EQ(reloaded.forcing_calibration->prior_sigma, 0.02);
   EXPECT_EQ(reloaded.forcing_calibration->held_out_dwells, HeldOutDwells::kBelowHalfPeak);
   std::string path;
-  const InputError negative = LoadError(
-      dir, std::string(kValidConfig) + "forcing_calibration: {prior_sigma: -1}\n", &path);
+  const InputError negative =
+      LoadError(dir, std::string(kValidConfig) + "forcing_calibration: {prior_sigma: -1}\n", &path);
   EXPECT_THAT(negative.what(), HasSubstr("prior_sigma must lie in (0, 1]"));
   const InputError choice = LoadError(
       dir, std::string(kValidConfig) + "forcing_calibration: {held_out_dwells: all}\n", &path);
