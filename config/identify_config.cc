@@ -499,6 +499,21 @@ PenaltyOptions ReadPenalties(const ConfigValue& value, const ConfigSource& sourc
   return penalties;
 }
 
+// The `forcing_calibration` block (fit/forcing_calibration.h); its IsValid
+// is reported at its line.
+ForcingCalibrationOptions ReadForcingCalibration(const ConfigValue& value,
+                                                 const ConfigSource& source) {
+  const StrictMap block(value, source, {"prior_sigma", "held_out_dwells"});
+  ForcingCalibrationOptions calibration;
+  block.Read("prior_sigma", &calibration.prior_sigma);
+  if (const auto dwells = block.Optional("held_out_dwells")) {
+    if (!HeldOutDwellsFromName(ReadNonEmptyString(*dwells, source), &calibration.held_out_dwells)) {
+      throw source.Error(dwells->path, dwells->mark, "give before_jump or below_half_peak");
+    }
+  }
+  return calibration;
+}
+
 // `units:` and `plot:`: how figures and reports show the data.
 void ReadPresentation(const StrictMap& top, const ConfigSource& source, IdentifyConfig* config) {
   if (const auto value = top.Optional("units")) {
@@ -518,7 +533,7 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
       DocumentValue(source), source,
       {"data", "fit", "validate", "initial_guess", "fixed", "stages", "residual", "solver",
        "penalties", "multi_start", "jump_detection", "jumps", "effective_nonlinearity_reference_hz",
-       "model_selection", "output_dir", "units", "plot"});
+       "model_selection", "forcing_calibration", "output_dir", "units", "plot"});
   IdentifyConfig config;
   config.data_files =
       ReadDataFiles(top.Required("data", "give the CSV file with the sweeps (or a list of files)"),
@@ -557,6 +572,10 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
 
   if (const auto value = top.Optional("model_selection")) {
     config.model_selection = ReadModelSelectionConfig(*value, source, config.initial_guess);
+  }
+  if (top.Optional("forcing_calibration")) {
+    config.forcing_calibration =
+        ReadValid(top, "forcing_calibration", source, ReadForcingCalibration);
   }
   config.multi_start = ReadValid(top, "multi_start", source, ReadMultiStart);
   config.jump_detection = ReadValid(top, "jump_detection", source, ReadJumpDetection);

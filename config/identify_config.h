@@ -15,6 +15,7 @@
 #include "dwellfit/config/model_selection_config.h"
 #include "dwellfit/config/sweep_selection.h"
 #include "dwellfit/estimator/data/jump_detection.h"
+#include "dwellfit/estimator/fit/forcing_calibration.h"
 #include "dwellfit/estimator/fit/identification_options.h"
 #include "dwellfit/estimator/fit/initial_guess.h"
 #include "dwellfit/estimator/fit/multi_start.h"
@@ -63,6 +64,11 @@ struct IdentifyConfig {
   // The model variants to compare and how (`model_selection:`); unset when
   // the config has no such block. `identify` ignores it; `select_model` runs it.
   std::optional<ModelSelectionConfig> model_selection;
+  // Per-sweep forcing calibration (`forcing_calibration: {prior_sigma: 0.05,
+  // held_out_dwells: before_jump}`, fit/forcing_calibration.h); unset when the
+  // config has no such block. `identify` ignores it; `forcing_calibration`
+  // runs it.
+  std::optional<ForcingCalibrationOptions> forcing_calibration;
   // The overrides applied on top of the file, in order.
   std::vector<ConfigOverride> overrides;
 };

@@ -209,6 +209,12 @@ std::string ConfigToYaml(const IdentifyConfig& config, ConfigKeys keys) {
         << YAML::Comment(FormatRoundTrip(*config.omega_ref_rad_s) + " rad/s");
   }  // unset: the identified omega (the key's default)
   if (config.model_selection.has_value()) EmitModelSelection(out, *config.model_selection);
+  if (config.forcing_calibration.has_value()) {
+    out << YAML::Key << "forcing_calibration" << YAML::Value << YAML::BeginMap;
+    Put(out, "prior_sigma", config.forcing_calibration->prior_sigma);
+    Put(out, "held_out_dwells", HeldOutDwellsName(config.forcing_calibration->held_out_dwells));
+    out << YAML::EndMap;
+  }
   if (!config.units.a.empty() || !config.units.a_base.empty()) {
     out << YAML::Key << "units" << YAML::Value << YAML::BeginMap;
     if (!config.units.a.empty()) Put(out, "a", config.units.a);

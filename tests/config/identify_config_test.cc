@@ -215,6 +215,33 @@ TEST(LoadIdentifyConfig, UnitsAndPlotAreReadAndShown) {
   EXPECT_THAT(not_bool.what(), HasSubstr("log_amplitude"));
 }
 
+// The forcing calibration's block: unset and not shown by default; read,
+// shown and read back when given; an invalid prior or dwell choice names its
+// key.
+TEST(LoadIdentifyConfig, ForcingCalibrationIsReadAndShown) {
+  const ConfigDirectory dir;
+  const IdentifyConfig by_default = LoadIdentifyConfig(dir.WriteConfig(kValidConfig));
+  EXPECT_FALSE(by_default.forcing_calibration.has_value());
+  EXPECT_THAT(ConfigToYaml(by_default), Not(HasSubstr("forcing_calibration")));
+  const IdentifyConfig stated = LoadIdentifyConfig(dir.WriteConfig(
+      std::string(kValidConfig) +
+      "forcing_calibration: {prior_sigma: 0.02, held_out_dwells: below_half_peak}\n"));
+  ASSERT_TRUE(stated.forcing_calibration.has_value());
+  EXPECT_EQ(stated.forcing_calibration->prior_sigma, 0.02);
+  EXPECT_EQ(stated.forcing_calibration->held_out_dwells, HeldOutDwells::kBelowHalfPeak);
+  const IdentifyConfig reloaded = LoadIdentifyConfig(dir.WriteConfig(ConfigToYaml(stated)));
+  ASSERT_TRUE(reloaded.forcing_calibration.has_value());
+  EXPECT_EQ(reloaded.forcing_calibration->prior_sigma, 0.02);
+  EXPECT_EQ(reloaded.forcing_calibration->held_out_dwells, HeldOutDwells::kBelowHalfPeak);
+  std::string path;
+  const InputError negative =
+      LoadError(dir, std::string(kValidConfig) + "forcing_calibration: {prior_sigma: -1}\n", &path);
+  EXPECT_THAT(negative.what(), HasSubstr("prior_sigma must lie in (0, 1]"));
+  const InputError choice = LoadError(
+      dir, std::string(kValidConfig) + "forcing_calibration: {held_out_dwells: all}\n", &path);
+  EXPECT_THAT(choice.what(), HasSubstr("held_out_dwells"));
+}
+
 // The valley polish: on by default, off when the config says so, shown in
 // the configuration in effect; a value that is not a bool names its line.
 TEST(LoadIdentifyConfig, ValleyPolishIsReadAndShown) {

@@ -1,0 +1,102 @@
+// Per-sweep forcing calibration (estimator/fit/forcing_calibration.h) on
+// noise-free simulated sweeps whose recorded level is off by a known factor:
+// the calibrated fit finds that factor and the true parameters, a held-out
+// sweep's scale comes from its dwells before the jump, and the prior's
+// derivatives match finite differences.
+#include "dwellfit/estimator/fit/forcing_calibration.h"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "ceres/gradient_checker.h"
+#include "gtest/gtest.h"
+#include "tests/fit_test_support.h"
+
+namespace dwellfit {
+namespace {
+
+// The shaker drove the "F" sweeps `factor` times harder than recorded: the
+// recorded a_base is the true one divided by `factor`.
+std::vector<Sweep> MisleveledDataset(double factor) {
+  std::vector<Sweep> sweeps = SimulateDataset(kThesisTruth, 0.0, 1);
+  for (Sweep& sweep : sweeps) {
+    if (sweep.id != "F") continue;
+    for (DwellPoint& point : sweep.points) point.a_base /= factor;
+  }
+  return sweeps;
+}
+
+TEST(ForcingCalibration, ThePriorsJacobianMatchesFiniteDifferences) {
+  const ForcingScalePrior prior(3, 1, 7.0);
+  ParameterVector shared = kThesisTruth;
+  std::vector<double> etas = {95.0, 104.0, 99.0};
+  ceres::NumericDiffOptions numeric;
+  const std::vector<const ceres::Manifold*>* euclidean = nullptr;
+  ceres::GradientChecker checker(&prior, euclidean, numeric);
+  ceres::GradientChecker::ProbeResults results;
+  std::vector<double*> blocks = {shared.data(), etas.data()};
+  EXPECT_TRUE(checker.Probe(blocks.data(), 1e-9, &results)) << results.error_log;
+  double residual = 0.0;
+  const double* values[] = {shared.data(), etas.data()};
+  ASSERT_TRUE(prior.Evaluate(values, &residual, nullptr));
+  EXPECT_DOUBLE_EQ(residual, 7.0 * (104.0 / 100.0 - 1.0));
+}
+
+TEST(ForcingCalibration, TheCalibratedFitFindsTheLevelErrorAndTheTrueParameters) {
+  const double factor = 1.05;
+  const std::vector<Sweep> sweeps = MisleveledDataset(factor);
+  IdentificationOptions options;
+  options.initial = kThesisTruth;
+  options.initial[kEtaE] *= 1.02;
+  options.initial[kDelta] *= 0.9;
+  options.fixed[kNaturalFrequency] = true;
+  ForcingCalibrationOptions calibration;
+  const CalibratedIdentification result = IdentifyWithForcingCalibration(
+      Pointers(sweeps), options, calibration, 1e-9);  // the data decide
+  ASSERT_TRUE(result.fit.IsSolutionUsable()) << result.fit.message;
+  ASSERT_EQ(result.scales.size(), sweeps.size());
+  for (size_t k = 0; k < sweeps.size(); ++k) {
+    const double expected = sweeps[k].id == "F" ? factor : 1.0;
+    // Each sweep's eta_k = s_k eta_e is fixed by its dwells: the ratios are exact.
+    EXPECT_NEAR(result.scales[k] / result.scales.back(), expected, 1e-6) << sweeps[k].Name();
+    EXPECT_NEAR(result.scales[k] * result.fit.parameters[kEtaE], expected * kThesisTruth[kEtaE],
+                1e-4)
+        << sweeps[k].Name();
+  }
+  for (ParameterIndex i : {kMu1, kMu2, kDelta, kAlpha}) {
+    EXPECT_NEAR(result.fit.parameters[i] / kThesisTruth[i], 1.0, 1e-6) << ParameterName(i);
+  }
+}
+
+TEST(ForcingCalibration, AHeldOutSweepsScaleComesFromItsDwellsBeforeTheJump) {
+  const std::vector<Sweep> sweeps = MisleveledDataset(1.04);
+  const Sweep& up = sweeps[0];
+  ASSERT_EQ(up.Name(), "F/up");
+  ASSERT_FALSE(up.jumps.empty());
+  const Sweep before = CalibrationDwells(up, HeldOutDwells::kBeforeJump);
+  EXPECT_EQ(before.points.size(), static_cast<size_t>(up.jumps.front().index_before) + 1);
+  EXPECT_TRUE(before.jumps.empty());
+  const Sweep low = CalibrationDwells(up, HeldOutDwells::kBelowHalfPeak);
+  ASSERT_GE(low.points.size(), 2u);
+  EXPECT_LT(low.points.size(), before.points.size());
+  IdentificationOptions options;
+  options.initial = kThesisTruth;
+  std::string why;
+  ForcingCalibrationOptions calibration;
+  // A data sigma far below the prior's: the dwells decide.
+  const double scale = CalibrateHeldOutScale(up, kThesisTruth, options, calibration, 1e-8, &why);
+  EXPECT_NEAR(scale, 1.04, 1e-5) << why;
+  // A data sigma far above it: the prior holds the scale near 1.
+  const double held = CalibrateHeldOutScale(up, kThesisTruth, options, calibration, 1e3, &why);
+  EXPECT_NEAR(held, 1.0, 1e-3) << why;
+  calibration.held_out_dwells = HeldOutDwells::kBelowHalfPeak;
+  EXPECT_NEAR(CalibrateHeldOutScale(up, kThesisTruth, options, calibration, 1e-8, &why), 1.04, 1e-5)
+      << why;
+  calibration.prior_sigma = 0.0;
+  EXPECT_TRUE(std::isnan(CalibrateHeldOutScale(up, kThesisTruth, options, calibration, 1.0, &why)));
+  EXPECT_NE(why.find("prior_sigma"), std::string::npos) << why;
+}
+
+}  // namespace
+}  // namespace dwellfit
