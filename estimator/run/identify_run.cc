@@ -9,9 +9,11 @@
 #include "dwellfit/estimator/analysis/parameter_uncertainty.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/memory_policy.h"
+#include "dwellfit/estimator/curves/sweep_curves.h"
 #include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
 #include "dwellfit/estimator/run/html_report.h"
+#include "dwellfit/estimator/run/measured_outputs.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/run/run_figures.h"
 #include "glog/logging.h"
@@ -154,6 +156,10 @@ std::unique_ptr<IdentifyOutcome> ComputeIdentify(const IdentifyConfig& config, s
     for (const std::string& step : steps) out << "  " << step << "\n";
     out << "\n";
   };
+  if (!run.phase_note.empty()) {
+    out << run.phase_note << "\n\n";
+    if (config.test.estimate_phase_offset) LOG(WARNING) << run.phase_note;
+  }
   print_steps(run.guessed_from_data, "automatic initial guess", run.initial_guess_steps);
   print_steps(!run.automatic_start_steps.empty(), "automatic start of the multi-start",
               run.automatic_start_steps);
@@ -185,13 +191,20 @@ std::unique_ptr<IdentifyOutcome> ComputeIdentify(const IdentifyConfig& config, s
   report.config_in_effect = ConfigToYaml(config, ConfigKeys::kAffectingTheResult);
   MarkUnidentifiable(&report);
   report.modal = FitModalProperties(run.fitted, report);
+  if (!config.test.IsModelForm()) {
+    MapOutputsToMeasured(config.test, run.phase_offset_rad, &outcome->run.sweeps, &report,
+                         &curves.curves);
+    predictions_csv = ReportToPredictionsCsv(report);
+    curves.csv = CurvesToCsv(curves.curves);
+  }
   PrintReport(report, out);
   std::vector<NamedFile> files = {{"result.yaml", ReportToYaml(report)},
                                   {"predictions.csv", std::move(predictions_csv)},
                                   {"modal_properties.csv", ModalPropertiesCsv(report.modal)}};
   const std::string figures_note = AppendCurvesAndFigures(report, config, std::move(curves), &files,
                                                           out, run_options.render_figures);
-  files.emplace_back(kHtmlReportName, ReportToHtml(report, files, figures_note, config.units));
+  files.emplace_back(kHtmlReportName, ReportToHtml(report, files, figures_note,
+                                                   ModelFormUnits(config.units, config.test)));
   outcome->files = std::move(files);
   return outcome;
 }
