@@ -71,14 +71,14 @@ int TestQuantities::LevelPower() const {
 }
 
 std::optional<double> EstimatePhaseOffset(const TestQuantities& test,
-                                          const std::vector<Sweep>& sweeps) {
+                                          const std::vector<const Sweep*>& sweeps) {
   const int p = test.ResponsePower();
   // Per sweep id (both directions), the dwell of the largest displacement.
   std::map<std::string, const DwellPoint*> peaks;
-  for (const Sweep& sweep : sweeps) {
-    if (sweep.kind != SweepKind::kFrequency) continue;
-    for (const DwellPoint& point : sweep.points) {
-      const DwellPoint*& peak = peaks[sweep.id];
+  for (const Sweep* sweep : sweeps) {
+    if (sweep->kind != SweepKind::kFrequency) continue;
+    for (const DwellPoint& point : sweep->points) {
+      const DwellPoint*& peak = peaks[sweep->id];
       const auto displacement = [p](const DwellPoint& x) {
         return x.amplitude / OmegaPower(x.drive_frequency_rad_s, p);
       };
@@ -97,22 +97,18 @@ std::optional<double> EstimatePhaseOffset(const TestQuantities& test,
   return offsets[offsets.size() / 2];
 }
 
-void ToModelForm(const TestQuantities& test, double phase_offset_rad, std::vector<Sweep>* sweeps) {
+void ToModelForm(const TestQuantities& test, double phase_offset_rad, Sweep* sweep) {
   if (test.IsModelForm() && phase_offset_rad == 0.0) return;
-  const QuantityMap map(test, phase_offset_rad, /*to_model=*/true);
-  for (Sweep& sweep : *sweeps) {
-    if (test.LevelPower() != 0 && sweep.kind == SweepKind::kFrequency && sweep.points.size() > 1) {
-      throw InputError(
-          sweep.source_file, sweep.points.front().source_line, "a_base",
-          "sweep '" + sweep.Name() +
-              "' is a frequency sweep driven by base displacement: its base acceleration "
-              "Omega^2 a_base changes along the sweep, and the model's folds and curves hold "
-              "the level fixed. With excitation: base_displacement fit amplitude sweeps (each at "
-              "one "
-              "frequency); frequency sweeps at a held displacement are not supported");
-    }
-    map.Apply(&sweep);
+  if (test.LevelPower() != 0 && sweep->kind == SweepKind::kFrequency && sweep->points.size() > 1) {
+    throw InputError(
+        sweep->source_file, sweep->points.front().source_line, "a_base",
+        "sweep '" + sweep->Name() +
+            "' is a frequency sweep driven by base displacement: its base acceleration "
+            "Omega^2 a_base changes along the sweep, and the model's folds and curves hold "
+            "the level fixed. With excitation: base_displacement fit amplitude sweeps (each at one "
+            "frequency); frequency sweeps at a held displacement are not supported");
   }
+  QuantityMap(test, phase_offset_rad, /*to_model=*/true).Apply(sweep);
 }
 
 QuantityMap::QuantityMap(const TestQuantities& test, double phase_offset_rad, bool to_model)

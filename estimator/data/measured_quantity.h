@@ -69,14 +69,14 @@ struct TestQuantities {
 // are dense (an up-sweep of a hardening mode ends its upper branch there).
 // None when no frequency sweep has a phase at its peak.
 std::optional<double> EstimatePhaseOffset(const TestQuantities& test,
-                                          const std::vector<Sweep>& sweeps);
+                                          const std::vector<const Sweep*>& sweeps);
 
-// Maps measured sweeps (their jumps and missing rows too) into the model's
+// Maps a measured sweep (its jumps and missing rows too) into the model's
 // form, in place, with `phase_offset_rad` as the offset (the stated or the
 // estimated one). Throws InputError for a frequency sweep driven by base
 // displacement (its base acceleration Omega^2 a_base changes along the
 // sweep, and the model's curves and folds hold the level fixed).
-void ToModelForm(const TestQuantities& test, double phase_offset_rad, std::vector<Sweep>* sweeps);
+void ToModelForm(const TestQuantities& test, double phase_offset_rad, Sweep* sweep);
 
 // One direction of the map: into the model's form (`to_model`) or back into
 // the measured quantities (for outputs).

@@ -1,5 +1,7 @@
 #include "dwellfit/estimator/run/measured_outputs.h"
 
+#include <algorithm>
+
 namespace dwellfit {
 namespace {
 
@@ -36,7 +38,12 @@ void MapOutputsToMeasured(const TestQuantities& test, double phase_offset_rad,
                           std::vector<ResponseCurve>* curves) {
   if (test.IsModelForm() && phase_offset_rad == 0.0) return;
   const QuantityMap map(test, phase_offset_rad, /*to_model=*/false);
-  for (Sweep& sweep : *sweeps) map.Apply(&sweep);
+  for (Sweep& sweep : *sweeps) {  // the predicted ones: those in the model's form
+    const auto predicted = [&sweep](const SweepPrediction& p) { return p.sweep == &sweep; };
+    if (std::any_of(report->predictions.begin(), report->predictions.end(), predicted)) {
+      map.Apply(&sweep);
+    }
+  }
   for (SweepPrediction& prediction : report->predictions) {
     const Sweep& sweep = *prediction.sweep;
     for (std::size_t i = 0; i < sweep.points.size(); ++i) {

@@ -14,7 +14,7 @@
 
 namespace dwellfit {
 
-// Maps `sweeps` (which `report`'s predictions point into), the predictions
+// Maps the sweeps of `sweeps` that `report`'s predictions point into, the predictions
 // (model amplitudes, jumps, RMS errors) and `curves` from the model's form
 // into the measured quantities. Nothing changes for the model's own form.
 // The modal properties stay functions of the displacement amplitude.

@@ -112,17 +112,18 @@ void FindAutomaticStart(const IdentifyConfig& config, ResolvedRun* run) {
   }
 }
 
-// Maps the sweeps into the model's form with the stated or estimated phase
-// offset (measured_quantity.h).
+// Maps the fitted and validation sweeps into the model's form with the
+// stated or estimated phase offset (measured_quantity.h); the others are
+// not used.
 void MapToModelForm(const IdentifyConfig& config, ResolvedRun* run) {
   const TestQuantities& test = config.test;
   run->phase_offset_rad = test.phase_offset_rad;
   if (test.estimate_phase_offset) {
-    const std::optional<double> estimate = EstimatePhaseOffset(test, run->sweeps);
+    const std::optional<double> estimate = EstimatePhaseOffset(test, run->fitted);
     if (!estimate) {
       throw InputError(config.config_path, 0, "phase.offset",
-                       "cannot estimate the phase offset: no frequency sweep has a measured phase "
-                       "at its largest amplitude; state it with phase: {offset_deg: X}");
+                       "cannot estimate the phase offset: no fitted frequency sweep has a measured "
+                       "phase at its largest amplitude; state it with phase: {offset_deg: X}");
     }
     run->phase_offset_rad = *estimate;
     run->phase_note = StringPrintf(
@@ -134,7 +135,12 @@ void MapToModelForm(const IdentifyConfig& config, ResolvedRun* run) {
     run->phase_note = StringPrintf("phase offset %.10g deg as stated (phase.offset_deg)",
                                    test.phase_offset_rad * 180.0 / kPi);
   }
-  ToModelForm(test, run->phase_offset_rad, &run->sweeps);
+  for (Sweep& sweep : run->sweeps) {
+    const auto in = [&sweep](const std::vector<const Sweep*>& list) {
+      return std::find(list.begin(), list.end(), &sweep) != list.end();
+    };
+    if (in(run->fitted) || in(run->validation)) ToModelForm(test, run->phase_offset_rad, &sweep);
+  }
 }
 
 // The phase_lag stage reads the lag gamma of the displacement behind the
@@ -195,9 +201,9 @@ ResolvedRun ResolveRun(const IdentifyConfig& config, std::vector<Sweep> sweeps) 
   run.sweeps = std::move(sweeps);
   DetectJumps(config.jump_detection, &run.sweeps);
   ApplyJumpOverrides(config.jump_overrides, config.config_path, &run.sweeps);
-  MapToModelForm(config, &run);
   run.fitted = SelectSweeps(run.sweeps, config.fit_sweeps, config.config_path, "fit");
   run.validation = SelectSweeps(run.sweeps, config.validate_sweeps, config.config_path, "validate");
+  MapToModelForm(config, &run);
   CheckEnoughDwells(config, run.fitted);
   CheckPhaseConvention(config, run.fitted);
   run.options = config.identification;

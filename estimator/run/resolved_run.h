@@ -26,9 +26,9 @@ struct ResolvedRun {
   ResolvedRun(const ResolvedRun&) = delete;
   ResolvedRun& operator=(const ResolvedRun&) = delete;
 
-  // Every sweep, its branches labelled, in the model's form (a displacement
-  // response to a base acceleration: ToModelForm of the config's `test`);
-  // the selections in data order.
+  // Every sweep, its branches labelled; the selections in data order, in
+  // the model's form (a displacement response to a base acceleration:
+  // ToModelForm of the config's `test`; the unselected sweeps as measured).
   std::vector<Sweep> sweeps;
   std::vector<const Sweep*> fitted;
   std::vector<const Sweep*> validation;

@@ -207,6 +207,11 @@ TEST(TestQuantities, BaseDisplacementFrequencySweepIsRefusedNamingTheSweep) {
   EXPECT_THAT(error.what(), HasSubstr("sweep 'F0.01/up' is a frequency sweep driven by base "
                                       "displacement"));
   EXPECT_THAT(error.what(), HasSubstr("fit amplitude sweeps"));
+  // A frequency sweep in the data that is neither fitted nor validated is
+  // not used, and not refused.
+  const IdentifyConfig amplitude_only =
+      Config({{"excitation", "base_displacement"}, {"fit", "[A41.5]"}, {"validate", "[A41.2]"}});
+  EXPECT_NO_THROW(ResolveRun(amplitude_only, Recorded(SimulatedPlan(), 0, 2)));
 }
 
 // The phase_lag stage on a velocity measured with a lock-in amplifier whose
