@@ -249,6 +249,7 @@ TEST(TestQuantities, OutputsAreInTheMeasuredQuantity) {
   WriteSweepsCsvFile(recorded, (dir.path() / "velocity.csv").string());
   IdentifyConfig config = Config({{"response", "velocity"},
                                   {"excitation", "force"},
+                                  {"units", "{a: mm/s, a_base: N}"},
                                   {"data", (dir.path() / "velocity.csv").string()},
                                   {"output_dir", (dir.path() / "out").string()}});
   std::ostringstream printed;
@@ -268,11 +269,21 @@ TEST(TestQuantities, OutputsAreInTheMeasuredQuantity) {
     }
     EXPECT_LT(prediction.relative_rms_error, 1e-6);
   }
-  std::string predictions, curves;
+  std::string predictions, curves, script, html;
   for (const NamedFile& file : outcome->files) {
     if (file.first == "predictions.csv") predictions = file.second;
     if (file.first == "curves.csv") curves = file.second;
+    if (file.first == "figures.gp") script = file.second;
+    if (file.first == "report.html") html = file.second;
   }
+  // Labels and units follow the test: the figures' axes name the velocity
+  // and the force; the parameters are in the displacement's mm (mm/s times s).
+  EXPECT_THAT(script, HasSubstr("set ylabel \"velocity amplitude [\".amplitude_unit.\"]\""));
+  EXPECT_THAT(script, HasSubstr("amplitude_unit = \"mm/s\""));
+  EXPECT_THAT(script, HasSubstr("force level [N]"));
+  EXPECT_THAT(script, HasSubstr("amplitude a [mm]"));  // the modal figure: displacement
+  EXPECT_THAT(html, HasSubstr("<td>eta_e</td><td>mm/(N s^2)</td>"));
+  EXPECT_THAT(html, HasSubstr("<td>delta</td><td>1/mm^2</td>"));
   // predictions.csv's first row: the up-sweep's first dwell, its velocity
   // beside the model's.
   const std::vector<std::string> prediction_lines = Lines(predictions);
