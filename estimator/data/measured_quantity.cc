@@ -150,6 +150,7 @@ void QuantityMap::Apply(Sweep* sweep) const {
   }
   for (MissingDwell& row : sweep->missing)
     row.a_base = Level(row.a_base, row.drive_frequency_rad_s);
+  if (sweep->points.empty()) return;  // no dwell, so no jump
   const double held_omega = sweep->points.front().drive_frequency_rad_s;
   for (JumpBracket& jump : sweep->jumps) Apply(sweep->kind, held_omega, &jump);
 }

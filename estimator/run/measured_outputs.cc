@@ -50,7 +50,8 @@ void MapOutputsToMeasured(const TestQuantities& test, double phase_offset_rad,
       prediction.model[i].a =
           map.Amplitude(prediction.model[i].a, sweep.points[i].drive_frequency_rad_s);
     }
-    const double held_omega = sweep.points.front().drive_frequency_rad_s;
+    const double held_omega =
+        sweep.points.empty() ? 0.0 : sweep.points.front().drive_frequency_rad_s;
     for (PredictedJump& jump : prediction.jumps) {
       map.Apply(sweep.kind, held_omega, &jump.bracket);
       if (sweep.kind == SweepKind::kAmplitude) jump.control = map.Level(jump.control, held_omega);
