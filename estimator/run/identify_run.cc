@@ -190,6 +190,8 @@ std::unique_ptr<IdentifyOutcome> ComputeIdentify(const IdentifyConfig& config, s
   report.initial_guess_steps = run.initial_guess_steps;
   report.multi_start = multi_start;
   report.uncertainty = std::move(uncertainty);
+  // An estimated phase offset is an error source the intervals do not hold.
+  if (config.test.estimate_phase_offset) report.uncertainty.warnings.push_back(run.phase_note);
   std::string predictions_csv;
   RunCurves curves;
   ComputeAfterFit(run, result, &report, &predictions_csv, &curves);
