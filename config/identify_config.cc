@@ -514,6 +514,50 @@ ForcingCalibrationOptions ReadForcingCalibration(const ConfigValue& value,
   return calibration;
 }
 
+// `excitation:`, `response:` and `phase:`: the test as run. A relative
+// error with a floor is refused for a velocity or acceleration response
+// (ResidualOptions::IsValid), at the `response` key.
+void ReadTestQuantities(const StrictMap& top, const ConfigSource& source, IdentifyConfig* config) {
+  TestQuantities& test = config->test;
+  if (const auto value = top.Optional("excitation")) {
+    ExcitationFromName(ReadOneOf(*value, source, "excitation",
+                                 {ExcitationName(Excitation::kBaseAcceleration),
+                                  ExcitationName(Excitation::kBaseDisplacement),
+                                  ExcitationName(Excitation::kForce)}),
+                       &test.excitation);
+  }
+  if (const auto value = top.Optional("response")) {
+    ResponseFromName(
+        ReadOneOf(*value, source, "response",
+                  {ResponseName(Response::kDisplacement), ResponseName(Response::kVelocity),
+                   ResponseName(Response::kAcceleration)}),
+        &test.response);
+    ResidualOptions& residual = config->identification.solve.residual;
+    residual.response_power = test.ResponsePower();
+    std::string message;
+    if (!residual.IsValid(&message)) throw source.Error(value->path, value->mark, message);
+  }
+  if (const auto value = top.Optional("phase")) {
+    const StrictMap block(*value, source, {"offset_deg", "offset"});
+    const auto degrees = block.Optional("offset_deg");
+    const auto estimate = block.Optional("offset");
+    if (degrees && estimate) {
+      throw source.Error(estimate->path, estimate->mark,
+                         "give either offset_deg (a stated offset) or offset: estimate, not both");
+    }
+    if (degrees) test.phase_offset_rad = ReadFiniteDouble(*degrees, source) * kPi / 180.0;
+    if (estimate) {
+      ReadOneOf(*estimate, source, "phase offset", {"estimate"});
+      test.estimate_phase_offset = true;
+    }
+    if (!degrees && !estimate) {
+      throw source.Error(value->path, value->mark,
+                         "states no offset; give offset_deg: X (the phase column minus the "
+                         "measured quantity's lag, in degrees) or offset: estimate");
+    }
+  }
+}
+
 // `units:` and `plot:`: how figures and reports show the data.
 void ReadPresentation(const StrictMap& top, const ConfigSource& source, IdentifyConfig* config) {
   if (const auto value = top.Optional("units")) {
@@ -528,12 +572,33 @@ void ReadPresentation(const StrictMap& top, const ConfigSource& source, Identify
   }
 }
 
+// The top-level keys; the last three describe the test as run.
+std::vector<std::string> TopLevelKeys() {
+  return {"data",
+          "fit",
+          "validate",
+          "initial_guess",
+          "fixed",
+          "stages",
+          "residual",
+          "solver",
+          "penalties",
+          "multi_start",
+          "jump_detection",
+          "jumps",
+          "effective_nonlinearity_reference_hz",
+          "model_selection",
+          "forcing_calibration",
+          "output_dir",
+          "units",
+          "plot",
+          "excitation",
+          "response",
+          "phase"};
+}
+
 IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& config_dir) {
-  const StrictMap top(
-      DocumentValue(source), source,
-      {"data", "fit", "validate", "initial_guess", "fixed", "stages", "residual", "solver",
-       "penalties", "multi_start", "jump_detection", "jumps", "effective_nonlinearity_reference_hz",
-       "model_selection", "forcing_calibration", "output_dir", "units", "plot"});
+  const StrictMap top(DocumentValue(source), source, TopLevelKeys());
   IdentifyConfig config;
   config.data_files =
       ReadDataFiles(top.Required("data", "give the CSV file with the sweeps (or a list of files)"),
@@ -593,6 +658,7 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
     config.omega_ref_rad_s = RadPerSecond(hz, *value, source);
   }
 
+  ReadTestQuantities(top, source, &config);
   ReadPresentation(top, source, &config);
   const ConfigValue output_dir =
       top.Required("output_dir", "give the directory for the results, e.g. output_dir: out");
@@ -617,6 +683,24 @@ IdentifyConfig ReadSource(ConfigSource source, const std::string& name, const fs
 }
 
 }  // namespace
+
+DataUnits ModelFormUnits(const DataUnits& units, const TestQuantities& test) {
+  const int p = test.ResponsePower();
+  DataUnits model;
+  const char* unstated[] = {"[A]", "[V]", "[Acc]"};
+  const std::string a = units.a.empty() ? unstated[p] : units.a;
+  const std::string time = p == 1 ? "/s" : "/s^2";
+  if (p == 0) {
+    model.a = a;
+  } else if (a.size() > time.size() && a.compare(a.size() - time.size(), time.size(), time) == 0) {
+    model.a = a.substr(0, a.size() - time.size());  // m/s -> m
+  } else {
+    model.a = "(" + a + (p == 1 ? " s)" : " s^2)");
+  }
+  const std::string b = units.a_base.empty() ? "[B]" : units.a_base;
+  model.a_base = test.LevelPower() == 0 ? b : b + "/s^2";
+  return model;
+}
 
 IdentifyConfig LoadIdentifyConfig(const std::string& path,
                                   const std::vector<ConfigOverride>& overrides) {

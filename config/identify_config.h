@@ -15,6 +15,7 @@
 #include "dwellfit/config/model_selection_config.h"
 #include "dwellfit/config/sweep_selection.h"
 #include "dwellfit/estimator/data/jump_detection.h"
+#include "dwellfit/estimator/data/measured_quantity.h"
 #include "dwellfit/estimator/fit/forcing_calibration.h"
 #include "dwellfit/estimator/fit/identification_options.h"
 #include "dwellfit/estimator/fit/initial_guess.h"
@@ -27,6 +28,13 @@ struct DataUnits {
   std::string a_base;  // of the base level a_base
 };
 
+// The units of the model's form (docs/model.md, "The test as run"), in which
+// the parameters are: the displacement's, `units.a` times s^p (m/s -> m,
+// m/s^2 -> m), and the level's, `units.a_base` per s^q (base displacement
+// m -> m/s^2). Unstated units are [A] (displacement), [V] (velocity),
+// [Acc] (acceleration) and [B] (level).
+DataUnits ModelFormUnits(const DataUnits& units, const TestQuantities& test);
+
 struct IdentifyConfig {
   // The config file, absolute.
   std::string config_path;
@@ -37,6 +45,11 @@ struct IdentifyConfig {
   std::vector<SweepSelection> fit_sweeps;
   // Sweeps only predicted and scored; none of them is also fitted.
   std::vector<SweepSelection> validate_sweeps;
+  // The test as run (`excitation:`, `response:`, `phase:`): how the sweeps
+  // map into the model's form (measured_quantity.h). The defaults are the
+  // model's own form; identification.solve.residual.response_power follows
+  // `response`.
+  TestQuantities test;
   // The initial guesses the config gives (physical units, omega in rad/s);
   // an entry left out or `auto` is found from the data (initial_guess.h).
   KnownParameters initial_guess;

@@ -183,6 +183,25 @@ void EmitModelSelection(YAML::Emitter& out, const ModelSelectionConfig& selectio
   out << YAML::EndMap;
 }
 
+// Only what differs from the model's own form (the defaults), so that a
+// config without these keys keeps its text.
+void EmitTestQuantities(YAML::Emitter& out, const TestQuantities& test) {
+  if (test.excitation != Excitation::kBaseAcceleration) {
+    Put(out, "excitation", ExcitationName(test.excitation));
+  }
+  if (test.response != Response::kDisplacement) Put(out, "response", ResponseName(test.response));
+  if (test.estimate_phase_offset || test.phase_offset_rad != 0.0) {
+    out << YAML::Key << "phase" << YAML::Value << YAML::BeginMap;
+    if (test.estimate_phase_offset) {
+      Put(out, "offset", "estimate");
+    } else {
+      out << YAML::Key << "offset_deg" << YAML::Value
+          << ConvertedNumber(test.phase_offset_rad * 180.0 / kPi);
+    }
+    out << YAML::EndMap;
+  }
+}
+
 }  // namespace
 
 std::string ConfigToYaml(const IdentifyConfig& config, ConfigKeys keys) {
@@ -215,6 +234,7 @@ std::string ConfigToYaml(const IdentifyConfig& config, ConfigKeys keys) {
     Put(out, "held_out_dwells", HeldOutDwellsName(config.forcing_calibration->held_out_dwells));
     out << YAML::EndMap;
   }
+  EmitTestQuantities(out, config.test);
   if (!config.units.a.empty() || !config.units.a_base.empty()) {
     out << YAML::Key << "units" << YAML::Value << YAML::BeginMap;
     if (!config.units.a.empty()) Put(out, "a", config.units.a);

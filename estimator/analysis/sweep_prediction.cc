@@ -49,8 +49,6 @@ SweepPrediction PredictSweep(const ParameterVector& parameters, const Sweep& swe
   SweepPrediction prediction;
   prediction.sweep = &sweep;
   prediction.fitted = fitted;
-  double sum_squared = 0.0;
-  double sum_squared_relative = 0.0;
   for (const DwellPoint& point : sweep.points) {
     // From the measured amplitude, as the vertical error's root solve (most
     // dwells lie near their branch: no turning points to find).
@@ -58,17 +56,26 @@ SweepPrediction PredictSweep(const ParameterVector& parameters, const Sweep& swe
                                                point.a_base, point.branch, point.amplitude);
     prediction.model.push_back(root);
     if (root.status == RootStatus::kBranchEnd) ++prediction.points_off_branch;
-    const double error = root.a - point.amplitude;
-    sum_squared += error * error;
-    sum_squared_relative += (error / point.amplitude) * (error / point.amplitude);
   }
   prediction.jumps = PredictJumps(parameters, sweep);
-  const double n = static_cast<double>(sweep.points.size());
-  if (n > 0) {
-    prediction.rms_error = std::sqrt(sum_squared / n);
-    prediction.relative_rms_error = std::sqrt(sum_squared_relative / n);
-  }
+  ScoreSweepPrediction(&prediction);
   return prediction;
+}
+
+void ScoreSweepPrediction(SweepPrediction* prediction) {
+  const std::vector<DwellPoint>& points = prediction->sweep->points;
+  double sum_squared = 0.0;
+  double sum_squared_relative = 0.0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double error = prediction->model[i].a - points[i].amplitude;
+    sum_squared += error * error;
+    sum_squared_relative += (error / points[i].amplitude) * (error / points[i].amplitude);
+  }
+  const double n = static_cast<double>(points.size());
+  if (n > 0) {
+    prediction->rms_error = std::sqrt(sum_squared / n);
+    prediction->relative_rms_error = std::sqrt(sum_squared_relative / n);
+  }
 }
 
 std::vector<SweepPrediction> PredictSweeps(const ParameterVector& parameters,

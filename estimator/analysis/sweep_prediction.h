@@ -47,6 +47,10 @@ struct SweepPrediction {
 
 SweepPrediction PredictSweep(const ParameterVector& parameters, const Sweep& sweep, bool fitted);
 
+// Sets rms_error and relative_rms_error from `model` and the sweep's points
+// (after both were mapped into the measured quantity, measured_outputs.h).
+void ScoreSweepPrediction(SweepPrediction* prediction);
+
 std::vector<SweepPrediction> PredictSweeps(const ParameterVector& parameters,
                                            const std::vector<const Sweep*>& fitted,
                                            const std::vector<const Sweep*>& validation);

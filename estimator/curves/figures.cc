@@ -100,7 +100,7 @@ std::string SweepFigure(const FigureSet& figures, const FigureSweep& s, size_t i
   gp << "set multiplot\n"
         "set origin 0, 0.3\nset size 1, 0.7\nset lmargin 12\nset format x \"\"\nunset xlabel\n";
   gp << "set title " << Quoted(title) << "\n";
-  gp << "set ylabel \"a [\".amplitude_unit.\"]\"\n"
+  gp << "set ylabel \"" << figures.amplitude_name << " [\".amplitude_unit.\"]\"\n"
      << (figures.log_amplitude ? "set logscale y\n" : "");
   // The key under the corner's lines (about 0.037 of the graph's height each).
   const double key_top = 0.93 - 0.037 * static_cast<double>(figures.corner_lines.size());
@@ -134,8 +134,9 @@ std::string SweepFigure(const FigureSet& figures, const FigureSweep& s, size_t i
   gp << "unset label 1\nunset arrow\nunset title\nunset logscale y\n";
   gp << "set origin 0, 0\nset size 1, 0.3\nset format x \"% h\"\n";
   gp << "set xlabel "
-     << Quoted(s.kind == SweepKind::kFrequency ? "drive frequency [Hz]"
-                                               : "base level a_base [" + figures.control_unit + "]")
+     << Quoted(s.kind == SweepKind::kFrequency
+                   ? "drive frequency [Hz]"
+                   : figures.level_name + " [" + figures.control_unit + "]")
      << "\nset ylabel " << Quoted(figures.residual_label) << "\nunset key\n";
   gp << Plot(prefix + "r",
              {{"up", {s.up_residual}, up_style}, {"down", {s.down_residual}, down_style}},
@@ -186,7 +187,7 @@ OverviewRows OverviewData(std::vector<OverviewJump> jumps) {
 // the held values) and the validation sweeps' 95 % prediction intervals.
 std::string OverviewFigure(const FigureSet& figures, SweepKind sweep_kind) {
   const bool frequency = sweep_kind == SweepKind::kFrequency;
-  const std::string level = "base level a_base [" + figures.control_unit + "]";
+  const std::string level = figures.level_name + " [" + figures.control_unit + "]";
   const bool has_band =
       std::any_of(figures.overview.begin(), figures.overview.end(), [&](const OverviewJump& j) {
         return j.sweep_kind == sweep_kind && std::isfinite(j.band_low);
@@ -247,7 +248,11 @@ std::string ModalFigure(const FigureSet& figures) {
       "set origin 0, 0\nset size 1, 1\nset multiplot layout 2,1 title \"The identified "
       "model's natural frequency and damping ratio against the amplitude (95 % bands)\"\n"
       "unset logscale\nset key inside top left\nset format x \"% h\"\nset xlabel " +
-      Quoted("amplitude a [" + figures.amplitude_unit + "]") + "\n";
+      Quoted(
+          "amplitude a [" +
+          (figures.displacement_unit.empty() ? figures.amplitude_unit : figures.displacement_unit) +
+          "]") +
+      "\n";
   for (const auto& [column, label] :
        {std::pair{2, "natural frequency omega(a) [Hz]"}, std::pair{5, "damping ratio zeta(a)"}}) {
     gp += StringPrintf(

@@ -65,7 +65,15 @@ struct FigureSet {
   std::vector<OverviewJump> overview;
   std::vector<std::string> corner_lines;  // the estimates and the status, one per line
   std::string amplitude_unit = "data's unit";
-  std::string control_unit;    // unit of a_base, for an amplitude sweep's x axis
+  std::string control_unit;  // unit of a_base, for an amplitude sweep's x axis
+  // What the sweeps' amplitude and level are (the test as run): "a" and
+  // "base level a_base" for the model's form, e.g. "velocity amplitude" and
+  // "force level" otherwise.
+  std::string amplitude_name = "a";
+  std::string level_name = "base level a_base";
+  // The modal figure's amplitude is the displacement's: its unit (empty:
+  // amplitude_unit).
+  std::string displacement_unit;
   std::string residual_label;  // the fit's error measure, for the residual axis
   bool log_amplitude = false;  // the amplitude axis logarithmic
   // Drawn as figure_modal_properties when not empty: per amplitude a, the

@@ -53,6 +53,18 @@ bool ErrorMeasureFromName(const std::string& name, ErrorMeasure* measure) {
 }
 
 bool ResidualOptions::IsValid(std::string* error) const {
+  if (response_power < 0 || response_power > 2) {
+    *error = "residual.response_power must be 0, 1 or 2 (displacement, velocity, acceleration)";
+    return false;
+  }
+  if (response_power != 0 && this->error == ErrorMeasure::kRelative && amplitude_floor > 0.0) {
+    *error =
+        "residual.amplitude_floor is a floor of the measured velocity or acceleration, but the "
+        "fit's amplitude is the displacement y / Omega^p, and ln(y + f) - ln(y_model + f) is no "
+        "error of the displacement with one floor; set amplitude_floor: 0 (the relative error is "
+        "then exact) or use error: absolute";
+    return false;
+  }
   return IsNonNegative("residual.amplitude_floor", amplitude_floor, error);
 }
 

@@ -32,6 +32,11 @@ struct ResidualOptions {
   // f of the relative error ln(a_i + f) - ln(a_model + f), in the data's
   // amplitude unit: the measurement's noise floor (0: purely relative).
   double amplitude_floor = 0.0;
+  // p: the measured amplitude is Omega^p times the model's displacement
+  // amplitude (measured_quantity.h). The absolute error of a dwell without
+  // a used sigma is weighted by Omega^p, so that it stays the error of the
+  // measured quantity: Omega^p (a_i - a_model) = y_i - y_model.
+  int response_power = 0;
   bool IsValid(std::string* error) const;
 };
 

@@ -29,6 +29,8 @@ double ProblemBuilder::AmplitudeWeight(const DwellPoint& point) const {
     weight *= options_.residual_options.error == ErrorMeasure::kAbsolute
                   ? 1.0 / *point.sigma
                   : (point.amplitude + options_.residual_options.amplitude_floor) / *point.sigma;
+  } else if (options_.residual_options.error == ErrorMeasure::kAbsolute) {
+    weight *= std::pow(point.drive_frequency_rad_s, options_.residual_options.response_power);
   }
   return weight;
 }

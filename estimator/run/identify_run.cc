@@ -9,9 +9,11 @@
 #include "dwellfit/estimator/analysis/parameter_uncertainty.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/memory_policy.h"
+#include "dwellfit/estimator/curves/sweep_curves.h"
 #include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
 #include "dwellfit/estimator/run/html_report.h"
+#include "dwellfit/estimator/run/measured_outputs.h"
 #include "dwellfit/estimator/run/output_files.h"
 #include "dwellfit/estimator/run/run_figures.h"
 #include "glog/logging.h"
@@ -145,8 +147,15 @@ std::unique_ptr<IdentifyOutcome> ComputeIdentify(const IdentifyConfig& config, s
   auto outcome = std::make_unique<IdentifyOutcome>();
   outcome->run = ResolveRun(config);
   const ResolvedRun& run = outcome->run;
-  for (const Sweep* sweep : run.fitted) out << "fit      " << DescribeJumps(*sweep) << "\n";
-  for (const Sweep* sweep : run.validation) out << "validate " << DescribeJumps(*sweep) << "\n";
+  // The jumps in the measured quantities (the run's sweeps are in the model's form).
+  const auto jumps = [&](const Sweep& sweep) {
+    if (config.test.IsModelForm()) return DescribeJumps(sweep);
+    Sweep measured = sweep;
+    QuantityMap(config.test, run.phase_offset_rad, /*to_model=*/false).Apply(&measured);
+    return DescribeJumps(measured);
+  };
+  for (const Sweep* sweep : run.fitted) out << "fit      " << jumps(*sweep) << "\n";
+  for (const Sweep* sweep : run.validation) out << "validate " << jumps(*sweep) << "\n";
   out << "\n";
   const auto print_steps = [&out](bool print, const char* title, const auto& steps) {
     if (!print) return;
@@ -154,6 +163,10 @@ std::unique_ptr<IdentifyOutcome> ComputeIdentify(const IdentifyConfig& config, s
     for (const std::string& step : steps) out << "  " << step << "\n";
     out << "\n";
   };
+  if (!run.phase_note.empty()) {
+    out << run.phase_note << "\n\n";
+    if (config.test.estimate_phase_offset) LOG(WARNING) << run.phase_note;
+  }
   print_steps(run.guessed_from_data, "automatic initial guess", run.initial_guess_steps);
   print_steps(!run.automatic_start_steps.empty(), "automatic start of the multi-start",
               run.automatic_start_steps);
@@ -177,6 +190,8 @@ std::unique_ptr<IdentifyOutcome> ComputeIdentify(const IdentifyConfig& config, s
   report.initial_guess_steps = run.initial_guess_steps;
   report.multi_start = multi_start;
   report.uncertainty = std::move(uncertainty);
+  // An estimated phase offset is an error source the intervals do not hold.
+  if (config.test.estimate_phase_offset) report.uncertainty.warnings.push_back(run.phase_note);
   std::string predictions_csv;
   RunCurves curves;
   ComputeAfterFit(run, result, &report, &predictions_csv, &curves);
@@ -185,13 +200,20 @@ std::unique_ptr<IdentifyOutcome> ComputeIdentify(const IdentifyConfig& config, s
   report.config_in_effect = ConfigToYaml(config, ConfigKeys::kAffectingTheResult);
   MarkUnidentifiable(&report);
   report.modal = FitModalProperties(run.fitted, report);
+  if (!config.test.IsModelForm()) {
+    MapOutputsToMeasured(config.test, run.phase_offset_rad, &outcome->run.sweeps, &report,
+                         &curves.curves);
+    predictions_csv = ReportToPredictionsCsv(report);
+    curves.csv = CurvesToCsv(curves.curves);
+  }
   PrintReport(report, out);
   std::vector<NamedFile> files = {{"result.yaml", ReportToYaml(report)},
                                   {"predictions.csv", std::move(predictions_csv)},
                                   {"modal_properties.csv", ModalPropertiesCsv(report.modal)}};
   const std::string figures_note = AppendCurvesAndFigures(report, config, std::move(curves), &files,
                                                           out, run_options.render_figures);
-  files.emplace_back(kHtmlReportName, ReportToHtml(report, files, figures_note, config.units));
+  files.emplace_back(kHtmlReportName, ReportToHtml(report, files, figures_note,
+                                                   ModelFormUnits(config.units, config.test)));
   outcome->files = std::move(files);
   return outcome;
 }

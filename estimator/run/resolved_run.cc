@@ -1,10 +1,13 @@
 #include "dwellfit/estimator/run/resolved_run.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
+#include <optional>
 #include <utility>
 
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/data/sweep_csv.h"
 #include "dwellfit/estimator/fit/initial_guess.h"
@@ -109,6 +112,62 @@ void FindAutomaticStart(const IdentifyConfig& config, ResolvedRun* run) {
   }
 }
 
+// Maps the fitted and validation sweeps into the model's form with the
+// stated or estimated phase offset (measured_quantity.h); the others are
+// not used.
+void MapToModelForm(const IdentifyConfig& config, ResolvedRun* run) {
+  const TestQuantities& test = config.test;
+  run->phase_offset_rad = test.phase_offset_rad;
+  if (test.estimate_phase_offset) {
+    const std::optional<double> estimate = EstimatePhaseOffset(test, run->fitted);
+    if (!estimate) {
+      throw InputError(config.config_path, 0, "phase.offset",
+                       "cannot estimate the phase offset: no fitted frequency sweep has a measured "
+                       "phase at its largest amplitude; state it with phase: {offset_deg: X}");
+    }
+    run->phase_offset_rad = *estimate;
+    run->phase_note = StringPrintf(
+        "phase offset %.2f deg estimated from the frequency sweeps' peaks (taken on the "
+        "backbone, where the displacement lags the forcing by 90 deg; off by a few deg where the "
+        "dwells near the peak are sparse): state it with phase: {offset_deg: X} when it is known",
+        run->phase_offset_rad * 180.0 / kPi);
+  } else if (test.phase_offset_rad != 0.0) {
+    run->phase_note = StringPrintf("phase offset %.10g deg as stated (phase.offset_deg)",
+                                   test.phase_offset_rad * 180.0 / kPi);
+  }
+  for (Sweep& sweep : run->sweeps) {
+    const auto in = [&sweep](const std::vector<const Sweep*>& list) {
+      return std::find(list.begin(), list.end(), &sweep) != list.end();
+    };
+    if (in(run->fitted) || in(run->validation)) ToModelForm(test, run->phase_offset_rad, &sweep);
+  }
+}
+
+// The phase_lag stage reads the lag gamma of the displacement behind the
+// forcing, which positive damping keeps in (0, 180) deg (docs/model.md,
+// "Phase convention"). A fitted dwell's lag outside -10 to 190 deg (after
+// the offset, wrapped) shows an offset or another convention in the file:
+// refused rather than fitted.
+void CheckPhaseConvention(const IdentifyConfig& config, const std::vector<const Sweep*>& fitted) {
+  const auto& stages = config.identification.solve.stages;
+  if (std::find(stages.begin(), stages.end(), ResidualKind::kPhaseLag) == stages.end()) return;
+  for (const Sweep* sweep : fitted) {
+    for (const DwellPoint& point : sweep->points) {
+      if (!point.phase_rad || std::sin(*point.phase_rad) >= -std::sin(kPi / 18.0)) continue;
+      const double lag_deg = std::remainder(*point.phase_rad, 2.0 * kPi) * 180.0 / kPi;
+      throw InputError(
+          sweep->source_file, point.source_line, "phase_deg",
+          StringPrintf("the phase_lag stage needs the lag of the response behind the forcing, "
+                       "which lies between 0 and 180 deg with positive damping; this dwell of "
+                       "sweep '%s' gives %.1f deg (after the response's convention and the "
+                       "offset %.2f deg): the phase column has an offset or another sign. State "
+                       "it in the config with phase: {offset_deg: X}, or phase: {offset: "
+                       "estimate} (docs/model.md, \"Phase convention\")",
+                       sweep->Name().c_str(), lag_deg, config.test.phase_offset_rad * 180.0 / kPi));
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<const Sweep*> SelectSweeps(const std::vector<Sweep>& sweeps,
@@ -144,7 +203,9 @@ ResolvedRun ResolveRun(const IdentifyConfig& config, std::vector<Sweep> sweeps) 
   ApplyJumpOverrides(config.jump_overrides, config.config_path, &run.sweeps);
   run.fitted = SelectSweeps(run.sweeps, config.fit_sweeps, config.config_path, "fit");
   run.validation = SelectSweeps(run.sweeps, config.validate_sweeps, config.config_path, "validate");
+  MapToModelForm(config, &run);
   CheckEnoughDwells(config, run.fitted);
+  CheckPhaseConvention(config, run.fitted);
   run.options = config.identification;
   run.multi_start = config.multi_start;
   FillGuessesFromData(config, &run);

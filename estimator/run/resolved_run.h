@@ -26,7 +26,9 @@ struct ResolvedRun {
   ResolvedRun(const ResolvedRun&) = delete;
   ResolvedRun& operator=(const ResolvedRun&) = delete;
 
-  // Every sweep, its branches labelled; the selections in data order.
+  // Every sweep, its branches labelled; the selections in data order, in
+  // the model's form (a displacement response to a base acceleration:
+  // ToModelForm of the config's `test`; the unselected sweeps as measured).
   std::vector<Sweep> sweeps;
   std::vector<const Sweep*> fitted;
   std::vector<const Sweep*> validation;
@@ -43,6 +45,10 @@ struct ResolvedRun {
   // sweeps show no resonance to estimate from (its step says so).
   std::optional<ParameterVector> automatic_start;
   std::vector<std::string> automatic_start_steps;
+  // The phase columns' offset [rad] taken off by ToModelForm: the stated one,
+  // or the estimate; `phase_note` says which (empty without `phase:`).
+  double phase_offset_rad = 0.0;
+  std::string phase_note;
 };
 
 // Reads the config's data files (sweep ids unique across files) and resolves

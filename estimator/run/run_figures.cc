@@ -224,6 +224,16 @@ std::string AppendCurvesAndFigures(const IdentificationReport& report, const Ide
   }
   figures.amplitude_unit = config.units.a.empty() ? "data's unit" : config.units.a;
   figures.control_unit = config.units.a_base.empty() ? "data's unit" : config.units.a_base;
+  // The test as run names the quantities; the defaults keep "a" and "base level a_base".
+  const char* amplitude[] = {"a", "velocity amplitude", "acceleration amplitude"};
+  figures.amplitude_name = amplitude[config.test.ResponsePower()];
+  figures.level_name = config.test.excitation == Excitation::kForce ? "force level"
+                       : config.test.excitation == Excitation::kBaseDisplacement
+                           ? "base displacement level"
+                           : "base level a_base";
+  if (config.test.ResponsePower() != 0) {
+    figures.displacement_unit = ModelFormUnits(config.units, config.test).a;
+  }
   figures.log_amplitude = config.log_amplitude;
   figures.residual_label = ResidualLabel(report.options.solve.residual, figures.amplitude_unit);
   for (const ResponseCurve& curve : traced.curves)
