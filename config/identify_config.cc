@@ -499,7 +499,7 @@ PenaltyOptions ReadPenalties(const ConfigValue& value, const ConfigSource& sourc
   return penalties;
 }
 
-// `units:` and `plot:`: how figures and reports show the data.
+// `units:`, `plot:` and `outputs:`: how figures and reports show the data.
 void ReadPresentation(const StrictMap& top, const ConfigSource& source, IdentifyConfig* config) {
   if (const auto value = top.Optional("units")) {
     const StrictMap units(*value, source, {"a", "a_base"});
@@ -511,6 +511,9 @@ void ReadPresentation(const StrictMap& top, const ConfigSource& source, Identify
   if (const auto value = top.Optional("plot")) {
     StrictMap(*value, source, {"log_amplitude"}).Read("log_amplitude", &config->log_amplitude);
   }
+  if (const auto value = top.Optional("outputs")) {
+    StrictMap(*value, source, {"mat"}).Read("mat", &config->write_mat);
+  }
 }
 
 IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& config_dir) {
@@ -518,10 +521,10 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
       DocumentValue(source), source,
       {"data", "fit", "validate", "initial_guess", "fixed", "stages", "residual", "solver",
        "penalties", "multi_start", "jump_detection", "jumps", "effective_nonlinearity_reference_hz",
-       "model_selection", "output_dir", "units", "plot"});
+       "model_selection", "output_dir", "units", "plot", "outputs"});
   IdentifyConfig config;
   config.data_files =
-      ReadDataFiles(top.Required("data", "give the CSV file with the sweeps (or a list of files)"),
+      ReadDataFiles(top.Required("data", "give the sweeps file, CSV or .mat (or a list of files)"),
                     source, config_dir);
 
   const ConfigValue fit_value =

@@ -1,0 +1,203 @@
+#include "dwellfit/estimator/matfile/mat_sweeps.h"
+
+#include <matio.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/data/sweep_csv_writer.h"
+#include "dwellfit/estimator/matfile/mat_handles.h"
+
+namespace dwellfit {
+namespace {
+
+// The CSV's columns, in SweepRowFields' order; the first two are text.
+constexpr std::array<const char*, 8> kColumns = {"sweep", "direction", "freq_hz",   "a_base",
+                                                 "a",     "phase_deg", "phase_rad", "sigma"};
+constexpr int kNumRequired = 5;
+constexpr int kNumText = 2;
+
+constexpr char kLayout[] =
+    "a sweeps MAT file holds the cell arrays sweep and direction and the double vectors "
+    "freq_hz, a_base, a (required), phase_deg or phase_rad, sigma (optional), one value per "
+    "row (docs/matlab.md)";
+
+// Each column's values as text, one per row; empty for a column not given.
+using Table = std::array<std::vector<std::string>, kColumns.size()>;
+
+[[noreturn]] void Fail(const std::string& path, const std::string& variable, std::size_t row,
+                       const std::string& what) {
+  std::string where = variable.empty() ? "" : "variable '" + EscapeForMessage(variable) + "'";
+  if (row > 0) where += (where.empty() ? "row " : ", row ") + std::to_string(row);
+  throw InputError(path, 0, "", (where.empty() ? "" : where + ": ") + what);
+}
+
+// The number of values of a vector (either orientation; 0 x 0 is empty).
+std::size_t Length(const std::string& path, const matvar_t& var) {
+  if (var.rank == 2 && (var.dims[0] == 0 || var.dims[1] == 0)) return 0;
+  if (var.rank != 2 || (var.dims[0] != 1 && var.dims[1] != 1)) {
+    std::string shape;
+    for (int i = 0; i < var.rank; ++i) shape += (i ? " x " : "") + std::to_string(var.dims[i]);
+    Fail(path, var.name ? var.name : "", 0,
+         "is a " + shape + " array; give a vector, one value per row (x(:) in MATLAB)");
+  }
+  return var.dims[0] * var.dims[1];
+}
+
+// The text of a char array (UTF-8, or UTF-16 code units of the BMP).
+std::string CharText(const std::string& path, const char* name, std::size_t row,
+                     const matvar_t* cell) {
+  if (cell == nullptr || cell->class_type != MAT_C_CHAR) {
+    Fail(path, name, row, "is not a char string; give each row's text as a char string");
+  }
+  const std::size_t n = Length(path, *cell);
+  if (n > 0 && cell->dims[0] != 1) Fail(path, name, row, "give the text as one row of chars");
+  std::string text;
+  const bool wide = cell->data_size == 2;
+  if ((cell->data_size != 1 && !wide) || cell->nbytes < n * cell->data_size ||
+      (n > 0 && cell->data == nullptr)) {
+    Fail(path, name, row, "the chars cannot be read; save the text as a char string");
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const unsigned unit = wide ? static_cast<const std::uint16_t*>(cell->data)[i]
+                               : static_cast<const unsigned char*>(cell->data)[i];
+    if (unit < 0x80 || !wide) {
+      text += static_cast<char>(unit);
+    } else if (unit < 0x800) {
+      text += {static_cast<char>(0xC0 | unit >> 6), static_cast<char>(0x80 | (unit & 0x3F))};
+    } else {
+      text += {static_cast<char>(0xE0 | unit >> 12), static_cast<char>(0x80 | (unit >> 6 & 0x3F)),
+               static_cast<char>(0x80 | (unit & 0x3F))};
+    }
+  }
+  return text;
+}
+
+// A text column: a cell array of char strings.
+std::vector<std::string> ReadText(const std::string& path, matvar_t* var) {
+  const char* name = var->name;
+  if (var->class_type != MAT_C_CELL) {
+    Fail(path, name, 0,
+         std::string(var->class_type == MAT_C_CHAR ? "is a char array" : "is not a cell array") +
+             "; give a cell array of char strings, one per row (cellstr(x) in MATLAB; a NumPy "
+             "array of dtype=object for scipy.io.savemat)");
+  }
+  std::vector<std::string> values(Length(path, *var));
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    values[i] = CharText(path, name, i + 1, Mat_VarGetCell(var, static_cast<int>(i)));
+  }
+  return values;
+}
+
+// A numeric column: a real double vector, as round-trip text.
+std::vector<std::string> ReadNumbers(const std::string& path, const matvar_t& var) {
+  if (var.class_type != MAT_C_DOUBLE || var.isComplex || var.isLogical) {
+    Fail(path, var.name, 0,
+         "is not a real double array; give the numbers as doubles (double(x) in MATLAB; a "
+         "float64 NumPy array)");
+  }
+  std::vector<std::string> values(Length(path, var));
+  if (var.data_size != sizeof(double) || var.nbytes < values.size() * sizeof(double) ||
+      (!values.empty() && var.data == nullptr)) {
+    Fail(path, var.name, 0, "the values cannot be read; save the vector again");
+  }
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    values[i] = FormatRoundTrip(static_cast<const double*>(var.data)[i]);
+  }
+  return values;
+}
+
+// Reads every variable into `table`; throws on an unknown or missing one.
+void ReadTable(const std::string& path, mat_t* mat, Table* table, std::vector<bool>* given) {
+  std::vector<std::string> names;
+  while (MatVar info{Mat_VarReadNextInfo(mat)}) {
+    if (info->name != nullptr) names.emplace_back(info->name);
+  }
+  for (const std::string& name : names) {
+    const auto column = std::find(kColumns.begin(), kColumns.end(), name);
+    if (column == kColumns.end()) Fail(path, name, 0, std::string("unknown variable; ") + kLayout);
+    const auto index = static_cast<std::size_t>(column - kColumns.begin());
+    MatVar var{Mat_VarRead(mat, name.c_str())};
+    if (!var) Fail(path, name, 0, "cannot be read; save the file again");
+    (*table)[index] = index < kNumText ? ReadText(path, var.get()) : ReadNumbers(path, *var);
+    (*given)[index] = true;
+  }
+  for (int i = 0; i < kNumRequired; ++i) {
+    if (!(*given)[i]) Fail(path, kColumns[i], 0, std::string("is missing; ") + kLayout);
+  }
+  if ((*given)[5] && (*given)[6]) {
+    Fail(path, "phase_rad", 0, "the file has both phase_deg and phase_rad; keep one of them");
+  }
+  for (std::size_t i = 0; i < kColumns.size(); ++i) {
+    if ((*given)[i] && (*table)[i].size() != (*table)[0].size()) {
+      Fail(path, kColumns[i], 0,
+           "has " + std::to_string((*table)[i].size()) + " values but sweep has " +
+               std::to_string((*table)[0].size()) + "; give every variable one value per row");
+    }
+  }
+  if ((*table)[0].empty()) Fail(path, "sweep", 0, "is empty; give one row per dwell");
+}
+
+// An error of the row checks, reworded for a MAT file: "variable 'a', row 5".
+[[noreturn]] void Reword(const std::string& path, const InputError& error) {
+  std::string what = error.what();
+  std::string prefix = path + (error.line() > 0 ? ":" + std::to_string(error.line()) : "") + ": ";
+  if (!error.field().empty()) prefix += "field '" + error.field() + "': ";
+  if (what.compare(0, prefix.size(), prefix) == 0) what.erase(0, prefix.size());
+  for (std::size_t at = what.find("line "); at != std::string::npos; at = what.find("line ", at)) {
+    what.replace(at, 5, "row ");
+  }
+  Fail(path, error.field(), static_cast<std::size_t>(std::max(error.line(), 0)), what);
+}
+
+}  // namespace
+
+bool IsMatFileName(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string extension = path.substr(path.size() - 4);
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return extension == ".mat";
+}
+
+LoadedSweeps LoadSweepsMat(const std::string& path) {
+  const std::string not_a_file = NotARegularFile(path);
+  if (!not_a_file.empty()) Fail(path, "", 0, not_a_file + "; give the path of a sweeps MAT file");
+  if (!std::ifstream(path, std::ios::binary)) {
+    Fail(path, "", 0, "cannot open the file; check the path and permissions");
+  }
+  MatFile mat{Mat_Open(path.c_str(), MAT_ACC_RDONLY)};
+  if (!mat) {
+    Fail(path, "", 0,
+         "is not a MAT file that libmatio reads (v5, v7 or v7.3); save it with MATLAB's save or "
+         "scipy.io.savemat");
+  }
+  Table table;
+  std::vector<bool> given(kColumns.size(), false);
+  ReadTable(path, mat.get(), &table, &given);
+  mat.reset();
+  std::size_t next = 0;
+  std::array<char * SweepRowFields::*, kColumns.size()> members = {
+      &SweepRowFields::sweep,     &SweepRowFields::direction, &SweepRowFields::freq_hz,
+      &SweepRowFields::a_base,    &SweepRowFields::a,         &SweepRowFields::phase_deg,
+      &SweepRowFields::phase_rad, &SweepRowFields::sigma};
+  try {
+    return LoadSweepsFromRows(path, 0, [&](SweepRowFields* row, int* line) {
+      if (next == table[0].size()) return false;
+      for (std::size_t i = 0; i < kColumns.size(); ++i) {
+        row->*members[i] = given[i] ? table[i][next].data() : nullptr;
+      }
+      *line = static_cast<int>(++next);
+      return true;
+    });
+  } catch (const InputError& error) {
+    Reword(path, error);
+  }
+}
+
+}  // namespace dwellfit
