@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -39,24 +40,27 @@ using Table = std::array<std::vector<std::string>, kColumns.size()>;
 }
 
 // The number of values of a vector (either orientation; 0 x 0 is empty).
-std::size_t Length(const std::string& path, const matvar_t& var) {
-  if (var.rank == 2 && (var.dims[0] == 0 || var.dims[1] == 0)) return 0;
-  if (var.rank != 2 || (var.dims[0] != 1 && var.dims[1] != 1)) {
+std::size_t Length(const std::string& path, const std::string& name, std::size_t row,
+                   const matvar_t& var) {
+  const bool matrix = var.rank == 2 && var.dims != nullptr;
+  if (matrix && (var.dims[0] == 0 || var.dims[1] == 0)) return 0;
+  if (!matrix || (var.dims[0] != 1 && var.dims[1] != 1)) {
     std::string shape;
-    for (int i = 0; i < var.rank; ++i) shape += (i ? " x " : "") + std::to_string(var.dims[i]);
-    Fail(path, var.name ? var.name : "", 0,
-         "is a " + shape + " array; give a vector, one value per row (x(:) in MATLAB)");
+    for (int i = 0; var.dims != nullptr && i < var.rank; ++i) {
+      shape += (i ? " x " : "") + std::to_string(var.dims[i]);
+    }
+    Fail(path, name, row, "is a " + shape + " array; give a vector (x(:) in MATLAB)");
   }
   return var.dims[0] * var.dims[1];
 }
 
 // The text of a char array (UTF-8, or UTF-16 code units of the BMP).
-std::string CharText(const std::string& path, const char* name, std::size_t row,
+std::string CharText(const std::string& path, const std::string& name, std::size_t row,
                      const matvar_t* cell) {
   if (cell == nullptr || cell->class_type != MAT_C_CHAR) {
     Fail(path, name, row, "is not a char string; give each row's text as a char string");
   }
-  const std::size_t n = Length(path, *cell);
+  const std::size_t n = Length(path, name, row, *cell);
   if (n > 0 && cell->dims[0] != 1) Fail(path, name, row, "give the text as one row of chars");
   std::string text;
   const bool wide = cell->data_size == 2;
@@ -80,15 +84,14 @@ std::string CharText(const std::string& path, const char* name, std::size_t row,
 }
 
 // A text column: a cell array of char strings.
-std::vector<std::string> ReadText(const std::string& path, matvar_t* var) {
-  const char* name = var->name;
+std::vector<std::string> ReadText(const std::string& path, const std::string& name, matvar_t* var) {
   if (var->class_type != MAT_C_CELL) {
     Fail(path, name, 0,
          std::string(var->class_type == MAT_C_CHAR ? "is a char array" : "is not a cell array") +
              "; give a cell array of char strings, one per row (cellstr(x) in MATLAB; a NumPy "
              "array of dtype=object for scipy.io.savemat)");
   }
-  std::vector<std::string> values(Length(path, *var));
+  std::vector<std::string> values(Length(path, name, 0, *var));
   for (std::size_t i = 0; i < values.size(); ++i) {
     values[i] = CharText(path, name, i + 1, Mat_VarGetCell(var, static_cast<int>(i)));
   }
@@ -96,16 +99,17 @@ std::vector<std::string> ReadText(const std::string& path, matvar_t* var) {
 }
 
 // A numeric column: a real double vector, as round-trip text.
-std::vector<std::string> ReadNumbers(const std::string& path, const matvar_t& var) {
+std::vector<std::string> ReadNumbers(const std::string& path, const std::string& name,
+                                     const matvar_t& var) {
   if (var.class_type != MAT_C_DOUBLE || var.isComplex || var.isLogical) {
-    Fail(path, var.name, 0,
+    Fail(path, name, 0,
          "is not a real double array; give the numbers as doubles (double(x) in MATLAB; a "
          "float64 NumPy array)");
   }
-  std::vector<std::string> values(Length(path, var));
+  std::vector<std::string> values(Length(path, name, 0, var));
   if (var.data_size != sizeof(double) || var.nbytes < values.size() * sizeof(double) ||
       (!values.empty() && var.data == nullptr)) {
-    Fail(path, var.name, 0, "the values cannot be read; save the vector again");
+    Fail(path, name, 0, "the values cannot be read; save the vector again");
   }
   for (std::size_t i = 0; i < values.size(); ++i) {
     values[i] = FormatRoundTrip(static_cast<const double*>(var.data)[i]);
@@ -115,9 +119,19 @@ std::vector<std::string> ReadNumbers(const std::string& path, const matvar_t& va
 
 // Reads every variable into `table`; throws on an unknown or missing one.
 void ReadTable(const std::string& path, mat_t* mat, Table* table, std::vector<bool>* given) {
+  // zlib inflates at most 1032-fold: a variable claiming more values is damaged
+  // (and would make libmatio allocate for them).
+  std::error_code error;
+  const double max_values = 1032.0 * static_cast<double>(std::filesystem::file_size(path, error));
   std::vector<std::string> names;
   while (MatVar info{Mat_VarReadNextInfo(mat)}) {
-    if (info->name != nullptr) names.emplace_back(info->name);
+    if (info->name == nullptr) continue;
+    double values = 1.0;
+    for (int i = 0; info->dims != nullptr && i < info->rank; ++i) values *= info->dims[i];
+    if (values > max_values) {
+      Fail(path, info->name, 0, "claims more values than the file holds; the file is damaged");
+    }
+    names.emplace_back(info->name);
   }
   for (const std::string& name : names) {
     const auto column = std::find(kColumns.begin(), kColumns.end(), name);
@@ -125,7 +139,8 @@ void ReadTable(const std::string& path, mat_t* mat, Table* table, std::vector<bo
     const auto index = static_cast<std::size_t>(column - kColumns.begin());
     MatVar var{Mat_VarRead(mat, name.c_str())};
     if (!var) Fail(path, name, 0, "cannot be read; save the file again");
-    (*table)[index] = index < kNumText ? ReadText(path, var.get()) : ReadNumbers(path, *var);
+    (*table)[index] =
+        index < kNumText ? ReadText(path, name, var.get()) : ReadNumbers(path, name, *var);
     (*given)[index] = true;
   }
   for (int i = 0; i < kNumRequired; ++i) {

@@ -203,7 +203,8 @@ std::string ResultMatBytes(const std::string& result_yaml,
     variables.push_back(FromYaml(name.c_str(), entry.second));
   }
   for (const auto& [file, csv] : csv_files) {
-    const std::string name = ValidName(std::filesystem::path(file).stem().string(), &taken);
+    const std::string name =
+        ValidName(std::filesystem::path(file).stem().string() + "_csv", &taken);
     variables.push_back(FromCsv(name.c_str(), csv));
   }
   const std::string path = TemporaryFile();

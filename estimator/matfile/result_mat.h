@@ -5,7 +5,7 @@
 //       becomes a struct, a list of numbers a double column vector, a list of
 //       text a cell column of char strings, any other list a cell column; a
 //       number a double, true/false a logical, null [] and text a char string
-//   every CSV `<name>.csv`   a struct variable `<name>` of column vectors,
+//   every CSV `<name>.csv`   a struct variable `<name>_csv` of column vectors,
 //       one field per column: a double vector when every non-empty field is
 //       a number (an empty field is NaN), else a cell column of char strings
 // Names that are no MATLAB identifier ("F0.01/up") are made one the way

@@ -6,7 +6,7 @@
 #
 # SECONDS per target; 0 only replays the seeds and regression inputs once.
 # TARGETs: sweep_csv identify_config set_flag dwell_plan trace_set rig_config
-# result_parameters shard_merge uff58 (default: all).
+# result_parameters shard_merge uff58 mat_sweeps (default: all).
 # The fuzzers are taken from $FUZZ_BUILD_DIR (default build-fuzz), a build
 # configured with -DDWELLFIT_BUILD_FUZZERS=ON and built with --target fuzzers.
 # Inputs: tests/fuzz/corpus/<target> and tests/fuzz/regressions/<target>
@@ -26,7 +26,7 @@ seconds=$1
 shift
 targets=("$@")
 ((${#targets[@]} > 0)) || targets=(sweep_csv identify_config set_flag dwell_plan trace_set
-  rig_config result_parameters shard_merge uff58)
+  rig_config result_parameters shard_merge uff58 mat_sweeps)
 build_dir=${FUZZ_BUILD_DIR:-build-fuzz}
 
 # Files under datasets/ that seed each target.
@@ -78,6 +78,7 @@ run_target() {
   local dict=tests/fuzz/dict/yaml.dict
   [[ "${name}" != sweep_csv && "${name}" != trace_set ]] || dict=tests/fuzz/dict/csv.dict
   [[ "${name}" != uff58 ]] || dict=tests/fuzz/dict/uff.dict
+  [[ "${name}" != mat_sweeps ]] || dict=tests/fuzz/dict/mat.dict
   local options=(-timeout=10 -rss_limit_mb=2048 -max_len=8192 -print_final_stats=1
     -dict="${dict}" -artifact_prefix="${findings}/")
   local asan_options status

@@ -231,7 +231,7 @@ TEST(MatSweepsTest, MatrixInsteadOfVector) {
   std::size_t dims[2] = {3, 2};
   vars[4].reset(Mat_VarCreate("a", MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, values, 0));
   EXPECT_THAT(LoadError(WriteMat("matrix", vars)),
-              HasSubstr("variable 'a': is a 3 x 2 array; give a vector, one value per row"));
+              HasSubstr("variable 'a': is a 3 x 2 array; give a vector (x(:) in MATLAB)"));
 }
 
 }  // namespace

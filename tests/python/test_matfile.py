@@ -150,7 +150,7 @@ def test_a_savemat_file_identifies_as_its_csv(dataset, tmp_path):
     csv_names = sorted(name for name in os.listdir(tmp_path / "mat") if name.endswith(".csv"))
     assert {"predictions.csv", "curves.csv", "modal_properties.csv"} <= set(csv_names)
     for name in csv_names:
-        stem = valid_name(name[:-len(".csv")], taken)
+        stem = valid_name(name[:-len(".csv")] + "_csv", taken)
         assert_csv_in_mat(tmp_path / "mat" / name, variables[stem], name)
     assert set(variables) == taken
     classes = {name: kind for name, _, kind in scipy.io.whosmat(tmp_path / "mat" / "result.mat")}
