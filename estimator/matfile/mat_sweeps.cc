@@ -54,23 +54,27 @@ std::size_t Length(const std::string& path, const std::string& name, std::size_t
   return var.dims[0] * var.dims[1];
 }
 
-// The text of a char array (UTF-8, or UTF-16 code units of the BMP).
-std::string CharText(const std::string& path, const std::string& name, std::size_t row,
-                     const matvar_t* cell) {
-  if (cell == nullptr || cell->class_type != MAT_C_CHAR) {
+// Throws unless `var` is a char array whose data hold all its chars.
+void CheckChars(const std::string& path, const std::string& name, std::size_t row,
+                const matvar_t* var) {
+  if (var == nullptr || var->class_type != MAT_C_CHAR || var->rank != 2 || var->dims == nullptr) {
     Fail(path, name, row, "is not a char string; give each row's text as a char string");
   }
-  const std::size_t n = Length(path, name, row, *cell);
-  if (n > 0 && cell->dims[0] != 1) Fail(path, name, row, "give the text as one row of chars");
-  std::string text;
-  const bool wide = cell->data_size == 2;
-  if ((cell->data_size != 1 && !wide) || cell->nbytes < n * cell->data_size ||
-      (n > 0 && cell->data == nullptr)) {
+  const std::size_t n = var->dims[0] * var->dims[1];
+  if ((var->data_size != 1 && var->data_size != 2) || var->nbytes < n * var->data_size ||
+      (n > 0 && var->data == nullptr)) {
     Fail(path, name, row, "the chars cannot be read; save the text as a char string");
   }
-  for (std::size_t i = 0; i < n; ++i) {
-    const unsigned unit = wide ? static_cast<const std::uint16_t*>(cell->data)[i]
-                               : static_cast<const unsigned char*>(cell->data)[i];
+}
+
+// Chars [begin, end) in steps of `step` of a char array, as UTF-8 (its
+// bytes, or UTF-16 code units of the BMP).
+std::string Chars(const matvar_t& var, std::size_t begin, std::size_t end, std::size_t step) {
+  std::string text;
+  for (std::size_t i = begin; i < end; i += step) {
+    const bool wide = var.data_size == 2;
+    const unsigned unit = wide ? static_cast<const std::uint16_t*>(var.data)[i]
+                               : static_cast<const unsigned char*>(var.data)[i];
     if (unit < 0x80 || !wide) {
       text += static_cast<char>(unit);
     } else if (unit < 0x800) {
@@ -83,17 +87,30 @@ std::string CharText(const std::string& path, const std::string& name, std::size
   return text;
 }
 
-// A text column: a cell array of char strings.
+// A text column: a cell array of char strings, or a char matrix of one row
+// per row (column-major; padding spaces and NULs at the end cut off).
 std::vector<std::string> ReadText(const std::string& path, const std::string& name, matvar_t* var) {
+  if (var->class_type == MAT_C_CHAR) {
+    CheckChars(path, name, 0, var);
+    const std::size_t rows = var->dims[0], end = rows * var->dims[1];
+    std::vector<std::string> values(rows);
+    for (std::size_t i = 0; i < rows; ++i) {
+      values[i] = Chars(*var, i, end, rows);
+      values[i].erase(values[i].find_last_not_of(std::string(" \0", 2)) + 1);
+    }
+    return values;
+  }
   if (var->class_type != MAT_C_CELL) {
     Fail(path, name, 0,
-         std::string(var->class_type == MAT_C_CHAR ? "is a char array" : "is not a cell array") +
-             "; give a cell array of char strings, one per row (cellstr(x) in MATLAB; a NumPy "
-             "array of dtype=object for scipy.io.savemat)");
+         "is neither a cell array nor a char matrix; give a cell array of char strings, one per "
+         "row (cellstr(x) in MATLAB; a NumPy array of dtype=object for scipy.io.savemat)");
   }
   std::vector<std::string> values(Length(path, name, 0, *var));
   for (std::size_t i = 0; i < values.size(); ++i) {
-    values[i] = CharText(path, name, i + 1, Mat_VarGetCell(var, static_cast<int>(i)));
+    const matvar_t* cell = Mat_VarGetCell(var, static_cast<int>(i));
+    CheckChars(path, name, i + 1, cell);
+    if (cell->dims[0] > 1) Fail(path, name, i + 1, "give the text as one row of chars");
+    values[i] = Chars(*cell, 0, cell->dims[0] * cell->dims[1], 1);
   }
   return values;
 }

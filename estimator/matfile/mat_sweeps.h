@@ -3,7 +3,8 @@
 //
 // One variable per column of the sweeps CSV (estimator/data/sweep_csv.h), of
 // the same name, meaning and unit, each holding one value per row:
-//   sweep, direction     cell arrays of char strings (ids; 'up' or 'down')
+//   sweep, direction     cell arrays of char strings (ids; 'up' or 'down'), or
+//                        char matrices of one row each (padding cut off)
 //   freq_hz, a_base, a   double vectors (freq_hz in Hz)
 //   phase_deg | phase_rad, sigma   optional double vectors
 // Vectors may be columns or rows; all have the same length. Any other
