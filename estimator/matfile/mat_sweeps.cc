@@ -7,6 +7,7 @@
 #include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/data/sweep_csv_writer.h"
 #include "dwellfit/estimator/matfile/mat_handles.h"
+#include "dwellfit/estimator/matfile/mat_v5_check.h"
 
 namespace dwellfit {
 namespace {
@@ -200,9 +202,10 @@ bool IsMatFileName(const std::string& path) {
 LoadedSweeps LoadSweepsMat(const std::string& path) {
   const std::string not_a_file = NotARegularFile(path);
   if (!not_a_file.empty()) Fail(path, "", 0, not_a_file + "; give the path of a sweeps MAT file");
-  if (!std::ifstream(path, std::ios::binary)) {
-    Fail(path, "", 0, "cannot open the file; check the path and permissions");
-  }
+  std::ifstream stream(path, std::ios::binary);
+  if (!stream) Fail(path, "", 0, "cannot open the file; check the path and permissions");
+  const std::string damage = CheckMatV5(std::string(std::istreambuf_iterator<char>(stream), {}));
+  if (!damage.empty()) Fail(path, "", 0, "the file is damaged (" + damage + "); save it again");
   MatFile mat{Mat_Open(path.c_str(), MAT_ACC_RDONLY)};
   if (!mat) {
     Fail(path, "", 0,
