@@ -146,7 +146,9 @@ void ReadTable(const std::string& path, mat_t* mat, Table* table, std::vector<bo
   while (MatVar info{Mat_VarReadNextInfo(mat)}) {
     if (info->name == nullptr) continue;
     double values = 1.0;
-    for (int i = 0; info->dims != nullptr && i < info->rank; ++i) values *= info->dims[i];
+    for (int i = 0; info->dims != nullptr && i < info->rank; ++i) {
+      values *= std::max<double>(static_cast<double>(info->dims[i]), 1.0);  // N x 0 too
+    }
     if (values > max_values) {
       Fail(path, info->name, 0, "claims more values than the file holds; the file is damaged");
     }
@@ -204,9 +206,10 @@ LoadedSweeps LoadSweepsMat(const std::string& path) {
   if (!not_a_file.empty()) Fail(path, "", 0, not_a_file + "; give the path of a sweeps MAT file");
   std::ifstream stream(path, std::ios::binary);
   if (!stream) Fail(path, "", 0, "cannot open the file; check the path and permissions");
-  const std::string damage = CheckMatV5(std::string(std::istreambuf_iterator<char>(stream), {}));
+  const std::string bytes(std::istreambuf_iterator<char>(stream), {});
+  const std::string damage = CheckMatV5(bytes);
   if (!damage.empty()) Fail(path, "", 0, "the file is damaged (" + damage + "); save it again");
-  MatFile mat{Mat_Open(path.c_str(), MAT_ACC_RDONLY)};
+  MatFile mat{HasMatHeader(bytes) ? Mat_Open(path.c_str(), MAT_ACC_RDONLY) : nullptr};
   if (!mat) {
     Fail(path, "", 0,
          "is not a MAT file that libmatio reads (v5, v7 or v7.3); save it with MATLAB's save or "

@@ -79,7 +79,7 @@ std::string CheckMatrix(const Bytes& bytes, std::size_t at, std::size_t end, int
   }
   std::uint32_t value_type = 0;
   std::size_t values = 0, value_bytes = 0;
-  if (count == 0) return "";
+  if (at >= end) return count == 0 ? "" : "an array's values are missing";
   if (std::string e = NextElement(bytes, &at, end, &value_type, &values, &value_bytes);
       !e.empty()) {
     return e;
@@ -108,11 +108,13 @@ bool Inflate(const unsigned char* data, std::size_t size, std::size_t limit, std
 
 }  // namespace
 
+bool HasMatHeader(const std::string& file) {
+  return file.size() >= 128 && file[124] + file[125] <= 2 && file[124] + file[125] >= 1 &&
+         (file.compare(126, 2, "IM") == 0 || file.compare(126, 2, "MI") == 0);
+}
+
 std::string CheckMatV5(const std::string& file) {
-  if (file.size() < 128 || file[124] + file[125] != 1 ||
-      (file.compare(126, 2, "IM") != 0 && file.compare(126, 2, "MI") != 0)) {
-    return "";  // not v5: left to libmatio
-  }
+  if (!HasMatHeader(file) || file[124] + file[125] != 1) return "";  // not v5
   const Bytes bytes{reinterpret_cast<const unsigned char*>(file.data()), file[126] == 'M'};
   for (std::size_t at = 128; at < file.size();) {
     std::uint32_t type = 0;

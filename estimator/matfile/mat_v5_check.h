@@ -11,6 +11,12 @@
 
 namespace dwellfit {
 
+// True when `file` starts with the 128-byte header of a v5 or v7.3 file (the
+// version 0x0100 or 0x0200 and the byte-order mark "IM" or "MI"). libmatio
+// would read anything else as a v4 file, allocating what its first bytes
+// claim (a 25-byte file: 2 GB).
+bool HasMatHeader(const std::string& file);
+
 // What is wrong with the v5 file whose bytes are `file`; "" when nothing is,
 // or when it is no v5 file (v7.3 files are HDF5, which checks its own).
 std::string CheckMatV5(const std::string& file);

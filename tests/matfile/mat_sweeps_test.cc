@@ -187,6 +187,18 @@ TEST(MatSweepsTest, NotAMatFile) {
               HasSubstr(path + ": is not a MAT file that libmatio reads (v5, v7 or v7.3)"));
 }
 
+// A v5 file whose first variable claims 2 GB (libmatio would allocate them).
+TEST(MatSweepsTest, DamagedFile) {
+  const std::string path = WriteMat("damaged", Vars(SmallTable()));
+  std::fstream file(path, std::ios::in | std::ios::out | std::ios::binary);
+  file.seekp(128 + 4);  // the first element's byte count, after the 128-byte header
+  file.write("\xFF\xFF\xFF\x7F", 4);
+  file.close();
+  EXPECT_THAT(LoadError(path),
+              HasSubstr(path + ": the file is damaged (an element claims more bytes than the file "
+                               "gives it); save it again"));
+}
+
 TEST(MatSweepsTest, MissingVariable) {
   std::vector<Column> table = SmallTable();
   table.pop_back();
