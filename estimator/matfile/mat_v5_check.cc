@@ -107,15 +107,23 @@ bool Inflate(const unsigned char* data, std::size_t size, std::size_t limit, std
   return status == Z_STREAM_END;
 }
 
+// The header's version: 0x0100 (v5) or 0x0200 (v7.3); 0 for no header.
+unsigned Version(const std::string& file) {
+  if (file.size() < 128) return 0;
+  const auto byte = [&file](std::size_t at) { return static_cast<unsigned char>(file[at]); };
+  if (file.compare(126, 2, "IM") == 0) return byte(125) << 8 | byte(124);
+  if (file.compare(126, 2, "MI") == 0) return byte(124) << 8 | byte(125);
+  return 0;
+}
+
 }  // namespace
 
 bool HasMatHeader(const std::string& file) {
-  return file.size() >= 128 && file[124] + file[125] <= 2 && file[124] + file[125] >= 1 &&
-         (file.compare(126, 2, "IM") == 0 || file.compare(126, 2, "MI") == 0);
+  return Version(file) == 0x0100 || Version(file) == 0x0200;
 }
 
 std::string CheckMatV5(const std::string& file) {
-  if (!HasMatHeader(file) || file[124] + file[125] != 1) return "";  // not v5
+  if (Version(file) != 0x0100) return "";  // not v5
   const Bytes bytes{reinterpret_cast<const unsigned char*>(file.data()), file[126] == 'M'};
   for (std::size_t at = 128; at < file.size();) {
     std::uint32_t type = 0;
