@@ -24,6 +24,9 @@ packages=(
   libfccp-dev
   libboost-dev
   libtbb-dev
+  # MATLAB MAT files (estimator/matfile); SciPy writes and reads them in the tests.
+  libmatio-dev
+  python3-scipy
   gnuplot-nox
   # The library-state check (tests/check_library_state.py).
   python3

@@ -570,6 +570,9 @@ void ReadPresentation(const StrictMap& top, const ConfigSource& source, Identify
   if (const auto value = top.Optional("plot")) {
     StrictMap(*value, source, {"log_amplitude"}).Read("log_amplitude", &config->log_amplitude);
   }
+  if (const auto value = top.Optional("outputs")) {
+    StrictMap(*value, source, {"mat"}).Read("mat", &config->write_mat);
+  }
 }
 
 // The top-level keys; the last three describe the test as run.
@@ -592,6 +595,7 @@ std::vector<std::string> TopLevelKeys() {
           "output_dir",
           "units",
           "plot",
+          "outputs",
           "excitation",
           "response",
           "phase"};
@@ -601,7 +605,7 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
   const StrictMap top(DocumentValue(source), source, TopLevelKeys());
   IdentifyConfig config;
   config.data_files =
-      ReadDataFiles(top.Required("data", "give the CSV file with the sweeps (or a list of files)"),
+      ReadDataFiles(top.Required("data", "give the sweeps file, CSV or .mat (or a list of files)"),
                     source, config_dir);
 
   const ConfigValue fit_value =

@@ -74,6 +74,8 @@ struct IdentifyConfig {
   DataUnits units;
   // `plot: {log_amplitude: true}`: the figures' amplitude axes logarithmic.
   bool log_amplitude = false;
+  // `outputs: {mat: true}`: also write result.mat (docs/matlab.md).
+  bool write_mat = false;
   // The model variants to compare and how (`model_selection:`); unset when
   // the config has no such block. `identify` ignores it; `select_model` runs it.
   std::optional<ModelSelectionConfig> model_selection;

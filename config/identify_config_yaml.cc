@@ -246,6 +246,11 @@ std::string ConfigToYaml(const IdentifyConfig& config, ConfigKeys keys) {
     Put(out, "log_amplitude", true);
     out << YAML::EndMap;
   }
+  if (keys == ConfigKeys::kAll && config.write_mat) {
+    out << YAML::Key << "outputs" << YAML::Value << YAML::BeginMap;
+    Put(out, "mat", true);
+    out << YAML::EndMap;
+  }
   if (keys == ConfigKeys::kAll) Put(out, "output_dir", config.output_dir);
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";

@@ -31,6 +31,9 @@ DEFINE_bool(accept_no_convergence, false,
 DEFINE_bool(figures, true,
             "Render the figures (PNG and SVG) with gnuplot; without, curves.csv and the gnuplot "
             "script figures.gp are still written");
+DEFINE_bool(mat, false,
+            "Also write result.mat (MATLAB v5) beside result.yaml, as the config's outputs: {mat: "
+            "true} does (docs/matlab.md)");
 DEFINE_string(set, "",
               "Overrides any config value: key.path=value[,key.path=value...], each key once, "
               "e.g. initial_guess.mu1=0.3,solver.function_tolerance=1e-12");
@@ -88,6 +91,7 @@ int main(int argc, char** argv) {
         dwellfit::LoadIdentifyConfig(FLAGS_config, OverridesFromFlags());
     dwellfit::IdentifyRunOptions run_options;
     run_options.render_figures = FLAGS_figures;
+    run_options.write_mat = FLAGS_mat;
     const auto outcome = dwellfit::RunIdentify(config, std::cout, run_options);
     const dwellfit::IdentificationResult& result = outcome->report.result;
     const int exit_status = dwellfit::ExitStatusFor(result.status, FLAGS_accept_no_convergence);

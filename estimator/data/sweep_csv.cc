@@ -44,16 +44,7 @@ using CsvReader =
                   io::throw_on_overflow, io::empty_line_comment>;
 
 // One data row, as text; a column absent from the header stays nullptr.
-struct RowFields {
-  char* sweep = nullptr;
-  char* direction = nullptr;
-  char* freq_hz = nullptr;
-  char* a_base = nullptr;
-  char* a = nullptr;
-  char* phase_deg = nullptr;
-  char* phase_rad = nullptr;
-  char* sigma = nullptr;
-};
+using RowFields = SweepRowFields;
 
 // Where in the file a value came from, for error messages.
 struct Location {
@@ -429,13 +420,22 @@ LoadedSweeps LoadSweepsCsv(const std::string& path) {
   std::optional<CsvReader> reader;
   OpenCsv(path, &reader);
   const int header_line = ReadHeader(path, &*reader);
+  return LoadSweepsFromRows(path, header_line, [&](RowFields* fields, int* line) {
+    if (!ReadRow(path, &*reader, fields)) return false;
+    *line = static_cast<int>(reader->get_file_line());
+    return true;
+  });
+}
 
+LoadedSweeps LoadSweepsFromRows(const std::string& path, int header_line,
+                                const SweepRowSource& next_row) {
   std::vector<SweepBuilder> builders;
   std::map<std::pair<std::string, SweepDirection>, size_t> index_of;
   std::size_t current = 0;  // the previous row's sweep in `builders`
   RowFields fields;
-  while (ReadRow(path, &*reader, &fields)) {
-    const Location where{path, static_cast<int>(reader->get_file_line())};
+  int line = 0;
+  while (next_row(&fields, &line)) {
+    const Location where{path, line};
     const RowValues row = ParseRow(where, fields);
     // Rows come sweep by sweep: most belong to the previous row's sweep.
     const bool same_sweep = current < builders.size() && builders[current].sweep.id == row.id &&

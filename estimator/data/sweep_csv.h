@@ -33,6 +33,7 @@
 #ifndef DWELLFIT_ESTIMATOR_DATA_SWEEP_CSV_H_
 #define DWELLFIT_ESTIMATOR_DATA_SWEEP_CSV_H_
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,31 @@ std::string NotARegularFile(const std::string& path);
 // detection reads a sweep ending in missing rows as a jump into missing data).
 // Throws InputError naming file, line and column for any malformed content.
 LoadedSweeps LoadSweepsCsv(const std::string& path);
+
+// One row of a sweeps table as the text of its fields (the columns above); a
+// column the table lacks stays nullptr. Readers of other file formats (the
+// MAT file's, estimator/matfile) hand their rows over as text, so that every
+// source passes the checks of the CSV's rows.
+struct SweepRowFields {
+  char* sweep = nullptr;
+  char* direction = nullptr;
+  char* freq_hz = nullptr;
+  char* a_base = nullptr;
+  char* a = nullptr;
+  char* phase_deg = nullptr;
+  char* phase_rad = nullptr;
+  char* sigma = nullptr;
+};
+
+// Fills the next row and its 1-based position `line` (named in errors);
+// returns false after the last row.
+using SweepRowSource = std::function<bool(SweepRowFields* row, int* line)>;
+
+// What LoadSweepsCsv does after the header, for rows from any source: checks
+// and assembles them into sweeps. Errors name `path` and the row's line
+// (`header_line` when there is no row). The source checks the column set.
+LoadedSweeps LoadSweepsFromRows(const std::string& path, int header_line,
+                                const SweepRowSource& next_row);
 
 }  // namespace dwellfit
 

@@ -12,6 +12,7 @@
 #include "dwellfit/estimator/curves/sweep_curves.h"
 #include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
+#include "dwellfit/estimator/matfile/result_mat.h"
 #include "dwellfit/estimator/run/html_report.h"
 #include "dwellfit/estimator/run/measured_outputs.h"
 #include "dwellfit/estimator/run/output_files.h"
@@ -123,6 +124,18 @@ ModalProperties FitModalProperties(const std::vector<const Sweep*>& fitted,
                                 a_min, a_max);
 }
 
+// result.mat from result.yaml and the CSVs among `files` (docs/matlab.md).
+void AppendResultMat(std::vector<NamedFile>* files) {
+  std::string result_yaml;
+  std::vector<NamedFile> csv_files;
+  for (const NamedFile& file : *files) {
+    const std::string& name = file.first;
+    if (name == "result.yaml") result_yaml = file.second;
+    if (name.size() > 4 && name.compare(name.size() - 4, 4, ".csv") == 0) csv_files.push_back(file);
+  }
+  files->emplace_back("result.mat", ResultMatBytes(result_yaml, csv_files));
+}
+
 }  // namespace
 
 int ExitStatusFor(FitStatus status, bool accept_no_convergence) {
@@ -212,6 +225,7 @@ std::unique_ptr<IdentifyOutcome> ComputeIdentify(const IdentifyConfig& config, s
                                   {"modal_properties.csv", ModalPropertiesCsv(report.modal)}};
   const std::string figures_note = AppendCurvesAndFigures(report, config, std::move(curves), &files,
                                                           out, run_options.render_figures);
+  if (run_options.write_mat || config.write_mat) AppendResultMat(&files);
   files.emplace_back(kHtmlReportName, ReportToHtml(report, files, figures_note,
                                                    ModelFormUnits(config.units, config.test)));
   outcome->files = std::move(files);

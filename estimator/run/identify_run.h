@@ -23,6 +23,7 @@ struct IdentifyOutcome {
 
 struct IdentifyRunOptions {
   bool render_figures = true;  // gnuplot's images (curves.csv and figures.gp either way)
+  bool write_mat = false;      // result.mat too (as does the config's outputs: {mat: true})
 };
 
 // Runs the identification and writes its files; prints the config in effect

@@ -11,6 +11,7 @@
 #include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/data/sweep_csv.h"
 #include "dwellfit/estimator/fit/initial_guess.h"
+#include "dwellfit/estimator/matfile/mat_sweeps.h"
 
 namespace dwellfit {
 namespace {
@@ -20,7 +21,7 @@ std::vector<Sweep> LoadSweeps(const std::vector<std::string>& data_files) {
   std::vector<Sweep> sweeps;
   std::map<std::string, std::string> file_of_sweep;
   for (const std::string& file : data_files) {
-    LoadedSweeps loaded = LoadSweepsCsv(file);
+    LoadedSweeps loaded = IsMatFileName(file) ? LoadSweepsMat(file) : LoadSweepsCsv(file);
     for (Sweep& sweep : loaded.sweeps) {
       const auto [it, inserted] = file_of_sweep.emplace(sweep.Name(), file);
       if (!inserted) {

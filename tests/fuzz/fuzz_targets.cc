@@ -15,6 +15,7 @@ const std::vector<FuzzTarget>& AllFuzzTargets() {
       {"result_parameters", &ResultParametersBody, ""},
       {"shard_merge", &ShardMergeBody, ""},
       {"uff58", &Uff58Body, ""},
+      {"mat_sweeps", &MatSweepsBody, ""},
   };
   return targets;
 }

@@ -51,6 +51,10 @@ void ShardMergeBody(const std::uint8_t* data, std::size_t size);
 // AppendUff58.
 void Uff58Body(const std::uint8_t* data, std::size_t size);
 
+// The input as a sweeps MAT file (LoadSweepsMat); accepted sweeps hold
+// positive, finite dwells, as LoadSweepsCsv's.
+void MatSweepsBody(const std::uint8_t* data, std::size_t size);
+
 struct FuzzTarget {
   std::string name;  // tests/fuzz/corpus/<name>, tests/fuzz/regressions/<name>
   FuzzBody body;
