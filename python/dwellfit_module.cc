@@ -23,6 +23,8 @@
 #include "dwellfit/estimator/common/version.h"
 #include "dwellfit/estimator/curves/response_curve.h"
 #include "dwellfit/estimator/data/sweep_csv.h"
+#include "dwellfit/estimator/design/next_dwell_run.h"
+#include "dwellfit/estimator/matfile/mat_sweeps.h"
 #include "dwellfit/estimator/run/identify_run.h"
 #include "dwellfit/estimator/simulation/dwell_simulator.h"
 
@@ -149,7 +151,7 @@ py::dict PyLoadSweeps(const std::string& path) {
   LoadedSweeps loaded;
   {
     py::gil_scoped_release release;
-    loaded = LoadSweepsCsv(path);
+    loaded = IsMatFileName(path) ? LoadSweepsMat(path) : LoadSweepsCsv(path);
   }
   std::vector<const Sweep*> sweeps;
   for (const Sweep& sweep : loaded.sweeps) sweeps.push_back(&sweep);
@@ -206,6 +208,69 @@ py::dict PyCurve(const std::map<std::string, double>& parameters, const std::str
   return out;
 }
 
+// next_dwell on a config (as identify's): the fit of the dwells so far and
+// the candidates ranked best first, as columns.
+py::dict PyNextDwell(const std::string& path, const std::string& text, const std::string& base_dir,
+                     const Overrides& overrides, const std::string& state,
+                     const std::string& limits, const std::string& target, double noise_sigma,
+                     int segment_dwells, double settle_time_constants, double recording_seconds) {
+  NextDwellRequest request;
+  request.state = ParseRigState(state, "state");
+  request.limits_text = limits;
+  std::string error;
+  if (!ParseDesignTarget(target, &request.options.target, &error)) {
+    throw InputError("target", 0, "", error);
+  }
+  request.options.noise_sigma = noise_sigma;
+  request.options.segment_dwells = segment_dwells;
+  request.options.settle_time_constants = settle_time_constants;
+  request.options.recording_seconds = recording_seconds;
+  if (!request.options.IsValid(&error)) throw InputError("next_dwell", 0, "", error);
+  request.render_figures = false;
+  std::unique_ptr<NextDwellOutcome> outcome;
+  std::ostringstream printed;
+  {
+    py::gil_scoped_release release;
+    const IdentifyConfig config = LoadConfig(path, text, base_dir, overrides);
+    outcome = std::make_unique<NextDwellOutcome>(ComputeNextDwell(config, request, printed));
+  }
+  std::vector<double> freq_hz, level, amplitude, settle, record, gain, gain_per_second;
+  std::vector<std::string> branch;
+  std::vector<int> dwells;
+  std::vector<bool> jumps;
+  for (const Candidate& c : outcome->recommendation.ranked) {
+    freq_hz.push_back(c.frequency_hz);
+    level.push_back(c.level);
+    dwells.push_back(c.dwells);
+    branch.push_back(BranchName(c.branch));
+    jumps.push_back(c.jumps);
+    amplitude.push_back(c.amplitude);
+    settle.push_back(c.settle_seconds);
+    record.push_back(c.record_seconds);
+    gain.push_back(c.gain);
+    gain_per_second.push_back(c.gain_per_second);
+  }
+  py::dict candidates;
+  candidates["freq_hz"] = py::array(py::cast(freq_hz));
+  candidates["level"] = py::array(py::cast(level));
+  candidates["dwells"] = py::array(py::cast(dwells));
+  candidates["branch"] = branch;
+  candidates["jumps"] = py::array(py::cast(jumps));
+  candidates["a"] = py::array(py::cast(amplitude));
+  candidates["settle_seconds"] = py::array(py::cast(settle));
+  candidates["record_seconds"] = py::array(py::cast(record));
+  candidates["gain"] = py::array(py::cast(gain));
+  candidates["gain_per_second"] = py::array(py::cast(gain_per_second));
+  py::dict out;
+  out["status"] = FitStatusName(outcome->fit.status);
+  out["message"] = outcome->fit.message;
+  out["parameters"] = ByParameter(outcome->fit.parameters);
+  out["target"] = outcome->recommendation.target.Name();
+  out["candidates"] = candidates;
+  out["printed"] = printed.str();
+  return out;
+}
+
 // The dwells a plan (plan YAML text, or a file when `text` is empty) makes.
 py::dict PySimulate(const std::string& path, const std::string& text) {
   std::vector<Sweep> sweeps;
@@ -236,6 +301,10 @@ PYBIND11_MODULE(_dwellfit, m) {
   m.def("load_sweeps", &dwellfit::PyLoadSweeps, py::arg("path"));
   m.def("curve", &dwellfit::PyCurve, py::arg("parameters"), py::arg("kind"), py::arg("held"),
         py::arg("low"), py::arg("high"), py::arg("points_per_side"));
+  m.def("next_dwell", &dwellfit::PyNextDwell, py::arg("path"), py::arg("text"),
+        py::arg("base_dir"), py::arg("overrides"), py::arg("state"), py::arg("limits"),
+        py::arg("target"), py::arg("noise_sigma"), py::arg("segment_dwells"),
+        py::arg("settle_time_constants"), py::arg("recording_seconds"));
   m.def("simulate", &dwellfit::PySimulate, py::arg("path"), py::arg("text"));
   m.attr("__version__") = dwellfit::DwellfitVersion();
 }

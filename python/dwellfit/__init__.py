@@ -15,7 +15,8 @@ import os
 from ._dwellfit import InputError, __version__
 from . import _dwellfit
 
-__all__ = ["InputError", "identify", "load_sweeps", "curve", "simulate", "__version__"]
+__all__ = ["InputError", "identify", "load_sweeps", "next_dwell", "curve", "simulate",
+           "__version__"]
 
 
 def _overrides(overrides):
@@ -50,9 +51,41 @@ def identify(config, *, overrides=None, output_dir=None, figures=False, base_dir
 
 
 def load_sweeps(path):
-    """The dwells of a sweeps CSV as columns (sweep, direction, kind: lists;
+    """The dwells of a sweeps CSV or .mat file (docs/matlab.md) as columns (sweep, direction, kind: lists;
     freq_hz, a_base, a: NumPy arrays), checked as identify checks them."""
     return _dwellfit.load_sweeps(os.fspath(path))
+
+
+def _key_values(value):
+    """{"f_hz": 41.5, "branch": "upper"} as "f_hz=41.5,branch=upper"; text as is."""
+    if isinstance(value, dict):
+        return ",".join(f"{key}={item}" for key, item in value.items())
+    return value or ""
+
+
+def next_dwell(config, state, *, limits=None, target="d_optimal", noise_sigma=0.0,
+               segment_dwells=1, settle_time_constants=5.0, recording_seconds=2.0,
+               overrides=None, base_dir="."):
+    """Where to dwell next (docs/next-dwell.md), as the next_dwell tool: fits
+    `config` (a path or a dict, as identify) and ranks the candidate dwells
+    from `state` (dict or text: f_hz, level, branch) within `limits` (dict or
+    text: f_min_hz, f_max_hz, f_step_min_hz, f_step_max_hz, level_min,
+    level_max, level_step_min, level_step_max; the rest from the fitted
+    sweeps) by the expected gain in `target` per second of test time.
+
+    Returns a dict: status, message, parameters, target, printed (the tool's
+    summary) and candidates, best first (columns: freq_hz, level, dwells,
+    branch, jumps, a, settle_seconds, record_seconds, gain, gain_per_second).
+    """
+    args = (_key_values(state), _key_values(limits), target, float(noise_sigma),
+            int(segment_dwells), float(settle_time_constants), float(recording_seconds))
+    pairs = _overrides(overrides)
+    if isinstance(config, dict):
+        config = dict(config)
+        config.setdefault("output_dir", "dwellfit-output")
+        return _dwellfit.next_dwell("<dict>", json.dumps(config, indent=2), os.fspath(base_dir),
+                                    pairs, *args)
+    return _dwellfit.next_dwell(os.fspath(config), "", "", pairs, *args)
 
 
 def curve(parameters, kind, held, low, high, points_per_side=400):

@@ -134,3 +134,54 @@ def test_simulate_makes_the_plans_dwells():
     sweeps = dwellfit.simulate(plan)
     assert len(sweeps["sweep"]) == sweeps["freq_hz"].shape[0] > 100
     assert np.all(sweeps["a"] > 0)
+
+
+def test_next_dwell_ranks_as_the_tool(tmp_path):
+    tool = os.path.join(os.path.dirname(IDENTIFY), "next_dwell")
+    state = "f_hz=41.5,level=0.01,branch=upper"
+    limits = "f_step_max_hz=2,level_step_max=0.01"
+    subprocess.run([tool, "--config", THESIS, "--state", state, "--limits", limits,
+                    "--noise_sigma", "0.01", "--figures=false", "--output_dir", str(tmp_path)],
+                   check=True, capture_output=True)
+    lines = open(tmp_path / "next_dwell.csv").read().splitlines()
+    header = lines[0].split(",")
+    rows = [dict(zip(header, line.split(","))) for line in lines[1:]]
+    result = dwellfit.next_dwell(THESIS, {"f_hz": 41.5, "level": 0.01, "branch": "upper"},
+                                 limits={"f_step_max_hz": 2, "level_step_max": 0.01},
+                                 noise_sigma=0.01)
+    assert result["status"] == "converged"
+    candidates = result["candidates"]
+    assert len(candidates["freq_hz"]) == len(rows)
+    for i in range(5):
+        # next_dwell.csv prints 10 significant digits.
+        assert candidates["freq_hz"][i] == pytest.approx(float(rows[i]["f_hz"]), rel=1e-9)
+        assert candidates["level"][i] == pytest.approx(float(rows[i]["level"]), rel=1e-9)
+        assert candidates["branch"][i] == rows[i]["branch"]
+        assert candidates["gain_per_second"][i] == pytest.approx(float(rows[i]["gain_per_s"]),
+                                                                 rel=1e-9)
+    assert np.all(np.diff(candidates["gain_per_second"]) <= 0)
+    with pytest.raises(dwellfit.InputError, match="level"):
+        dwellfit.next_dwell(THESIS, "f_hz=41.5")
+
+
+def test_load_sweeps_reads_a_mat_file_as_its_csv(tmp_path):
+    scipy_io = pytest.importorskip("scipy.io")
+    path = os.path.join(SOURCE, "datasets", "thesis-numerical", "sweeps.csv")
+    lines = open(path).read().splitlines()
+    header = lines[0].split(",")
+    rows = [line.split(",") for line in lines[1:]]
+    variables = {}
+    for k, name in enumerate(header):
+        if name in ("sweep", "direction"):
+            cells = np.empty((len(rows), 1), dtype=object)  # a cell array of text
+            for i, row in enumerate(rows):
+                cells[i, 0] = row[k]
+            variables[name] = cells
+        else:
+            variables[name] = np.array([[float(row[k])] for row in rows])
+    scipy_io.savemat(tmp_path / "sweeps.mat", variables)
+    from_csv = dwellfit.load_sweeps(path)
+    from_mat = dwellfit.load_sweeps(tmp_path / "sweeps.mat")
+    assert from_mat["sweep"] == from_csv["sweep"]
+    for column in ("freq_hz", "a_base", "a"):
+        np.testing.assert_array_equal(from_mat[column], from_csv[column])
