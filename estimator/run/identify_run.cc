@@ -180,6 +180,9 @@ std::unique_ptr<IdentifyOutcome> ComputeIdentify(const IdentifyConfig& config, s
     out << run.phase_note << "\n\n";
     if (config.test.estimate_phase_offset) LOG(WARNING) << run.phase_note;
   }
+  if (config.forcing_calibration.has_value())
+    out << "note: forcing_calibration is run by the forcing_calibration tool; identify fits one "
+           "eta_e for every sweep\n\n";
   print_steps(run.guessed_from_data, "automatic initial guess", run.initial_guess_steps);
   print_steps(!run.automatic_start_steps.empty(), "automatic start of the multi-start",
               run.automatic_start_steps);
