@@ -80,13 +80,11 @@ int main(int argc, char** argv) {
     dwellfit::CheckOutputDirectory(FLAGS_output_dir, "--output_dir");
     const dwellfit::DesignStudyCase study =
         dwellfit::LoadDesignStudyCase(FLAGS_name, FLAGS_config, FLAGS_plan, FLAGS_rig);
-    const dwellfit::DesignStudyResult result =
-        dwellfit::RunDesignStudy(study, options, &std::cerr);
+    const dwellfit::DesignStudyResult result = dwellfit::RunDesignStudy(study, options, &std::cerr);
     dwellfit::PrintDesignStudy(result, options, std::cout);
     std::string warning;
-    dwellfit::WriteFilesAtomically(FLAGS_output_dir,
-                                   dwellfit::DesignStudyFiles({result}, options, FLAGS_figures,
-                                                              &warning));
+    dwellfit::WriteFilesAtomically(
+        FLAGS_output_dir, dwellfit::DesignStudyFiles({result}, options, FLAGS_figures, &warning));
     if (!warning.empty()) std::cout << "figures: " << warning << "\n";
     std::cout << "wrote " << FLAGS_output_dir << "/" << dwellfit::kDesignStudyCsvName << "\n";
     return 0;

@@ -111,7 +111,13 @@ StudyFit FitDwells(const DesignStudyCase& study, const Measured& measured,
   fit.dwells = measured.dwells;
   const std::vector<Sweep> sweeps = ProcessedSweeps(measured, study.processing);
   const IdentifyConfig config = FitConfig(study.config, sweeps, start);
-  const ResolvedRun run = ResolveRun(config, sweeps);
+  ResolvedRun run;
+  try {
+    run = ResolveRun(config, sweeps);
+  } catch (const InputError&) {  // too few dwells for the free parameters: no fit yet
+    fit.status = FitStatus::kInvalidInput;
+    return fit;
+  }
   const IdentificationResult result = FitRun(run).best;
   fit.status = result.status;
   if (result.status != FitStatus::kConverged && result.status != FitStatus::kNoConvergence) {
@@ -197,8 +203,8 @@ bool DesignStudyOptions::IsValid(std::string* error) const {
     *error = "seeds, start_step_factor and hysteresis_steps must be >= 1, refit_dwells >= 0";
     return false;
   }
-  if (!(time_budget_seconds > 0.0) || !(frequency_step_max_hz >= 0.0) ||
-      !(level_step_max >= 0.0) || !(settle_time_constants >= 0.0)) {
+  if (!(time_budget_seconds > 0.0) || !(frequency_step_max_hz >= 0.0) || !(level_step_max >= 0.0) ||
+      !(settle_time_constants >= 0.0)) {
     *error =
         "time_budget_seconds must be positive, frequency_step_max_hz, level_step_max and "
         "settle_time_constants >= 0";
@@ -344,7 +350,7 @@ Branch BranchOf(const ParameterVector& estimate, double f_hz, double level, doub
     return Branch::kOnly;
   }
   return std::abs(std::log(a / upper.a)) < std::abs(std::log(a / lower.a)) ? Branch::kUpper
-                                                                          : Branch::kLower;
+                                                                           : Branch::kLower;
 }
 
 DesignTarget TargetOf(int quantity) {
@@ -353,7 +359,7 @@ DesignTarget TargetOf(int quantity) {
     target.kind = TargetKind::kEffectiveNonlinearity;
   } else {
     target.kind = TargetKind::kParameter;
-    target.parameter = quantity == kStudyEtaE ? kEtaE
+    target.parameter = quantity == kStudyEtaE    ? kEtaE
                        : quantity == kStudyOmega ? kNaturalFrequency
                                                  : kMu1;
   }
@@ -425,8 +431,7 @@ ArmRun RunClosedLoop(const DesignStudyCase& study, const DesignStudyOptions& opt
               &measured, &arm);
     Record(FitDwells(study, measured, estimate, options.target, &estimate, &basis), &arm);
     state = {next.frequency_hz, next.level,
-             BranchOf(estimate, next.frequency_hz, next.level,
-                      LastAmplitude(study, measured, id))};
+             BranchOf(estimate, next.frequency_hz, next.level, LastAmplitude(study, measured, id))};
     arm.dwells.back().expected_branch = BranchName(next.branch);
     arm.dwells.back().landed_branch = BranchName(state.branch);
   }
@@ -444,8 +449,8 @@ DesignStudyResult RunDesignStudy(const DesignStudyCase& study, const DesignStudy
   for (int i = 0; i < options.seeds; ++i) {
     const std::uint64_t seed = options.first_seed + i;
     for (bool closed : {false, true}) {
-      ArmRun arm = closed ? RunClosedLoop(study, options, seed)
-                          : RunStandardProtocol(study, options, seed);
+      ArmRun arm =
+          closed ? RunClosedLoop(study, options, seed) : RunStandardProtocol(study, options, seed);
       if (progress) {
         *progress << StringPrintf("%s seed %llu %-11s: %s at %.0f s, %zu dwells, %zu fits\n",
                                   study.name.c_str(), static_cast<unsigned long long>(seed),

@@ -54,11 +54,11 @@ struct PrecisionTarget {
 
 struct DesignStudyOptions {
   PrecisionTarget target;
-  int seeds = 10;                      // >= 1; the rig's noise seeds first_seed, first_seed + 1, ...
+  int seeds = 10;  // >= 1; the rig's noise seeds first_seed, first_seed + 1, ...
   std::uint64_t first_seed = 1;
-  double time_budget_seconds = 7200;   // simulated test time per arm and seed (> 0)
-  int refit_dwells = 0;                // standard: refit every k dwells too (0: per sweep direction)
-  int start_step_factor = 5;           // closed loop: the start's step in plan steps (>= 1)
+  double time_budget_seconds = 7200;  // simulated test time per arm and seed (> 0)
+  int refit_dwells = 0;               // standard: refit every k dwells too (0: per sweep direction)
+  int start_step_factor = 5;          // closed loop: the start's step in plan steps (>= 1)
   // Closed loop: the largest step between dwells [Hz] and of the base level;
   // 0: the plan's whole span (a shaker can go anywhere in one step; the
   // settling cost grows with the step).
@@ -69,8 +69,8 @@ struct DesignStudyOptions {
   // only within this many smallest steps of the present one on each axis, so
   // that the quasi-static landing rule holds (a large step into that range
   // often ends on the other attractor); the best such candidate is taken.
-  int hysteresis_steps = 2;  // >= 1
-  int max_closed_loop_dwells = 2000;   // a guard besides the budget (>= 1)
+  int hysteresis_steps = 2;           // >= 1
+  int max_closed_loop_dwells = 2000;  // a guard besides the budget (>= 1)
   bool IsValid(std::string* error) const;
 };
 

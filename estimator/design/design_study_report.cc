@@ -50,7 +50,8 @@ std::string HalfWidths(const ArmRun& arm) {
     if (!fit->has_intervals) continue;
     std::string text;
     for (int i = 0; i < kStudyQuantities; ++i) {
-      text += StringPrintf("%s%.3g", i ? " " : "", 100.0 * fit->half_width[i] / std::abs(fit->value[i]));
+      text += StringPrintf("%s%.3g", i ? " " : "",
+                           100.0 * fit->half_width[i] / std::abs(fit->value[i]));
     }
     return text;
   }
@@ -67,8 +68,8 @@ void PrintDesignStudy(const DesignStudyResult& result, const DesignStudyOptions&
                         100.0 * options.target.relative_half_width[i]);
   }
   out << StringPrintf("; budget %.0f s\n", options.time_budget_seconds);
-  out << StringPrintf("%-6s %-11s %7s %12s %8s %8s  %-6s %s\n", "seed", "arm", "reached",
-                      "time_s", "dwells", "fits", "covers", "final half-widths % (alpha_e eta_e w mu1)");
+  out << StringPrintf("%-6s %-11s %7s %12s %8s %8s  %-6s %s\n", "seed", "arm", "reached", "time_s",
+                      "dwells", "fits", "covers", "final half-widths % (alpha_e eta_e w mu1)");
   for (std::size_t k = 0; k < result.standard.size(); ++k) {
     for (const ArmRun* arm : {&result.standard[k], &result.closed_loop[k]}) {
       out << StringPrintf("%-6llu %-11s %7s %12.1f %8.0f %8zu  %-6s %s\n",
@@ -78,7 +79,8 @@ void PrintDesignStudy(const DesignStudyResult& result, const DesignStudyOptions&
     }
   }
   const ArmSummary st = Summarise(result.standard), cl = Summarise(result.closed_loop);
-  for (const auto& [name, s] : {std::make_pair("standard", st), std::make_pair("closed_loop", cl)}) {
+  for (const auto& [name, s] :
+       {std::make_pair("standard", st), std::make_pair("closed_loop", cl)}) {
     out << StringPrintf(
         "median %-11s: time to target %.1f s, %.0f dwells; reached in %d of %d seeds; final "
         "intervals cover the truth in %d of %d\n",
@@ -172,9 +174,10 @@ std::string DesignStudyGnuplot(const std::vector<DesignStudyResult>& results,
   gp += StringPrintf("set multiplot layout %zu,1\n", results.size());
   for (const DesignStudyResult& result : results) {
     const std::string c = result.case_name;
-    gp += StringPrintf("set title \"%s: closed loop (red) and standard protocol (blue), "
-                       "%d seeds; target met below 1\"\n",
-                       c.c_str(), options.seeds);
+    gp += StringPrintf(
+        "set title \"%s: closed loop (red) and standard protocol (blue), "
+        "%d seeds; target met below 1\"\n",
+        c.c_str(), options.seeds);
     gp += StringPrintf(
         "plot \"design_study_fits.csv\" skip 1 using (strcol(1) eq \"%s\" && strcol(2) eq "
         "\"standard\" ? $5 : 1/0):8 with linespoints pt 7 ps 0.4 lc rgb \"#3060c0\" "
