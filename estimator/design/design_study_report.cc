@@ -1,5 +1,6 @@
 // design_study's printed table, CSV files and gnuplot figure.
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "dwellfit/estimator/common/string_printf.h"
@@ -21,6 +22,7 @@ double DwellsOrAll(const ArmRun& arm) {
 struct ArmSummary {
   double median_time = 0.0, median_dwells = 0.0;
   int reached = 0, covered = 0, runs = 0;
+  std::array<int, kStudyQuantities> covered_each{};  // seeds whose interval holds the truth
 };
 
 ArmSummary Summarise(const std::vector<ArmRun>& arms) {
@@ -31,6 +33,7 @@ ArmSummary Summarise(const std::vector<ArmRun>& arms) {
     dwells.push_back(DwellsOrAll(arm));
     s.reached += arm.reached ? 1 : 0;
     s.covered += arm.covers_all ? 1 : 0;
+    for (int i = 0; i < kStudyQuantities; ++i) s.covered_each[i] += arm.covers[i] ? 1 : 0;
     ++s.runs;
   }
   s.median_time = Median(times);
@@ -83,8 +86,9 @@ void PrintDesignStudy(const DesignStudyResult& result, const DesignStudyOptions&
        {std::make_pair("standard", st), std::make_pair("closed_loop", cl)}) {
     out << StringPrintf(
         "median %-11s: time to target %.1f s, %.0f dwells; reached in %d of %d seeds; final "
-        "intervals cover the truth in %d of %d\n",
-        name, s.median_time, s.median_dwells, s.reached, s.runs, s.covered, s.runs);
+        "intervals cover the truth in %d of %d (alpha_e %d, eta_e %d, w %d, mu1 %d)\n",
+        name, s.median_time, s.median_dwells, s.reached, s.runs, s.covered, s.runs,
+        s.covered_each[0], s.covered_each[1], s.covered_each[2], s.covered_each[3]);
   }
   out << StringPrintf(
       "closed loop / standard, median time to target: %.3f (bar <= 0.5); closed loop coverage "
@@ -180,7 +184,7 @@ std::string DesignStudyGnuplot(const std::vector<DesignStudyResult>& results,
         c.c_str(), options.seeds);
     gp += StringPrintf(
         "plot \"design_study_fits.csv\" skip 1 using (strcol(1) eq \"%s\" && strcol(2) eq "
-        "\"standard\" ? $5 : 1/0):8 with linespoints pt 7 ps 0.4 lc rgb \"#3060c0\" "
+        "\"standard\" ? $5 : 1/0):8 with points pt 7 ps 0.4 lc rgb \"#3060c0\" "
         "title \"standard\", \\\n"
         "  \"\" skip 1 using (strcol(1) eq \"%s\" && strcol(2) eq \"closed_loop\" ? $5 : "
         "1/0):8 with points pt 7 ps 0.3 lc rgb \"#c03030\" title \"closed loop\", \\\n"
