@@ -123,13 +123,15 @@ StudyFit FitDwells(const DesignStudyCase& study, const Measured& measured,
   if (result.status != FitStatus::kConverged && result.status != FitStatus::kNoConvergence) {
     return fit;
   }
-  *estimate = result.parameters;
   const double omega_ref = config.omega_ref_rad_s.value_or(result.parameters[kNaturalFrequency]);
   std::string why;
   if (!DesignBasisFromFit(run.fitted, run.options, result.parameters, omega_ref, basis, &why)) {
+    // Not the next start: a warm start from an estimate the data cannot
+    // tell apart (a parameter on its bound) stays there.
     fit.status = FitStatus::kUnidentifiable;
     return fit;
   }
+  *estimate = result.parameters;
   fit.has_intervals = true;
   Intervals(*basis, &fit);
   fit.worst_ratio = WorstRatio(fit, target, nullptr);
