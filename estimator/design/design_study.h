@@ -2,7 +2,7 @@
 // (docs/design-study.md): per noise seed, two arms run on VirtualRig
 // (estimator/rig/rig_simulator.h), each dwell's traces processed into a dwell
 // point (ProcessTraces) and fitted by the identify config's fit with every
-// parameter free, from the previous estimate (a warm start):
+// parameter free, from the last estimate that gave intervals (a warm start):
 //
 //   standard    the plan's sweeps (every sweep, each direction as planned,
 //               each sweep from rest, as SimulateRig runs them), refitted at
@@ -13,8 +13,10 @@
 //               `start_step_factor` times their step (and the down directions
 //               when the start's fit gives no covariance), then: the quantity
 //               farthest from its target (largest half-width / target) ->
-//               RecommendNextDwell for it -> that one dwell on the rig -> refit
-//               ..., until the target or the budget.
+//               RecommendNextDwell for it -> its best candidate that is
+//               single-valued or within `hysteresis_steps` smallest steps of
+//               the present dwell -> that one dwell on the rig -> refit ...,
+//               until the target or the budget.
 //
 // The precision target is judged after every fit by its linearised 95 %
 // intervals (the data-only covariance, DesignBasisFromFit): the half-width
