@@ -393,6 +393,11 @@ ArmRun RunClosedLoop(const DesignStudyCase& study, const DesignStudyOptions& opt
   ParameterVector estimate = InitialGuess(study.config);
   DesignBasis basis;
   RunStart(study, options, SweepDirection::kUp, &rig, &measured, &arm);
+  if (arm.dwells.empty()) {
+    throw InputError(study.config.config_path, 0, "fit",
+                     "none of the fitted sweeps is in the plan, so the closed loop has no start; "
+                     "fit sweeps of the plan");
+  }
   Record(FitDwells(study, measured, estimate, options.target, &estimate, &basis), &arm);
   if (!arm.fits.back().has_intervals) {
     RunStart(study, options, SweepDirection::kDown, &rig, &measured, &arm);
