@@ -41,8 +41,9 @@ cmake --build build-sanitize -j"${jobs}"
 # that lighter tests run under the sanitizers too (the beam fit on one and three
 # threads, the profile of beam-selected.yaml, coverage on a few replicas,
 # select_model's verbose run, the model-selection unit tests, the coverage study
-# without guesses, two hundred random starts, four merged sensitivity shards:
-# each has a one-replica or one-shard sibling that runs here), and the packaging
+# without guesses, two hundred random starts, four merged sensitivity shards,
+# the design study's seeds twice over and its tool run: each has a one-replica,
+# one-shard or one-arm sibling that runs here), and the packaging
 # tests (outside projects built against the install) and the browser tests
 # (report.html in Chromium, whose writing the identify tests run) run in the
 # Release step only. Under ASan the two largest took 229 s and 175 s, the rest some 300 s.
@@ -50,7 +51,7 @@ heavy='MeasuredBeamFilesAreByteIdenticalOnOneAndTwoThreads|clamped-beam-27C/beam
 heavy+='UncertaintyCoverage\.|IdentifyOnTheMeasuredBeamReportsProfileIntervals|'
 heavy+='ModelSelectionBeam\.|method_comparison_reproducible|select_model_verbose_shows_ceres'
 heavy+='|WithNoInitialGuessesEveryReplicaConverges|TwoHundredRandomStartsReachTheTruth|'
-heavy+='FourMergedShardsEqualOneRun'
+heavy+='FourMergedShardsEqualOneRun|SameSeedSameStudyAnotherSeedAnother|design_study_virtual_beam'
 UBSAN_OPTIONS=print_stacktrace=1 ctest --test-dir build-sanitize --output-on-failure -j"${jobs}" \
   -E "${heavy}" -LE "packaging|browser"
 
