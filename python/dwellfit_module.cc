@@ -214,18 +214,12 @@ py::dict PyNextDwell(const std::string& path, const std::string& text, const std
                      const Overrides& overrides, const std::string& state,
                      const std::string& limits, const std::string& target, double noise_sigma,
                      int segment_dwells, double settle_time_constants, double recording_seconds) {
-  NextDwellRequest request;
-  request.state = ParseRigState(state, "state");
-  request.limits_text = limits;
-  std::string error;
-  if (!ParseDesignTarget(target, &request.options.target, &error)) {
-    throw InputError("target", 0, "", error);
-  }
-  request.options.noise_sigma = noise_sigma;
-  request.options.segment_dwells = segment_dwells;
-  request.options.settle_time_constants = settle_time_constants;
-  request.options.recording_seconds = recording_seconds;
-  if (!request.options.IsValid(&error)) throw InputError("next_dwell", 0, "", error);
+  DesignOptions options;
+  options.noise_sigma = noise_sigma;
+  options.segment_dwells = segment_dwells;
+  options.settle_time_constants = settle_time_constants;
+  options.recording_seconds = recording_seconds;
+  NextDwellRequest request = MakeNextDwellRequest(state, limits, target, options, "");
   request.render_figures = false;
   std::unique_ptr<NextDwellOutcome> outcome;
   std::ostringstream printed;

@@ -43,20 +43,14 @@ DEFINE_bool(figures, true, "render the figure with gnuplot");
 namespace {
 
 dwellfit::NextDwellRequest RequestFromFlags() {
-  using dwellfit::InputError;
-  dwellfit::NextDwellRequest request;
-  request.state = dwellfit::ParseRigState(FLAGS_state, "--state");
-  request.limits_text = FLAGS_limits;
-  std::string error;
-  if (!dwellfit::ParseDesignTarget(FLAGS_target, &request.options.target, &error)) {
-    throw InputError("--target", 0, "", error);
-  }
-  request.options.settle_time_constants = FLAGS_settle_time_constants;
-  request.options.recording_seconds = FLAGS_recording_seconds;
-  request.options.noise_sigma = FLAGS_noise_sigma;
-  request.options.top = FLAGS_top;
-  request.options.segment_dwells = FLAGS_segment_dwells;
-  if (!request.options.IsValid(&error)) throw InputError("next_dwell flags", 0, "", error);
+  dwellfit::DesignOptions options;
+  options.settle_time_constants = FLAGS_settle_time_constants;
+  options.recording_seconds = FLAGS_recording_seconds;
+  options.noise_sigma = FLAGS_noise_sigma;
+  options.top = FLAGS_top;
+  options.segment_dwells = FLAGS_segment_dwells;
+  dwellfit::NextDwellRequest request =
+      dwellfit::MakeNextDwellRequest(FLAGS_state, FLAGS_limits, FLAGS_target, options, "--");
   request.render_figures = FLAGS_figures;
   return request;
 }

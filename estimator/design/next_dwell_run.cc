@@ -96,6 +96,21 @@ RigState ParseRigState(const std::string& text, const std::string& flag) {
   return state;
 }
 
+NextDwellRequest MakeNextDwellRequest(const std::string& state, const std::string& limits,
+                                      const std::string& target, DesignOptions options,
+                                      const std::string& prefix) {
+  NextDwellRequest request;
+  request.state = ParseRigState(state, prefix + "state");
+  request.limits_text = limits;
+  std::string error;
+  if (!ParseDesignTarget(target, &options.target, &error)) {
+    throw InputError(prefix + "target", 0, "", error);
+  }
+  if (!options.IsValid(&error)) throw InputError("next_dwell options", 0, "", error);
+  request.options = options;
+  return request;
+}
+
 RigLimits LimitsFromSweeps(const std::vector<const Sweep*>& sweeps) {
   std::vector<double> fs, ls;
   for (const Sweep* sweep : sweeps) {

@@ -64,6 +64,15 @@ struct NextDwellOutcome {
 // `out`. Throws InputError on bad input. A fit that failed is returned with
 // its status and no candidates; one without a covariance likewise, with
 // status kUnidentifiable and the reason as its message.
+// The request from its texts, over `options`' numbers: `state` as
+// ParseRigState reads it, `limits` as OverrideLimits does and `target` as
+// ParseDesignTarget does; the options validated here, once. Messages name
+// `prefix` + "state", "target" (e.g. prefix "--" for the tool's flags).
+// Throws InputError.
+NextDwellRequest MakeNextDwellRequest(const std::string& state, const std::string& limits,
+                                      const std::string& target, DesignOptions options,
+                                      const std::string& prefix);
+
 NextDwellOutcome ComputeNextDwell(const IdentifyConfig& config, const NextDwellRequest& request,
                                   std::ostream& out);
 
