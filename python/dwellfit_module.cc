@@ -295,10 +295,10 @@ PYBIND11_MODULE(_dwellfit, m) {
   m.def("load_sweeps", &dwellfit::PyLoadSweeps, py::arg("path"));
   m.def("curve", &dwellfit::PyCurve, py::arg("parameters"), py::arg("kind"), py::arg("held"),
         py::arg("low"), py::arg("high"), py::arg("points_per_side"));
-  m.def("next_dwell", &dwellfit::PyNextDwell, py::arg("path"), py::arg("text"),
-        py::arg("base_dir"), py::arg("overrides"), py::arg("state"), py::arg("limits"),
-        py::arg("target"), py::arg("noise_sigma"), py::arg("segment_dwells"),
-        py::arg("settle_time_constants"), py::arg("recording_seconds"));
+  m.def("next_dwell", &dwellfit::PyNextDwell, py::arg("path"), py::arg("text"), py::arg("base_dir"),
+        py::arg("overrides"), py::arg("state"), py::arg("limits"), py::arg("target"),
+        py::arg("noise_sigma"), py::arg("segment_dwells"), py::arg("settle_time_constants"),
+        py::arg("recording_seconds"));
   m.def("simulate", &dwellfit::PySimulate, py::arg("path"), py::arg("text"));
   m.attr("__version__") = dwellfit::DwellfitVersion();
 }
