@@ -44,16 +44,17 @@ cmake --build build-sanitize -j"${jobs}"
 # without guesses, two hundred random starts, four merged sensitivity shards,
 # the design study's seeds twice over and its tool run: each has a one-replica,
 # one-shard or one-arm sibling that runs here), and the packaging
-# tests (outside projects built against the install) and the browser tests
-# (report.html in Chromium, whose writing the identify tests run) run in the
-# Release step only. Under ASan the two largest took 229 s and 175 s, the rest some 300 s.
+# tests (outside projects built against the install), the browser tests
+# (report.html in Chromium, whose writing the identify tests run) and the Python
+# tests (Debian's interpreter is given to the Release step; the MAT reader's own
+# tests run here) run in the Release step only. Under ASan the two largest took 229 s and 175 s, the rest some 300 s.
 heavy='MeasuredBeamFilesAreByteIdenticalOnOneAndTwoThreads|clamped-beam-27C/beam\.yaml|'
 heavy+='UncertaintyCoverage\.|IdentifyOnTheMeasuredBeamReportsProfileIntervals|'
 heavy+='ModelSelectionBeam\.|method_comparison_reproducible|select_model_verbose_shows_ceres'
 heavy+='|WithNoInitialGuessesEveryReplicaConverges|TwoHundredRandomStartsReachTheTruth|'
 heavy+='FourMergedShardsEqualOneRun|SameSeedSameStudyAnotherSeedAnother|design_study_virtual_beam'
 UBSAN_OPTIONS=print_stacktrace=1 ctest --test-dir build-sanitize --output-on-failure -j"${jobs}" \
-  -E "${heavy}" -LE "packaging|browser"
+  -E "${heavy}" -LE "packaging|browser|python"
 
 step "fuzzers (Clang, libFuzzer, ASan+UBSan)"
 cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
