@@ -53,10 +53,7 @@ heavy+='UncertaintyCoverage\.|IdentifyOnTheMeasuredBeamReportsProfileIntervals|'
 heavy+='ModelSelectionBeam\.|method_comparison_reproducible|select_model_verbose_shows_ceres'
 heavy+='|WithNoInitialGuessesEveryReplicaConverges|TwoHundredRandomStartsReachTheTruth|'
 heavy+='FourMergedShardsEqualOneRun|SameSeedSameStudyAnotherSeedAnother|design_study_virtual_beam'
-# allocator_may_return_null: an impossible allocation fails as outside ASan
-# (libmatio's on a damaged v7.3 file, replayed by fuzz_replay_test; see
-# tests/fuzz/run_fuzzers.sh).
-UBSAN_OPTIONS=print_stacktrace=1 ASAN_OPTIONS=allocator_may_return_null=1 ctest --test-dir build-sanitize --output-on-failure -j"${jobs}" \
+UBSAN_OPTIONS=print_stacktrace=1 ctest --test-dir build-sanitize --output-on-failure -j"${jobs}" \
   -E "${heavy}" -LE "packaging|browser|python"
 
 step "fuzzers (Clang, libFuzzer, ASan+UBSan)"

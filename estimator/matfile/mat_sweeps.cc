@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -14,6 +16,7 @@
 
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/data/sweep_csv_writer.h"
+#include "dwellfit/estimator/matfile/child_process.h"
 #include "dwellfit/estimator/matfile/mat_handles.h"
 #include "dwellfit/estimator/matfile/mat_v5_check.h"
 
@@ -25,6 +28,9 @@ constexpr std::array<const char*, 8> kColumns = {"sweep", "direction", "freq_hz"
                                                  "a",     "phase_deg", "phase_rad", "sigma"};
 constexpr int kNumRequired = 5;
 constexpr int kNumText = 2;
+// The longest a v7.3 file's reading process may take (a file of 24,576 rows
+// with cell arrays of ids: about 1 s).
+constexpr std::chrono::seconds kV73ReadLimit{60};
 
 constexpr char kLayout[] =
     "a sweeps MAT file holds the cell arrays sweep and direction and the double vectors "
@@ -180,6 +186,93 @@ void ReadTable(const std::string& path, mat_t* mat, Table* table, std::vector<bo
   if ((*table)[0].empty()) Fail(path, "sweep", 0, "is empty; give one row per dwell");
 }
 
+// Opens the MAT file `path` (when `has_header`, else reports it is none) and
+// reads its variables into `table`.
+void OpenAndReadTable(const std::string& path, bool has_header, Table* table,
+                      std::vector<bool>* given) {
+  MatFile mat{has_header ? Mat_Open(path.c_str(), MAT_ACC_RDONLY) : nullptr};
+  if (!mat) {
+    Fail(path, "", 0,
+         "is not a MAT file that libmatio reads (v5, v7 or v7.3); save it with MATLAB's save or "
+         "scipy.io.savemat");
+  }
+  ReadTable(path, mat.get(), table, given);
+}
+
+// The table handed from the reading child to the caller: per column a flag
+// byte (given or not), then the count of values and each value, every count
+// and length 8 bytes in the machine's order. An error is 'E' and its text.
+void PutSize(std::size_t size, std::string* out) {
+  out->append(reinterpret_cast<const char*>(&size), sizeof(size));
+}
+bool GetSize(const std::string& in, std::size_t* at, std::size_t* size) {
+  if (in.size() - *at < sizeof(*size)) return false;
+  std::memcpy(size, in.data() + *at, sizeof(*size));
+  *at += sizeof(*size);
+  return true;
+}
+std::string EncodeTable(const Table& table, const std::vector<bool>& given) {
+  std::string out = "T";
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    out += given[i] ? '1' : '0';
+    PutSize(table[i].size(), &out);
+    for (const std::string& value : table[i]) {
+      PutSize(value.size(), &out);
+      out += value;
+    }
+  }
+  return out;
+}
+bool DecodeTable(const std::string& in, Table* table, std::vector<bool>* given) {
+  std::size_t at = 1;
+  for (std::size_t i = 0; i < table->size(); ++i) {
+    std::size_t count = 0;
+    if (at >= in.size()) return false;
+    (*given)[i] = in[at++] == '1';
+    if (!GetSize(in, &at, &count) || count > in.size()) return false;
+    (*table)[i].resize(count);
+    for (std::string& value : (*table)[i]) {
+      std::size_t length = 0;
+      if (!GetSize(in, &at, &length) || in.size() - at < length) return false;
+      value = in.substr(at, length);
+      at += length;
+    }
+  }
+  return at == in.size();
+}
+
+// A v7.3 file is HDF5, which Debian's HDF5 1.10.8 does not parse safely when
+// the file is damaged (out-of-bounds reads, a use-after-free): it is read in a
+// child process (child_process.h), and what becomes of that process becomes a
+// message about the file.
+void ReadTableInChild(const std::string& path, Table* table, std::vector<bool>* given) {
+  const std::string prefix = path + ": ";
+  const ChildOutcome outcome = RunInChildProcess(
+      [&]() -> std::string {
+        Table child_table;
+        std::vector<bool> child_given(kColumns.size(), false);
+        try {
+          OpenAndReadTable(path, true, &child_table, &child_given);
+        } catch (const InputError& error) {
+          return "E" + std::string(error.what());
+        }
+        return EncodeTable(child_table, child_given);
+      },
+      kV73ReadLimit);
+  if (!outcome.completed || outcome.bytes.empty() ||
+      (outcome.bytes[0] == 'T' && !DecodeTable(outcome.bytes, table, given))) {
+    Fail(path, "", 0,
+         "HDF5 could not read this v7.3 file (the reading process " +
+             (outcome.completed ? std::string("handed back no table") : outcome.failure) +
+             "); the file is damaged: save it again, or as v7 (save -v7) or CSV");
+  }
+  if (outcome.bytes[0] == 'E') {
+    const std::string& what = outcome.bytes;
+    const bool prefixed = what.compare(1, prefix.size(), prefix) == 0;
+    throw InputError(path, 0, "", what.substr(prefixed ? 1 + prefix.size() : 1));
+  }
+}
+
 // An error of the row checks, reworded for a MAT file: "variable 'a', row 5".
 [[noreturn]] void Reword(const std::string& path, const InputError& error) {
   std::string what = error.what();
@@ -209,16 +302,13 @@ LoadedSweeps LoadSweepsMat(const std::string& path) {
   const std::string bytes(std::istreambuf_iterator<char>(stream), {});
   const std::string damage = CheckMatV5(bytes);
   if (!damage.empty()) Fail(path, "", 0, "the file is damaged (" + damage + "); save it again");
-  MatFile mat{HasMatHeader(bytes) ? Mat_Open(path.c_str(), MAT_ACC_RDONLY) : nullptr};
-  if (!mat) {
-    Fail(path, "", 0,
-         "is not a MAT file that libmatio reads (v5, v7 or v7.3); save it with MATLAB's save or "
-         "scipy.io.savemat");
-  }
   Table table;
   std::vector<bool> given(kColumns.size(), false);
-  ReadTable(path, mat.get(), &table, &given);
-  mat.reset();
+  if (IsMatV73(bytes)) {
+    ReadTableInChild(path, &table, &given);
+  } else {
+    OpenAndReadTable(path, HasMatHeader(bytes), &table, &given);
+  }
   std::size_t next = 0;
   std::array<char * SweepRowFields::*, kColumns.size()> members = {
       &SweepRowFields::sweep,     &SweepRowFields::direction, &SweepRowFields::freq_hz,

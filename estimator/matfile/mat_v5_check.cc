@@ -122,6 +122,8 @@ bool HasMatHeader(const std::string& file) {
   return Version(file) == 0x0100 || Version(file) == 0x0200;
 }
 
+bool IsMatV73(const std::string& file) { return Version(file) == 0x0200; }
+
 std::string CheckMatV5(const std::string& file) {
   if (Version(file) != 0x0100) return "";  // not v5
   const Bytes bytes{reinterpret_cast<const unsigned char*>(file.data()), file[126] == 'M'};

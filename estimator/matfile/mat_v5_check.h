@@ -17,6 +17,10 @@ namespace dwellfit {
 // claim (a 25-byte file: 2 GB).
 bool HasMatHeader(const std::string& file);
 
+// True when `file` starts with the header of a v7.3 file (version 0x0200):
+// an HDF5 file behind a MAT header.
+bool IsMatV73(const std::string& file);
+
 // What is wrong with the v5 file whose bytes are `file`; "" when nothing is,
 // or when it is no v5 file (v7.3 files are HDF5, which checks its own).
 std::string CheckMatV5(const std::string& file);

@@ -44,22 +44,10 @@ dataset_seeds() {
 # and global checks, leak detection and UBSan stay on; 1000 to 2400 runs/s
 # on two shared cores), and every input of its corpus is then replayed once
 # with all checks.
-#
-# mat_sweeps: libmatio allocates what a v7.3 file's HDF5 metadata claims
-# (1.4e17 bytes for tests/fuzz/regressions/mat_sweeps/v73-hdf5-claims-1e17-bytes.mat).
-# Outside AddressSanitizer malloc returns NULL for such a size and libmatio
-# reports the variable unreadable (identify: "the chars cannot be read"); the
-# target fuzzes and replays with ASan doing the same (allocator_may_return_null).
 fuzzing_asan_options() {
   case "$1" in
     sweep_csv | trace_set) echo "poison_heap=0" ;;
-    mat_sweeps) echo "allocator_may_return_null=1" ;;
   esac
-}
-
-# ASAN_OPTIONS of the replay with all checks.
-replay_asan_options() {
-  [[ "$1" != mat_sweeps ]] || echo "allocator_may_return_null=1"
 }
 
 # Prints "field=value" pairs of a finished run from its log.
@@ -93,25 +81,17 @@ run_target() {
   [[ "${name}" != mat_sweeps ]] || dict=tests/fuzz/dict/mat.dict
   local options=(-timeout=10 -rss_limit_mb=2048 -max_len=8192 -print_final_stats=1
     -dict="${dict}" -artifact_prefix="${findings}/")
-  # mat_sweeps: HDF5 and libmatio reserve what a damaged v7.3 file's metadata
-  # claim (4.3 GB for one 7,896-byte input) without touching it; the Release
-  # identify refuses that file in 0.02 s at 21 MB resident. Single mallocs up to
-  # 16 GB pass; the resident limit stays 2 GB.
-  [[ "${name}" != mat_sweeps ]] || options+=(-malloc_limit_mb=16384)
   local asan_options status
   asan_options=$(fuzzing_asan_options "${name}")
-  # HDF5's own leaks on damaged v7.3 files (tests/fuzz/lsan-mat_sweeps.supp).
-  local lsan_options=${LSAN_OPTIONS:-}
-  [[ "${name}" != mat_sweeps ]] || lsan_options="suppressions=tests/fuzz/lsan-mat_sweeps.supp"
   if ((seconds > 0)); then
-    LSAN_OPTIONS=${lsan_options} ASAN_OPTIONS=${asan_options:-${ASAN_OPTIONS:-}} "${fuzzer}" -max_total_time="${seconds}" "${options[@]}" \
+    ASAN_OPTIONS=${asan_options:-${ASAN_OPTIONS:-}} "${fuzzer}" -max_total_time="${seconds}" "${options[@]}" \
       "${inputs[@]}" >"${log}" 2>&1
     status=$?
     echo "${name}: $(summarize "${log}") time=${seconds}s${asan_options:+ (${asan_options})}"
     report "${name}" "${status}" "${log}" || return 1
   fi
   if ((seconds == 0)) || [[ -n "${asan_options}" ]]; then
-    LSAN_OPTIONS=${lsan_options} ASAN_OPTIONS=$(replay_asan_options "${name}") "${fuzzer}" -runs=0 "${options[@]}" "${inputs[@]}" >"${log}.replay" 2>&1
+    ASAN_OPTIONS= "${fuzzer}" -runs=0 "${options[@]}" "${inputs[@]}" >"${log}.replay" 2>&1
     status=$?
     echo "${name}: replayed with all checks: $(summarize "${log}.replay")"
     report "${name}" "${status}" "${log}.replay" || return 1

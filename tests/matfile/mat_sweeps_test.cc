@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -178,6 +179,37 @@ TEST(MatSweepsTest, ASmallTableOfCellArraysLoadsInV73) {
   ASSERT_EQ(loaded.sweeps.size(), 1u);
   EXPECT_EQ(loaded.sweeps[0].Name(), "F1/up");
   EXPECT_EQ(loaded.sweeps[0].points[2].amplitude, 1.5e-4);
+}
+
+// v7.3 files are read by HDF5 in a child process (child_process.h): a damaged
+// one is refused with a message, whatever HDF5 makes of it, and the caller
+// goes on. Each cut of a good v7.3 file, and each with a byte flipped, must
+// load or be refused; none may end the test.
+TEST(MatSweepsTest, DamagedV73FilesAreRefusedAndTheCallerGoesOn) {
+  const std::string good = WriteMat("damaged73", Vars(SmallTable()), MAT_FT_MAT73);
+  std::ifstream stream(good, std::ios::binary);
+  const std::string bytes(std::istreambuf_iterator<char>(stream), {});
+  ASSERT_GT(bytes.size(), 1024u);
+  const std::string path = ::testing::TempDir() + "dwellfit_mat_sweeps_damaged73_cut.mat";
+  int refused = 0;
+  for (std::size_t size = 512; size < bytes.size(); size += bytes.size() / 16) {
+    std::ofstream(path, std::ios::binary) << bytes.substr(0, size);
+    const std::string error = LoadError(path);
+    if (error == "(no error)") continue;
+    EXPECT_THAT(error, HasSubstr(path + ": ")) << "cut at " << size;
+    ++refused;
+  }
+  EXPECT_GT(refused, 0);
+  for (std::size_t at = 512; at < bytes.size(); at += 97) {
+    std::string flipped = bytes;
+    flipped[at] = static_cast<char>(~flipped[at]);
+    std::ofstream(path, std::ios::binary) << flipped;
+    try {
+      LoadSweepsMat(path);
+    } catch (const InputError& error) {
+      EXPECT_THAT(error.what(), HasSubstr(path + ": ")) << "flipped at " << at;
+    }
+  }
 }
 
 TEST(MatSweepsTest, NotAMatFile) {
