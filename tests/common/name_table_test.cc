@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+
+#include "dwellfit/estimator/analysis/parameter_uncertainty.h"
+#include "dwellfit/estimator/analysis/profile_likelihood.h"
 #include "dwellfit/estimator/data/measured_quantity.h"
 #include "dwellfit/estimator/data/sweep.h"
 #include "dwellfit/estimator/fit/forcing_calibration.h"
@@ -29,29 +33,34 @@ TEST(NameTableTest, AValueOutsideTheTableReadsAsAQuestionMark) {
   EXPECT_STREQ(NameOf(kColourNames, -1), "?");
 }
 
+// `name` reads back as `expected` and is `expected`'s name.
+template <typename Enum>
+void ExpectBothWays(const char* (*name_of)(Enum), bool (*from_name)(const std::string&, Enum*),
+                    const char* name, Enum expected) {
+  EXPECT_STREQ(name_of(expected), name);
+  Enum value = static_cast<Enum>(99);  // no enumerator
+  EXPECT_TRUE(from_name(name, &value)) << name;
+  EXPECT_EQ(value, expected) << name;
+}
+
 // The words of the config files and CSV columns, as docs/ spells them.
 TEST(NameTableTest, TheLibrarysEnumsKeepTheirDocumentedNames) {
-  EXPECT_STREQ(ExcitationName(Excitation::kBaseDisplacement), "base_displacement");
-  EXPECT_STREQ(ResponseName(Response::kAcceleration), "acceleration");
-  EXPECT_STREQ(SweepDirectionName(SweepDirection::kDown), "down");
-  EXPECT_STREQ(HeldOutDwellsName(HeldOutDwells::kBelowHalfPeak), "below_half_peak");
+  ExpectBothWays(ExcitationName, ExcitationFromName, "base_displacement",
+                 Excitation::kBaseDisplacement);
+  ExpectBothWays(ExcitationName, ExcitationFromName, "force", Excitation::kForce);
+  ExpectBothWays(ResponseName, ResponseFromName, "velocity", Response::kVelocity);
+  ExpectBothWays(SweepDirectionName, SweepDirectionFromName, "down", SweepDirection::kDown);
+  ExpectBothWays(HeldOutDwellsName, HeldOutDwellsFromName, "before_jump",
+                 HeldOutDwells::kBeforeJump);
+  ExpectBothWays(JumpTargetName, JumpTargetFromName, "amplitude_jump_down",
+                 JumpTarget::kAmplitudeJumpDown);
+  ExpectBothWays(IntervalMethodName, ParseIntervalMethod, "linearised",
+                 IntervalMethod::kLinearised);
   EXPECT_STREQ(FitStatusName(FitStatus::kUnidentifiable), "unidentifiable");
-  Excitation excitation = Excitation::kBaseAcceleration;
-  EXPECT_TRUE(ExcitationFromName("force", &excitation));
-  EXPECT_EQ(excitation, Excitation::kForce);
+  EXPECT_STREQ(ProfileEndName(ProfileEnd::kOpen), "open");
   Response response = Response::kDisplacement;
-  EXPECT_TRUE(ResponseFromName("velocity", &response));
-  EXPECT_EQ(response, Response::kVelocity);
   EXPECT_FALSE(ResponseFromName("jerk", &response));
-  SweepDirection direction = SweepDirection::kUp;
-  EXPECT_TRUE(SweepDirectionFromName("down", &direction));
-  EXPECT_EQ(direction, SweepDirection::kDown);
-  HeldOutDwells dwells = HeldOutDwells::kBelowHalfPeak;
-  EXPECT_TRUE(HeldOutDwellsFromName("before_jump", &dwells));
-  EXPECT_EQ(dwells, HeldOutDwells::kBeforeJump);
-  JumpTarget target = JumpTarget::kFrequencyJumpUp;
-  EXPECT_TRUE(JumpTargetFromName("amplitude_jump_down", &target));
-  EXPECT_EQ(target, JumpTarget::kAmplitudeJumpDown);
+  EXPECT_EQ(response, Response::kDisplacement);
 }
 
 }  // namespace
