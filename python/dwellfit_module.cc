@@ -10,10 +10,12 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -45,6 +47,23 @@ py::dict ByParameter(const ParameterVector& values) {
   py::dict out;
   for (int i = 0; i < kNumParameters; ++i) out[ParameterName(i)] = values[i];
   return out;
+}
+
+// One result column: value(row) (a function or a member) for each of `rows`,
+// as a NumPy array of numbers or flags, or a list when the values are names
+// (const char*).
+template <typename Row, typename Value>
+py::object Column(const std::vector<Row>& rows, Value value) {
+  using T = std::decay_t<std::invoke_result_t<Value, const Row&>>;
+  if constexpr (std::is_same_v<T, const char*>) {
+    std::vector<std::string> column;
+    for (const Row& row : rows) column.emplace_back(std::invoke(value, row));
+    return py::cast(column);
+  } else {
+    std::vector<T> column;
+    for (const Row& row : rows) column.push_back(std::invoke(value, row));
+    return py::array(py::cast(column));
+  }
 }
 
 // The dwells of `sweeps` as columns: names as lists, numbers as arrays.
@@ -188,23 +207,15 @@ py::dict PyCurve(const std::map<std::string, double>& parameters, const std::str
     py::gil_scoped_release release;
     curve = TraceResponseCurve(p, spec);
   }
-  std::vector<double> freq_hz, a_base, a, phase_rad;
-  std::vector<bool> stable, fold;
-  for (const CurvePoint& point : curve.points) {
-    freq_hz.push_back(RadPerSecondToHz(point.omega_rad_s));
-    a_base.push_back(point.a_base);
-    a.push_back(point.a);
-    phase_rad.push_back(point.phase_rad);
-    stable.push_back(point.stable);
-    fold.push_back(point.fold);
-  }
+  const std::vector<CurvePoint>& points = curve.points;
   py::dict out;
-  out["freq_hz"] = py::array(py::cast(freq_hz));
-  out["a_base"] = py::array(py::cast(a_base));
-  out["a"] = py::array(py::cast(a));
-  out["phase_rad"] = py::array(py::cast(phase_rad));
-  out["stable"] = py::array(py::cast(stable));
-  out["fold"] = py::array(py::cast(fold));
+  out["freq_hz"] =
+      Column(points, [](const CurvePoint& p) { return RadPerSecondToHz(p.omega_rad_s); });
+  out["a_base"] = Column(points, &CurvePoint::a_base);
+  out["a"] = Column(points, &CurvePoint::a);
+  out["phase_rad"] = Column(points, &CurvePoint::phase_rad);
+  out["stable"] = Column(points, &CurvePoint::stable);
+  out["fold"] = Column(points, &CurvePoint::fold);
   return out;
 }
 
@@ -228,33 +239,18 @@ py::dict PyNextDwell(const std::string& path, const std::string& text, const std
     const IdentifyConfig config = LoadConfig(path, text, base_dir, overrides);
     outcome = std::make_unique<NextDwellOutcome>(ComputeNextDwell(config, request, printed));
   }
-  std::vector<double> freq_hz, level, amplitude, settle, record, gain, gain_per_second;
-  std::vector<std::string> branch;
-  std::vector<int> dwells;
-  std::vector<bool> jumps;
-  for (const Candidate& c : outcome->recommendation.ranked) {
-    freq_hz.push_back(c.frequency_hz);
-    level.push_back(c.level);
-    dwells.push_back(c.dwells);
-    branch.push_back(BranchName(c.branch));
-    jumps.push_back(c.jumps);
-    amplitude.push_back(c.amplitude);
-    settle.push_back(c.settle_seconds);
-    record.push_back(c.record_seconds);
-    gain.push_back(c.gain);
-    gain_per_second.push_back(c.gain_per_second);
-  }
+  const std::vector<Candidate>& ranked = outcome->recommendation.ranked;
   py::dict candidates;
-  candidates["freq_hz"] = py::array(py::cast(freq_hz));
-  candidates["level"] = py::array(py::cast(level));
-  candidates["dwells"] = py::array(py::cast(dwells));
-  candidates["branch"] = branch;
-  candidates["jumps"] = py::array(py::cast(jumps));
-  candidates["a"] = py::array(py::cast(amplitude));
-  candidates["settle_seconds"] = py::array(py::cast(settle));
-  candidates["record_seconds"] = py::array(py::cast(record));
-  candidates["gain"] = py::array(py::cast(gain));
-  candidates["gain_per_second"] = py::array(py::cast(gain_per_second));
+  candidates["freq_hz"] = Column(ranked, &Candidate::frequency_hz);
+  candidates["level"] = Column(ranked, &Candidate::level);
+  candidates["dwells"] = Column(ranked, &Candidate::dwells);
+  candidates["branch"] = Column(ranked, [](const Candidate& c) { return BranchName(c.branch); });
+  candidates["jumps"] = Column(ranked, &Candidate::jumps);
+  candidates["a"] = Column(ranked, &Candidate::amplitude);
+  candidates["settle_seconds"] = Column(ranked, &Candidate::settle_seconds);
+  candidates["record_seconds"] = Column(ranked, &Candidate::record_seconds);
+  candidates["gain"] = Column(ranked, &Candidate::gain);
+  candidates["gain_per_second"] = Column(ranked, &Candidate::gain_per_second);
   py::dict out;
   out["status"] = FitStatusName(outcome->fit.status);
   out["message"] = outcome->fit.message;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "dwellfit/estimator/analysis/profile_likelihood.h"
+#include "dwellfit/estimator/common/name_table.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/fit/fit_description.h"
 #include "dwellfit/estimator/fit/problem_builder.h"
@@ -422,16 +423,11 @@ bool MoveToLower(const ProfileProblem& problem, const ParameterVector& start,
 constexpr const char* kIntervalMethodNames[] = {"data_only", "linearised", "profile"};
 
 const char* IntervalMethodName(IntervalMethod method) {
-  return kIntervalMethodNames[static_cast<int>(method)];
+  return NameOf(kIntervalMethodNames, method);
 }
 
 bool ParseIntervalMethod(const std::string& name, IntervalMethod* method) {
-  for (int i = 0; i < 3; ++i) {
-    if (name != kIntervalMethodNames[i]) continue;
-    *method = static_cast<IntervalMethod>(i);
-    return true;
-  }
-  return false;
+  return FromName(name, kIntervalMethodNames, method);
 }
 
 ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted,

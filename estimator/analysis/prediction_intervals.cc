@@ -7,6 +7,7 @@
 
 #include "Eigen/Dense"
 #include "dwellfit/estimator/analysis/sweep_prediction.h"
+#include "dwellfit/estimator/common/name_table.h"
 #include "dwellfit/estimator/fit/problem_builder.h"
 #include "dwellfit/residuals/model/stable_root.h"
 
@@ -227,13 +228,13 @@ double HeldOutPrediction::ErrorPercent() const {
 }
 
 const char* HeldOutQuantityName(HeldOutQuantity quantity) {
-  static const char* const kNames[] = {"jump-down", "jump-up", "upper-branch amplitude"};
-  return kNames[static_cast<int>(quantity)];
+  constexpr const char* kNames[] = {"jump-down", "jump-up", "upper-branch amplitude"};
+  return NameOf(kNames, quantity);
 }
 
 const char* HeldOutQuantityKey(HeldOutQuantity quantity) {
-  static const char* const kKeys[] = {"jump_down", "jump_up", "upper_branch_amplitude"};
-  return kKeys[static_cast<int>(quantity)];
+  constexpr const char* kKeys[] = {"jump_down", "jump_up", "upper_branch_amplitude"};
+  return NameOf(kKeys, quantity);
 }
 
 double MedianOf(std::vector<double> values) {

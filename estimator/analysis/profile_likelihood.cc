@@ -8,6 +8,7 @@
 
 #include "ceres/manifold.h"
 #include "ceres/solver.h"
+#include "dwellfit/estimator/common/name_table.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/fit/fit_description.h"
 #include "dwellfit/estimator/fit/stage_problem.h"
@@ -346,8 +347,8 @@ Side MakeSide(const ProfileProblem& problem, int quantity, double sign,
 }  // namespace
 
 const char* ProfileEndName(ProfileEnd end) {
-  static const char* const kNames[] = {"crossed", "bound", "open"};
-  return kNames[static_cast<int>(end)];
+  constexpr const char* kNames[] = {"crossed", "bound", "open"};
+  return NameOf(kNames, end);
 }
 
 double RefitProfileProblem(const ProfileProblem& problem, ParameterVector* p) {

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/name_table.h"
 #include "dwellfit/residuals/model/response_model.h"
 
 namespace dwellfit {
@@ -14,52 +15,22 @@ namespace {
 // The measured quantity's lag minus the displacement's: -p pi/2.
 double ResponseLead(const TestQuantities& test) { return 0.5 * kPi * test.ResponsePower(); }
 
+// Names in enumerator order.
+constexpr const char* kExcitationNames[] = {"base_acceleration", "base_displacement", "force"};
+constexpr const char* kResponseNames[] = {"displacement", "velocity", "acceleration"};
+
 }  // namespace
 
-const char* ExcitationName(Excitation excitation) {
-  switch (excitation) {
-    case Excitation::kBaseAcceleration:
-      return "base_acceleration";
-    case Excitation::kBaseDisplacement:
-      return "base_displacement";
-    case Excitation::kForce:
-      return "force";
-  }
-  return "base_acceleration";
-}
+const char* ExcitationName(Excitation excitation) { return NameOf(kExcitationNames, excitation); }
 
 bool ExcitationFromName(const std::string& name, Excitation* excitation) {
-  for (Excitation candidate :
-       {Excitation::kBaseAcceleration, Excitation::kBaseDisplacement, Excitation::kForce}) {
-    if (name == ExcitationName(candidate)) {
-      *excitation = candidate;
-      return true;
-    }
-  }
-  return false;
+  return FromName(name, kExcitationNames, excitation);
 }
 
-const char* ResponseName(Response response) {
-  switch (response) {
-    case Response::kDisplacement:
-      return "displacement";
-    case Response::kVelocity:
-      return "velocity";
-    case Response::kAcceleration:
-      return "acceleration";
-  }
-  return "displacement";
-}
+const char* ResponseName(Response response) { return NameOf(kResponseNames, response); }
 
 bool ResponseFromName(const std::string& name, Response* response) {
-  for (Response candidate :
-       {Response::kDisplacement, Response::kVelocity, Response::kAcceleration}) {
-    if (name == ResponseName(candidate)) {
-      *response = candidate;
-      return true;
-    }
-  }
-  return false;
+  return FromName(name, kResponseNames, response);
 }
 
 int TestQuantities::ResponsePower() const {

@@ -1,15 +1,20 @@
 #include "dwellfit/estimator/data/sweep.h"
 
+#include "dwellfit/estimator/common/name_table.h"
+
 namespace dwellfit {
+namespace {
+
+constexpr const char* kSweepDirectionNames[] = {"up", "down"};  // in enumerator order
+
+}  // namespace
 
 const char* SweepDirectionName(SweepDirection direction) {
-  return direction == SweepDirection::kUp ? "up" : "down";
+  return NameOf(kSweepDirectionNames, direction);
 }
 
 bool SweepDirectionFromName(const std::string& name, SweepDirection* direction) {
-  if (name != "up" && name != "down") return false;
-  *direction = name == "up" ? SweepDirection::kUp : SweepDirection::kDown;
-  return true;
+  return FromName(name, kSweepDirectionNames, direction);
 }
 
 std::string Sweep::Name() const { return id + "/" + SweepDirectionName(direction); }

@@ -9,6 +9,7 @@
 #include "dwellfit/config/dwell_plan_reader.h"
 #include "dwellfit/config/rig_config_reader.h"
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/common/name_table.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/design/next_dwell_run.h"
 #include "dwellfit/estimator/run/resolved_run.h"
@@ -183,8 +184,8 @@ ParameterVector InitialGuess(const IdentifyConfig& config) {
 }  // namespace
 
 const char* StudyQuantityName(int quantity) {
-  static const char* const kNames[kStudyQuantities] = {"alpha_e", "eta_e", "w", "mu1"};
-  return quantity >= 0 && quantity < kStudyQuantities ? kNames[quantity] : "?";
+  constexpr const char* kNames[kStudyQuantities] = {"alpha_e", "eta_e", "w", "mu1"};
+  return NameOf(kNames, quantity);
 }
 
 bool PrecisionTarget::IsValid(std::string* error) const {

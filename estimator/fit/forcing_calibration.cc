@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "ceres/problem.h"
+#include "dwellfit/estimator/common/name_table.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/fit/fit_description.h"
 #include "dwellfit/estimator/fit/staged_solve.h"
@@ -109,18 +110,13 @@ CalibratedIdentification IdentifyWithForcingCalibration(
   return out;
 }
 
-const char* HeldOutDwellsName(HeldOutDwells dwells) {
-  return dwells == HeldOutDwells::kBeforeJump ? "before_jump" : "below_half_peak";
-}
+// In enumerator order.
+constexpr const char* kHeldOutDwellsNames[] = {"before_jump", "below_half_peak"};
+
+const char* HeldOutDwellsName(HeldOutDwells dwells) { return NameOf(kHeldOutDwellsNames, dwells); }
 
 bool HeldOutDwellsFromName(const std::string& name, HeldOutDwells* dwells) {
-  for (HeldOutDwells d : {HeldOutDwells::kBeforeJump, HeldOutDwells::kBelowHalfPeak}) {
-    if (name == HeldOutDwellsName(d)) {
-      *dwells = d;
-      return true;
-    }
-  }
-  return false;
+  return FromName(name, kHeldOutDwellsNames, dwells);
 }
 
 Sweep CalibrationDwells(const Sweep& sweep, HeldOutDwells dwells) {

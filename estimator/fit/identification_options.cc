@@ -3,23 +3,11 @@
 #include <cmath>
 #include <utility>
 
+#include "dwellfit/estimator/common/name_table.h"
 #include "dwellfit/estimator/common/string_printf.h"
 
 namespace dwellfit {
 namespace {
-
-// The enumerator whose name (`names`, in enumerator order) is `name`, into
-// *value; false when none.
-template <typename Enum, size_t N>
-bool FromName(const std::string& name, const char* const (&names)[N], Enum* value) {
-  for (size_t i = 0; i < N; ++i) {
-    if (name == names[i]) {
-      *value = static_cast<Enum>(i);
-      return true;
-    }
-  }
-  return false;
-}
 
 // Names in enumerator order.
 constexpr const char* kResidualKindNames[] = {"algebraic", "vertical", "phase_lag", "all_roots"};
@@ -36,17 +24,13 @@ bool IsNonNegative(const std::string& field, double value, std::string* error) {
 
 }  // namespace
 
-const char* ResidualKindName(ResidualKind kind) {
-  return kResidualKindNames[static_cast<int>(kind)];
-}
+const char* ResidualKindName(ResidualKind kind) { return NameOf(kResidualKindNames, kind); }
 
 bool ResidualKindFromName(const std::string& name, ResidualKind* kind) {
   return FromName(name, kResidualKindNames, kind);
 }
 
-const char* ErrorMeasureName(ErrorMeasure measure) {
-  return kErrorMeasureNames[static_cast<int>(measure)];
-}
+const char* ErrorMeasureName(ErrorMeasure measure) { return NameOf(kErrorMeasureNames, measure); }
 
 bool ErrorMeasureFromName(const std::string& name, ErrorMeasure* measure) {
   return FromName(name, kErrorMeasureNames, measure);
@@ -88,7 +72,7 @@ bool SolverSettings::IsValid(std::string* error) const {
   return true;
 }
 
-const char* JumpTargetName(JumpTarget target) { return kJumpTargetNames[static_cast<int>(target)]; }
+const char* JumpTargetName(JumpTarget target) { return NameOf(kJumpTargetNames, target); }
 
 bool JumpTargetFromName(const std::string& name, JumpTarget* target) {
   return FromName(name, kJumpTargetNames, target);

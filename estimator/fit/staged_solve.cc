@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "boost/algorithm/string/join.hpp"
+#include "dwellfit/estimator/common/name_table.h"
 #include "dwellfit/estimator/fit/bound_rest_watcher.h"
 #include "dwellfit/estimator/fit/parallel_residual_evaluator.h"
 #include "dwellfit/estimator/fit/stage_problem.h"
@@ -23,7 +24,7 @@ const char* FitStatusName(FitStatus status) {
   // In enumerator order.
   constexpr const char* kNames[] = {"converged", "no_convergence", "failure", "invalid_input",
                                     "unidentifiable"};
-  return kNames[static_cast<int>(status)];
+  return NameOf(kNames, status);
 }
 
 ceres::Solver::Options MakeSolverOptions(const SolverSettings& settings) {

@@ -160,15 +160,10 @@ std::unique_ptr<IdentifyOutcome> ComputeIdentify(const IdentifyConfig& config, s
   auto outcome = std::make_unique<IdentifyOutcome>();
   outcome->run = ResolveRun(config);
   const ResolvedRun& run = outcome->run;
-  // The jumps in the measured quantities (the run's sweeps are in the model's form).
-  const auto jumps = [&](const Sweep& sweep) {
-    if (config.test.IsModelForm()) return DescribeJumps(sweep);
-    Sweep measured = sweep;
-    QuantityMap(config.test, run.phase_offset_rad, /*to_model=*/false).Apply(&measured);
-    return DescribeJumps(measured);
-  };
-  for (const Sweep* sweep : run.fitted) out << "fit      " << jumps(*sweep) << "\n";
-  for (const Sweep* sweep : run.validation) out << "validate " << jumps(*sweep) << "\n";
+  for (const Sweep* sweep : run.fitted)
+    out << "fit      " << DescribeMeasuredJumps(config.test, run.phase_offset_rad, *sweep) << "\n";
+  for (const Sweep* sweep : run.validation)
+    out << "validate " << DescribeMeasuredJumps(config.test, run.phase_offset_rad, *sweep) << "\n";
   out << "\n";
   const auto print_steps = [&out](bool print, const char* title, const auto& steps) {
     if (!print) return;

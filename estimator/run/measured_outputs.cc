@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "dwellfit/estimator/data/jump_detection.h"
+
 namespace dwellfit {
 namespace {
 
@@ -59,6 +61,14 @@ void MapOutputsToMeasured(const TestQuantities& test, double phase_offset_rad,
     ScoreSweepPrediction(&prediction);
   }
   for (ResponseCurve& curve : *curves) MapCurve(map, &curve);
+}
+
+std::string DescribeMeasuredJumps(const TestQuantities& test, double phase_offset_rad,
+                                  const Sweep& sweep) {
+  if (test.IsModelForm()) return DescribeJumps(sweep);
+  Sweep measured = sweep;
+  QuantityMap(test, phase_offset_rad, /*to_model=*/false).Apply(&measured);
+  return DescribeJumps(measured);
 }
 
 }  // namespace dwellfit

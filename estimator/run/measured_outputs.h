@@ -6,6 +6,7 @@
 #ifndef DWELLFIT_ESTIMATOR_RUN_MEASURED_OUTPUTS_H_
 #define DWELLFIT_ESTIMATOR_RUN_MEASURED_OUTPUTS_H_
 
+#include <string>
 #include <vector>
 
 #include "dwellfit/estimator/analysis/identification_report.h"
@@ -21,6 +22,11 @@ namespace dwellfit {
 void MapOutputsToMeasured(const TestQuantities& test, double phase_offset_rad,
                           std::vector<Sweep>* sweeps, IdentificationReport* report,
                           std::vector<ResponseCurve>* curves);
+
+// The jumps of `sweep` (in the model's form, as a run holds it) as
+// DescribeJumps words them, in the quantities the test measured.
+std::string DescribeMeasuredJumps(const TestQuantities& test, double phase_offset_rad,
+                                  const Sweep& sweep);
 
 }  // namespace dwellfit
 

@@ -1,6 +1,7 @@
 #include "dwellfit/estimator/studies/method_comparison.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -124,12 +125,12 @@ struct Quantity {
   int index;  // ParameterIndex, or kNumParameters for alpha_e
 };
 
-std::vector<Quantity> Quantities(const IdentifyConfig& config, double omega_ref_rad_s) {
+// The rows of the parameters not `fixed` (w in Hz), then alpha_e's.
+std::vector<Quantity> Quantities(const std::array<bool, kNumParameters>& fixed,
+                                 double omega_ref_rad_s) {
   std::vector<Quantity> rows;
   for (int i = 0; i < kNumParameters; ++i) {
-    if (!config.identification.fixed[i]) {
-      rows.push_back({i == kNaturalFrequency ? "w [Hz]" : ParameterName(i), i});
-    }
+    if (!fixed[i]) rows.push_back({i == kNaturalFrequency ? "w [Hz]" : ParameterName(i), i});
   }
   rows.push_back(
       {StringPrintf("alpha_e at %.4g Hz", RadPerSecondToHz(omega_ref_rad_s)), kNumParameters});
@@ -175,7 +176,7 @@ Comparison Compare(const IdentifyConfig& config, const std::vector<Method>& meth
   c.omega_ref_rad_s = config.omega_ref_rad_s.value_or(
       truth ? (*truth)[kNaturalFrequency]
             : c.fits.back().front().result.parameters[kNaturalFrequency]);
-  c.quantities = Quantities(config, c.omega_ref_rad_s);
+  c.quantities = Quantities(config.identification.fixed, c.omega_ref_rad_s);
   return c;
 }
 
@@ -383,18 +384,6 @@ std::string DatasetName(const IdentifyConfig& config) {
   return config.config_path.substr(at == std::string::npos ? 0 : at);
 }
 
-// The trace case's rows: every parameter (w too, which harmonic balance
-// always estimates) and alpha_e.
-std::vector<Quantity> TraceQuantities(double omega_ref_rad_s) {
-  std::vector<Quantity> rows;
-  for (int i = 0; i < kNumParameters; ++i) {
-    rows.push_back({i == kNaturalFrequency ? "w [Hz]" : ParameterName(i), i});
-  }
-  rows.push_back(
-      {StringPrintf("alpha_e at %.4g Hz", RadPerSecondToHz(omega_ref_rad_s)), kNumParameters});
-  return rows;
-}
-
 double StandardErrorOf(const HarmonicBalanceResult& hb, int index) {
   if (index == kNumParameters) return hb.effective_nonlinearity_error;
   return index == kNaturalFrequency ? RadPerSecondToHz(hb.standard_error[index])
@@ -416,7 +405,8 @@ Comparison CompareOnTraces(const TraceCase& traces, double phase_bias_rad) {
       JumpDownErrors(run.validation, fit.result.parameters, traces.truth);
   c.methods.push_back({"harmonic balance (traces)", {}});
   c.fits.push_back({fit});
-  c.quantities = TraceQuantities(c.omega_ref_rad_s);
+  // Every parameter's row: harmonic balance estimates w too.
+  c.quantities = Quantities({}, c.omega_ref_rad_s);
   return c;
 }
 

@@ -90,20 +90,7 @@ IndexRow ReadIndexRow(const std::string& file, int line, char* const* fields) {
   IndexRow row;
   DwellTrace& trace = row.trace;
   trace.source_line = line;
-  trace.sweep = fields[0];
-  if (trace.sweep.empty()) throw InputError(file, line, "sweep", "give the sweep id");
-  if (!SweepDirectionFromName(fields[1], &trace.direction)) {
-    throw InputError(file, line, "direction",
-                     "expected up or down, got '" + EscapeForMessage(fields[1]) + "'");
-  }
-  const std::string kind = fields[2];
-  trace.kind =
-      kind == SweepKindName(SweepKind::kAmplitude) ? SweepKind::kAmplitude : SweepKind::kFrequency;
-  if (kind != SweepKindName(trace.kind)) {
-    throw InputError(file, line, "kind",
-                     "expected frequency or amplitude, got '" + EscapeForMessage(kind) + "'");
-  }
-  trace.drive_frequency_rad_s = HzToRadPerSecond(ParsePositive(file, line, "freq_hz", fields[3]));
+  ReadDwellColumns(file, line, fields, &trace);
   trace.sample_rate_hz = ParsePositive(file, line, "sample_rate_hz", fields[4]);
   row.base_samples = ParseCount(file, line, "base_samples", fields[5]);
   row.response_samples = ParseCount(file, line, "response_samples", fields[6]);
@@ -146,6 +133,24 @@ std::vector<IndexRow> ReadIndex(const std::string& path) {
 }
 
 }  // namespace
+
+void ReadDwellColumns(const std::string& file, int line, const char* const* fields,
+                      DwellTrace* trace) {
+  trace->sweep = fields[0];
+  if (trace->sweep.empty()) throw InputError(file, line, "sweep", "give the sweep id");
+  if (!SweepDirectionFromName(fields[1], &trace->direction)) {
+    throw InputError(file, line, "direction",
+                     "expected up or down, got '" + EscapeForMessage(fields[1]) + "'");
+  }
+  const std::string kind = fields[2];
+  trace->kind =
+      kind == SweepKindName(SweepKind::kAmplitude) ? SweepKind::kAmplitude : SweepKind::kFrequency;
+  if (kind != SweepKindName(trace->kind)) {
+    throw InputError(file, line, "kind",
+                     "expected frequency or amplitude, got '" + EscapeForMessage(kind) + "'");
+  }
+  trace->drive_frequency_rad_s = HzToRadPerSecond(ParsePositive(file, line, "freq_hz", fields[3]));
+}
 
 std::string DwellTrace::Describe() const {
   std::string text = sweep + "/" + SweepDirectionName(direction) + " @ " +

@@ -53,6 +53,13 @@ struct DwellTrace {
 inline constexpr char kTraceIndexFile[] = "traces.csv";
 inline constexpr char kTraceSamplesFile[] = "traces.f32";
 
+// The columns every trace index (traces.csv, the UFF index of uff58_traces.h)
+// begins with: sweep, direction, kind and freq_hz, as `fields` [0, 4) of line
+// `line` of `file`, into `trace`. Throws InputError naming the file, the line
+// and the field.
+void ReadDwellColumns(const std::string& file, int line, const char* const* fields,
+                      DwellTrace* trace);
+
 // Writes `dwells` into `folder` (created when missing) as the two files
 // above, each written under a temporary name and renamed, so a failed write
 // leaves no half-written trace set. Throws InputError when it cannot write.

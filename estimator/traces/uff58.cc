@@ -137,30 +137,28 @@ int ParseInt(const Cursor& cursor, std::string_view line, std::size_t first, std
   return static_cast<int>(value);
 }
 
-// A finite real number (Fortran E or D notation); false when `text` is none.
-bool ToReal(std::string_view text, double* value) {
+// `text`, the field of columns [first, first + width) of the cursor's line,
+// as a finite real number (Fortran E or D notation); fails naming `field`.
+double ToReal(const Cursor& cursor, std::string_view text, std::size_t first, std::size_t width,
+              const std::string& field) {
   std::string copy(Trim(text));
-  if (copy.empty() || copy.find_first_not_of("+-.0123456789eEdD") != std::string::npos) {
-    return false;
-  }
   for (char& c : copy) {
     if (c == 'd' || c == 'D') c = 'E';
   }
   char* end = nullptr;
-  *value = std::strtod(copy.c_str(), &end);
-  return *end == '\0' && std::isfinite(*value);
-}
-
-double ParseReal(const Cursor& cursor, std::string_view line, std::size_t first, std::size_t width,
-                 const char* field) {
-  double value = 0.0;
-  const std::string_view text = Column(line, first, width);
-  if (!ToReal(text, &value)) {
+  const double value = std::strtod(copy.c_str(), &end);
+  if (copy.empty() || copy.find_first_not_of("+-.0123456789eE") != std::string::npos ||
+      *end != '\0' || !std::isfinite(value)) {
     cursor.Fail(field, StringPrintf("expected a finite number in columns %zu-%zu, got '", first + 1,
                                     first + width) +
                            EscapeForMessage(Trim(text)) + "'");
   }
   return value;
+}
+
+double ParseReal(const Cursor& cursor, std::string_view line, std::size_t first, std::size_t width,
+                 const char* field) {
+  return ToReal(cursor, Column(line, first, width), first, width, field);
 }
 
 // Record 6: Format(2(I5,I10),2(1X,10A1,I10,I4)).
@@ -302,19 +300,12 @@ void ReadAsciiValues(Cursor& c, Uff58Record* r) {
                           r->values.size(), static_cast<long long>(r->value_count)));
     }
     for (std::size_t first = 0; first < line.size(); first += width) {
-      double value = 0.0;
-      const std::string_view field = line.substr(first, width);
       const std::string at = "value " + std::to_string(r->values.size() + 1);
       if (r->values.size() == static_cast<std::size_t>(r->value_count)) {
         c.Fail(at, StringPrintf("more values than the %lld record 7 announces; check the export",
                                 static_cast<long long>(r->value_count)));
       }
-      if (!ToReal(field, &value)) {
-        c.Fail(at, StringPrintf("expected a finite number in columns %zu-%zu, got '", first + 1,
-                                first + width) +
-                       EscapeForMessage(Trim(field)) + "'");
-      }
-      r->values.push_back(value);
+      r->values.push_back(ToReal(c, line.substr(first, width), first, width, at));
     }
   }
 }

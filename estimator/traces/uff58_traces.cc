@@ -4,7 +4,6 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -118,35 +117,12 @@ std::vector<float> Channel(const RowPlace& at, const char* field, const Uff58Rec
   return std::vector<float>(r.values.begin(), r.values.end());
 }
 
-double ParsePositive(const RowPlace& at, const char* field, const char* text) {
-  char* end = nullptr;
-  const double value = std::strtod(text, &end);
-  if (std::strspn(text, "0123456789+-.eE") != std::strlen(text) || end == text || *end != '\0' ||
-      !std::isfinite(value) || !(value > 0.0)) {
-    throw InputError(at.index, at.line, field,
-                     "expected a positive number, got '" + EscapeForMessage(text) + "'");
-  }
-  return value;
-}
-
 // Dwell of index row `fields` (sweep, ..., base_unit).
 DwellTrace ReadRow(const RowPlace& at, char* const* fields, UffFiles* files) {
   DwellTrace trace;
   trace.source_line = at.line;
   trace.source_file = at.index;
-  trace.sweep = fields[0];
-  if (trace.sweep.empty()) throw InputError(at.index, at.line, "sweep", "give the sweep id");
-  if (!SweepDirectionFromName(fields[1], &trace.direction)) {
-    throw InputError(at.index, at.line, "direction",
-                     "expected up or down, got '" + EscapeForMessage(fields[1]) + "'");
-  }
-  if (std::strcmp(fields[2], "frequency") == 0 || std::strcmp(fields[2], "amplitude") == 0) {
-    trace.kind = fields[2][0] == 'f' ? SweepKind::kFrequency : SweepKind::kAmplitude;
-  } else {
-    throw InputError(at.index, at.line, "kind",
-                     "expected frequency or amplitude, got '" + EscapeForMessage(fields[2]) + "'");
-  }
-  trace.drive_frequency_rad_s = HzToRadPerSecond(ParsePositive(at, "freq_hz", fields[3]));
+  ReadDwellColumns(at.index, at.line, fields, &trace);
   if (fields[4][0] == '\0') throw InputError(at.index, at.line, "file", "give the UFF file");
   const std::string file = (fs::path(at.index).parent_path() / fields[4]).string();
   auto cached = files->find(file);

@@ -127,6 +127,8 @@ def test_the_curve_solves_the_frequency_response_equation():
     # Two folds (each ends one run of stability and starts the next).
     assert len(set(np.round(curve["freq_hz"][curve["fold"]], 9))) == 2
     assert curve["stable"].any() and not curve["stable"].all()
+    assert curve["stable"].dtype == curve["fold"].dtype == np.bool_
+    assert all(len(curve[name]) == len(curve["a"]) for name in ("freq_hz", "a_base", "phase_rad"))
 
 
 def test_simulate_makes_the_plans_dwells():
@@ -152,13 +154,16 @@ def test_next_dwell_ranks_as_the_tool(tmp_path):
     assert result["status"] == "converged"
     candidates = result["candidates"]
     assert len(candidates["freq_hz"]) == len(rows)
-    for i in range(5):
-        # next_dwell.csv prints 10 significant digits.
-        assert candidates["freq_hz"][i] == pytest.approx(float(rows[i]["f_hz"]), rel=1e-9)
-        assert candidates["level"][i] == pytest.approx(float(rows[i]["level"]), rel=1e-9)
-        assert candidates["branch"][i] == rows[i]["branch"]
-        assert candidates["gain_per_second"][i] == pytest.approx(float(rows[i]["gain_per_s"]),
-                                                                 rel=1e-9)
+    # Every column, one entry per candidate, as next_dwell.csv has it (10
+    # significant digits; settle_s 6).
+    numbers = {"freq_hz": ("f_hz", 1e-9), "level": ("level", 1e-9), "a": ("amplitude", 1e-9),
+               "settle_seconds": ("settle_s", 1e-5), "record_seconds": ("record_s", 1e-5),
+               "gain": ("gain", 1e-9), "gain_per_second": ("gain_per_s", 1e-9)}
+    for name, (column, rel) in numbers.items():
+        assert candidates[name] == pytest.approx([float(r[column]) for r in rows], rel=rel), name
+    assert candidates["branch"] == [r["branch"] for r in rows]
+    assert candidates["dwells"].tolist() == [int(r["dwells"]) for r in rows]
+    assert candidates["jumps"].tolist() == [r["jumps"] == "1" for r in rows]
     assert np.all(np.diff(candidates["gain_per_second"]) <= 0)
     with pytest.raises(dwellfit.InputError, match="level"):
         dwellfit.next_dwell(THESIS, "f_hz=41.5")

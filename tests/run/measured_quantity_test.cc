@@ -19,8 +19,10 @@
 #include "dwellfit/config/dwell_plan_reader.h"
 #include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/common/input_error.h"
+#include "dwellfit/estimator/data/jump_detection.h"
 #include "dwellfit/estimator/data/sweep_csv_writer.h"
 #include "dwellfit/estimator/run/identify_run.h"
+#include "dwellfit/estimator/run/measured_outputs.h"
 #include "dwellfit/estimator/run/resolved_run.h"
 #include "dwellfit/estimator/simulation/dwell_simulator.h"
 #include "gmock/gmock.h"
@@ -315,6 +317,27 @@ TEST(TestQuantities, OutputsAreInTheMeasuredQuantity) {
   EXPECT_LT(curve_max, 1.01 * measured_max);
   EXPECT_THAT(printed.str(), HasSubstr("response: velocity"));
   EXPECT_THAT(printed.str(), HasSubstr("excitation: force"));
+}
+
+// The jumps identify prints are in the measured quantity: a velocity sensor
+// reads Omega a, so the jump of 4.7e-3 -> 2.8e-4 (displacement) between 42.2
+// and 42.3 Hz reads 2 pi 42.2 Hz 4.7e-3 = 1.25 -> 2 pi 42.3 Hz 2.8e-4 = 0.0744.
+TEST(TestQuantities, JumpsAreDescribedInTheMeasuredQuantity) {
+  Sweep sweep;  // in the model's form: displacement amplitudes
+  sweep.id = "F";
+  sweep.kind = SweepKind::kFrequency;
+  const double freqs_hz[] = {41.8, 41.9, 42.0, 42.1, 42.2, 42.3, 42.4};
+  const double amplitudes[] = {3.0e-3, 3.6e-3, 4.1e-3, 4.5e-3, 4.7e-3, 2.8e-4, 2.2e-4};
+  for (int i = 0; i < 7; ++i) {
+    sweep.points.push_back({HzToRadPerSecond(freqs_hz[i]), 0.01, amplitudes[i]});
+  }
+  DetectJumps(JumpDetectionOptions(), &sweep);
+  TestQuantities velocity;
+  velocity.response = Response::kVelocity;
+  EXPECT_EQ(DescribeMeasuredJumps(velocity, 0.0, sweep),
+            "F/up: jump_down between 42.20 and 42.30 Hz (a 1.2e0 -> 7.4e-2)");
+  EXPECT_EQ(DescribeMeasuredJumps(TestQuantities(), 0.0, sweep),
+            "F/up: jump_down between 42.20 and 42.30 Hz (a 4.7e-3 -> 2.8e-4)");
 }
 
 // An estimated offset is a warning of the run: printed, in result.yaml and
