@@ -503,12 +503,19 @@ PenaltyOptions ReadPenalties(const ConfigValue& value, const ConfigSource& sourc
 // is reported at its line.
 ForcingCalibrationOptions ReadForcingCalibration(const ConfigValue& value,
                                                  const ConfigSource& source) {
-  const StrictMap block(value, source, {"prior_sigma", "held_out_dwells"});
+  const StrictMap block(value, source, {"prior_sigma", "held_out_dwells", "parameter"});
   ForcingCalibrationOptions calibration;
   block.Read("prior_sigma", &calibration.prior_sigma);
   if (const auto dwells = block.Optional("held_out_dwells")) {
     if (!HeldOutDwellsFromName(ReadNonEmptyString(*dwells, source), &calibration.held_out_dwells)) {
       throw source.Error(dwells->path, dwells->mark, "give before_jump or below_half_peak");
+    }
+  }
+  if (const auto parameter = block.Optional("parameter")) {
+    if (!CalibratedParameterFromName(ReadNonEmptyString(*parameter, source),
+                                     &calibration.parameter)) {
+      throw source.Error(parameter->path, parameter->mark,
+                         "give eta_e (the forcing) or omega (the natural frequency)");
     }
   }
   return calibration;

@@ -232,6 +232,7 @@ std::string ConfigToYaml(const IdentifyConfig& config, ConfigKeys keys) {
     out << YAML::Key << "forcing_calibration" << YAML::Value << YAML::BeginMap;
     Put(out, "prior_sigma", config.forcing_calibration->prior_sigma);
     Put(out, "held_out_dwells", HeldOutDwellsName(config.forcing_calibration->held_out_dwells));
+    Put(out, "parameter", CalibratedParameterName(config.forcing_calibration->parameter));
     out << YAML::EndMap;
   }
   EmitTestQuantities(out, config.test);

@@ -79,9 +79,12 @@ RigConfig ReadConfig(const ConfigSource& source) {
   if (auto v = block.Optional("settling")) ReadSettling(*v, source, &rig);
   if (auto v = block.Optional("channels")) rig.channels = ReadChannels(*v, source);
   if (auto v = block.Optional("noise")) {
-    const StrictMap noise(*v, source, {"relative_sigma", "seed"});
+    const StrictMap noise(*v, source, {"relative_sigma", "base_relative_sigma", "seed"});
     rig.noise_relative_sigma =
         ReadNonNegative(noise.Required("relative_sigma", "add relative_sigma (0: none)"), source);
+    if (auto base = noise.Optional("base_relative_sigma")) {
+      rig.base_noise_relative_sigma = ReadNonNegative(*base, source);
+    }
     rig.noise_seed = ReadUint64(noise.Required("seed", "add seed (a whole number >= 0)"), source);
   }
   ReadBeam(block.Required("beam",

@@ -12,6 +12,7 @@
 //     response_filter_hz: 200
 //   noise:                      # optional (simulate_rig); default none
 //     relative_sigma: 0.005     # of each dwell's amplitudes (rig_simulator.h)
+//     base_relative_sigma: 0    # optional: the base channel's own; default relative_sigma
 //     seed: 1
 //   beam:                       # the beam and its mode (estimator/traces/strain_gauge.h)
 //     boundary: cantilever      # or clamped_clamped

@@ -21,6 +21,9 @@ DEFINE_string(
     "A held-out sweep's dwells its scale is calibrated on: before_jump (up to its first "
     "jump) or below_half_peak (of those, below half their largest amplitude); overrides the "
     "config's");
+DEFINE_string(parameter, "eta_e",
+              "The parameter each sweep gets of its own: eta_e (its forcing) or omega (its "
+              "natural frequency); overrides the config's");
 DEFINE_string(set, "",
               "Overrides config values as identify's --set: key.path=value[,...], e.g. "
               "\"fixed=[mu2, delta],initial_guess.delta=0\"");
@@ -31,7 +34,7 @@ int main(int argc, char** argv) {
       "forcing_calibration",
       "held-out errors with and without per-sweep forcing calibration.\n"
       "  forcing_calibration --config CFG [--set K=V --prior_sigma S --held_out_dwells before_jump|"
-      "below_half_peak --output FILE]",
+      "below_half_peak --parameter eta_e|omega --output FILE]",
       __FILE__};
   return dwellfit::RunTool(argc, argv, tool, [] {
     if (!FLAGS_output.empty()) dwellfit::CheckOutputFile(FLAGS_output, "--output", {FLAGS_config});
@@ -48,6 +51,11 @@ int main(int argc, char** argv) {
       throw dwellfit::InputError(
           "--held_out_dwells", 0, "",
           "give before_jump or below_half_peak, got '" + FLAGS_held_out_dwells + "'");
+    }
+    if (!gflags::GetCommandLineFlagInfoOrDie("parameter").is_default &&
+        !dwellfit::CalibratedParameterFromName(FLAGS_parameter, &calibration.parameter)) {
+      throw dwellfit::InputError("--parameter", 0, "",
+                                 "give eta_e or omega, got '" + FLAGS_parameter + "'");
     }
     const std::string markdown = dwellfit::ForcingCalibrationMarkdown(
         dwellfit::CompareForcingCalibration(config, calibration));

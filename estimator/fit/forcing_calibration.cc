@@ -24,22 +24,23 @@ bool ForcingCalibrationOptions::IsValid(std::string* error) const {
   return true;
 }
 
-ForcingScalePrior::ForcingScalePrior(int size, int index, double weight)
-    : index_(index), weight_(weight) {
+ForcingScalePrior::ForcingScalePrior(int size, int index, double weight,
+                                     ParameterIndex shared_index)
+    : index_(index), weight_(weight), shared_index_(shared_index) {
   set_num_residuals(1);
   *mutable_parameter_block_sizes() = {kNumParameters, size};
 }
 
 bool ForcingScalePrior::Evaluate(double const* const* parameters, double* residuals,
                                  double** jacobians) const {
-  const double eta_e = parameters[0][kEtaE];
+  const double eta_e = parameters[0][shared_index_];
   const double eta_k = parameters[1][index_];
   if (!(eta_e > 0.0)) return false;
   residuals[0] = weight_ * (eta_k / eta_e - 1.0);
   if (jacobians == nullptr) return true;
   if (jacobians[0] != nullptr) {
     std::fill(jacobians[0], jacobians[0] + kNumParameters, 0.0);
-    jacobians[0][kEtaE] = -weight_ * eta_k / (eta_e * eta_e);
+    jacobians[0][shared_index_] = -weight_ * eta_k / (eta_e * eta_e);
   }
   if (jacobians[1] != nullptr) {
     std::fill(jacobians[1], jacobians[1] + parameter_block_sizes()[1], 0.0);
@@ -57,10 +58,12 @@ double DataSigma(const IdentificationResult& uncalibrated, int free_parameters) 
 namespace {
 
 // Adds one ForcingScalePrior per entry of the `size` eta_k's.
-std::function<void(ceres::Problem*)> Priors(double* shared, double* etas, int size, double weight) {
+std::function<void(ceres::Problem*)> Priors(double* shared, double* etas, int size, double weight,
+                                            ParameterIndex index) {
   return [=](ceres::Problem* problem) {
     for (int k = 0; k < size; ++k) {
-      problem->AddResidualBlock(new ForcingScalePrior(size, k, weight), nullptr, shared, etas);
+      problem->AddResidualBlock(new ForcingScalePrior(size, k, weight, index), nullptr, shared,
+                                etas);
     }
   };
 }
@@ -93,20 +96,22 @@ CalibratedIdentification IdentifyWithForcingCalibration(
     return out;
   }
   const int size = static_cast<int>(fitted.size());
-  std::vector<double> etas(size, options.initial[kEtaE]);
+  const ParameterIndex index = CalibratedIndex(calibration.parameter);
+  const std::string name = ParameterName(index);
+  std::vector<double> etas(size, options.initial[index]);
   FitDescription fit = SingleBlockFit(fitted, options.fixed, &out.fit.parameters);
-  fit.blocks.push_back({etas.data(), size, "eta_e per sweep"});
+  fit.blocks.push_back({etas.data(), size, name + " per sweep"});
   fit.datasets.clear();
   for (int k = 0; k < size; ++k) {
-    fit.blocks.back().entry_names.push_back("eta_e[" + fitted[k]->Name() + "]");
+    fit.blocks.back().entry_names.push_back(name + "[" + fitted[k]->Name() + "]");
     ParameterMap map = IdentityMap(out.fit.parameters.data());
-    map[kEtaE] = {etas.data(), k};
+    map[index] = {etas.data(), k};
     fit.datasets.push_back({fitted[k]->Name(), {fitted[k]}, map});
   }
-  fit.add_residuals =
-      Priors(out.fit.parameters.data(), etas.data(), size, data_sigma / calibration.prior_sigma);
+  fit.add_residuals = Priors(out.fit.parameters.data(), etas.data(), size,
+                             data_sigma / calibration.prior_sigma, index);
   static_cast<FitSummary&>(out.fit) = SolveStaged(fit, options.solve);
-  for (double eta : etas) out.scales.push_back(eta / out.fit.parameters[kEtaE]);
+  for (double eta : etas) out.scales.push_back(eta / out.fit.parameters[index]);
   return out;
 }
 
@@ -117,6 +122,21 @@ const char* HeldOutDwellsName(HeldOutDwells dwells) { return NameOf(kHeldOutDwel
 
 bool HeldOutDwellsFromName(const std::string& name, HeldOutDwells* dwells) {
   return FromName(name, kHeldOutDwellsNames, dwells);
+}
+
+// In enumerator order.
+constexpr const char* kCalibratedParameterNames[] = {"eta_e", "omega"};
+
+const char* CalibratedParameterName(CalibratedParameter parameter) {
+  return NameOf(kCalibratedParameterNames, parameter);
+}
+
+bool CalibratedParameterFromName(const std::string& name, CalibratedParameter* parameter) {
+  return FromName(name, kCalibratedParameterNames, parameter);
+}
+
+ParameterIndex CalibratedIndex(CalibratedParameter parameter) {
+  return parameter == CalibratedParameter::kForcing ? kEtaE : kNaturalFrequency;
 }
 
 Sweep CalibrationDwells(const Sweep& sweep, HeldOutDwells dwells) {
@@ -152,16 +172,17 @@ double CalibrateHeldOutScale(const Sweep& sweep, const ParameterVector& paramete
            HeldOutDwellsName(calibration.held_out_dwells) + ") to calibrate on";
     return kNaN;
   }
+  const ParameterIndex index = CalibratedIndex(calibration.parameter);
   ParameterVector shared = parameters;
-  double eta = parameters[kEtaE];
+  double eta = parameters[index];
   FitDescription fit;
   fit.blocks = {{shared.data(), kNumParameters, "parameters"},
-                {&eta, 1, "eta_e[" + sweep.Name() + "]"}};
+                {&eta, 1, std::string(ParameterName(index)) + "[" + sweep.Name() + "]"}};
   fit.blocks[0].fixed.assign(kNumParameters, true);
   ParameterMap map = IdentityMap(shared.data());
-  map[kEtaE] = {&eta, 0};
+  map[index] = {&eta, 0};
   fit.datasets = {{sweep.Name(), {&before}, map}};
-  fit.add_residuals = Priors(shared.data(), &eta, 1, data_sigma / calibration.prior_sigma);
+  fit.add_residuals = Priors(shared.data(), &eta, 1, data_sigma / calibration.prior_sigma, index);
   StagedSolveOptions solve = options.solve;
   solve.stages = {ResidualKind::kVertical};
   solve.algebraic_start_candidate = false;
@@ -171,7 +192,7 @@ double CalibrateHeldOutScale(const Sweep& sweep, const ParameterVector& paramete
     *why = sweep.Name() + ": the calibration did not solve: " + summary.message;
     return kNaN;
   }
-  return eta / parameters[kEtaE];
+  return eta / parameters[index];
 }
 
 }  // namespace dwellfit

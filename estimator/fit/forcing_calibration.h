@@ -46,9 +46,18 @@ enum class HeldOutDwells { kBeforeJump, kBelowHalfPeak };
 const char* HeldOutDwellsName(HeldOutDwells dwells);  // "before_jump", "below_half_peak"
 bool HeldOutDwellsFromName(const std::string& name, HeldOutDwells* dwells);
 
+// The parameter a sweep gets of its own: eta_e (its forcing, the default),
+// or w (its natural frequency: a structure that drifts between sweeps, with
+// temperature or between sessions). The scale s_k is then w_k / w and the
+// prior is on it; everything below reads "eta" as the calibrated parameter.
+enum class CalibratedParameter { kForcing, kNaturalFrequency };
+const char* CalibratedParameterName(CalibratedParameter parameter);  // "eta_e", "omega"
+bool CalibratedParameterFromName(const std::string& name, CalibratedParameter* parameter);
+ParameterIndex CalibratedIndex(CalibratedParameter parameter);  // kEtaE, kNaturalFrequency
 struct ForcingCalibrationOptions {
   double prior_sigma = 0.05;  // sigma_prior: the relative spread of a sweep's level, in (0, 1]
   HeldOutDwells held_out_dwells = HeldOutDwells::kBeforeJump;
+  CalibratedParameter parameter = CalibratedParameter::kForcing;
   bool IsValid(std::string* error) const;
 };
 
@@ -56,15 +65,17 @@ struct ForcingCalibrationOptions {
 // parameter blocks (the shared 6-block, whose entry kEtaE is eta_e; a block
 // of `size` per-sweep eta_e's, entry `index` being eta_k). Analytic
 // derivatives: dr/d eta_e = -weight eta_k / eta_e^2, dr/d eta_k = weight / eta_e.
+// With `shared_index` kNaturalFrequency the same with w and w_k.
 class ForcingScalePrior : public ceres::CostFunction {
  public:
-  ForcingScalePrior(int size, int index, double weight);
+  ForcingScalePrior(int size, int index, double weight, ParameterIndex shared_index = kEtaE);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
  private:
   int index_;
   double weight_;
+  ParameterIndex shared_index_;
 };
 
 // sigma_data of a fit without calibration (above); 0 when it has no dwells

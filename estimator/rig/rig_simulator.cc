@@ -176,12 +176,19 @@ double FilterGain(double cutoff_hz, double f_hz) {
 // The channels' noise (header).
 void AddNoise(const RigOptions& options, const StrainGauge& gauge, double a_base,
               const RigDwellTruth& truth, double f_hz, std::mt19937_64* random, DwellTrace* trace) {
-  if (options.noise_relative_sigma == 0.0) return;
+  const double response_sigma = options.noise_relative_sigma;
+  const double base_sigma = options.base_noise_relative_sigma.value_or(response_sigma);
+  if (response_sigma == 0.0 && base_sigma == 0.0) return;
+  // One sequence for both channels, at the response's sigma (the base's when
+  // the response has none); a channel of another sigma scales its draws.
+  const double drawn_sigma = response_sigma > 0.0 ? response_sigma : base_sigma;
   boost::random::normal_distribution<double> normal(
-      0.0, options.noise_relative_sigma * std::sqrt(0.5 * trace->base.size()));
-  const double base_amplitude = a_base * FilterGain(options.channels.base_filter_cutoff_hz, f_hz);
+      0.0, drawn_sigma * std::sqrt(0.5 * trace->base.size()));
+  const double base_amplitude = a_base * FilterGain(options.channels.base_filter_cutoff_hz, f_hz) *
+                                (base_sigma / drawn_sigma);
   const double volt_amplitude = std::abs(gauge.VoltageFromDisplacement(truth.amplitude)) *
-                                FilterGain(options.channels.response_filter_cutoff_hz, f_hz);
+                                FilterGain(options.channels.response_filter_cutoff_hz, f_hz) *
+                                (response_sigma / drawn_sigma);
   for (float& y : trace->base) y += static_cast<float>(base_amplitude * normal(*random));
   for (float& y : trace->response) y += static_cast<float>(volt_amplitude * normal(*random));
 }
@@ -279,6 +286,11 @@ bool RigOptions::IsValid(std::string* error) const {
   if (!(noise_relative_sigma >= 0.0 && noise_relative_sigma < 1.0)) {
     return fail(
         StringPrintf("noise relative_sigma must lie in [0, 1), got %g", noise_relative_sigma));
+  }
+  if (base_noise_relative_sigma &&
+      !(*base_noise_relative_sigma >= 0.0 && *base_noise_relative_sigma < 1.0)) {
+    return fail(StringPrintf("noise base_relative_sigma must lie in [0, 1), got %g",
+                             *base_noise_relative_sigma));
   }
   if (!(integration_tolerance > 0.0 && integration_tolerance < 1e-3)) {
     return fail("integration_tolerance must lie in (0, 1e-3)");

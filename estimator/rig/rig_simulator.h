@@ -22,7 +22,8 @@
 // `skew_samples` of a sample interval after the base channel; a channel with
 // a filter records the output of y' = 2 pi f_c (x - y), integrated with the
 // state. Noise: independent Gaussian samples of standard deviation
-// relative_sigma A sqrt(N/2), A the channel's first-harmonic amplitude and N
+// relative_sigma A sqrt(N/2) (the base channel's own relative_sigma where
+// given), A the channel's first-harmonic amplitude and N
 // the record's samples, so that each channel's first harmonic carries a
 // relative error of relative_sigma (its amplitude that much, its phase that
 // many radians): "0.5 % noise" means 0.5 % on every dwell's amplitudes, as in
@@ -35,6 +36,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -55,6 +57,12 @@ struct RigOptions {
   RigChannels channels;               // skew and filters (trace_processing.h)
   StrainGaugeOptions gauge;           // beam, mode and bridge (strain_gauge.h)
   double noise_relative_sigma = 0.0;  // [0, 1), per dwell amplitude (see above)
+  // The base channel's, where it differs from the response's (an
+  // accelerometer on the shaker head is often far cleaner than the gauge):
+  // [0, 1), unset for noise_relative_sigma. Both channels draw from one
+  // sequence as they do at one sigma, so a run with another base sigma has
+  // the same response noise, sample for sample.
+  std::optional<double> base_noise_relative_sigma;
   std::uint64_t noise_seed = 0;
   // Integrator tolerances of the controlled stepper (relative; the absolute
   // one is this times the state's scale).

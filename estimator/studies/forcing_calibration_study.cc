@@ -56,6 +56,7 @@ ForcingCalibrationComparison CompareForcingCalibration(
   c.config = config.config_path;
   c.prior_sigma = calibration.prior_sigma;
   c.held_out_dwells = calibration.held_out_dwells;
+  c.parameter = calibration.parameter;
   c.without = FitRun(run).best;
   if (!c.without.IsSolutionUsable()) {
     throw InputError(config.config_path +
@@ -75,7 +76,7 @@ ForcingCalibrationComparison CompareForcingCalibration(
                              : kNaN;
     if (!std::isfinite(scale)) c.notes.push_back(why.empty() ? c.with.fit.message : why);
     ParameterVector p = c.with.fit.parameters;
-    p[kEtaE] *= std::isfinite(scale) ? scale : 1.0;
+    p[CalibratedIndex(calibration.parameter)] *= std::isfinite(scale) ? scale : 1.0;
     c.errors_with.push_back(ErrorsOf(*sweep, p, scale, options.fixed));
   }
   return c;
@@ -92,7 +93,8 @@ double MedianAbsoluteError(const std::vector<HeldOutSweepErrors>& errors, bool j
 
 std::string ForcingCalibrationMarkdown(const ForcingCalibrationComparison& c) {
   std::ostringstream out;
-  out << "## `" << c.config << "`, prior sigma " << c.prior_sigma << ", held-out scales from "
+  out << "## `" << c.config << "`, " << CalibratedParameterName(c.parameter)
+      << " per sweep, prior sigma " << c.prior_sigma << ", held-out scales from "
       << HeldOutDwellsName(c.held_out_dwells) << "\n\n"
       << StringPrintf(
              "Fit without calibration: %s, cost %.6g; with: %s, cost %.6g (data sigma "

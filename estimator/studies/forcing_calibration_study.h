@@ -29,6 +29,7 @@ struct ForcingCalibrationComparison {
   std::string config;  // its path, for the report
   double prior_sigma = 0.0;
   HeldOutDwells held_out_dwells = HeldOutDwells::kBeforeJump;
+  CalibratedParameter parameter = CalibratedParameter::kForcing;
   IdentificationResult without;
   CalibratedIdentification with;
   std::vector<std::string> fitted;  // the fitted sweeps' names, as `with.scales`

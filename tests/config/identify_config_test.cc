@@ -221,18 +221,25 @@ TEST(LoadIdentifyConfig, UnitsAndPlotAreReadAndShown) {
 TEST(LoadIdentifyConfig, ForcingCalibrationIsReadAndShown) {
   const ConfigDirectory dir;
   const IdentifyConfig by_default = LoadIdentifyConfig(dir.WriteConfig(kValidConfig));
+  std::string path_first;
   EXPECT_FALSE(by_default.forcing_calibration.has_value());
   EXPECT_THAT(ConfigToYaml(by_default), Not(HasSubstr("forcing_calibration")));
   const IdentifyConfig stated = LoadIdentifyConfig(dir.WriteConfig(
       std::string(kValidConfig) +
-      "forcing_calibration: {prior_sigma: 0.02, held_out_dwells: below_half_peak}\n"));
+      "forcing_calibration: {prior_sigma: 0.02, held_out_dwells: below_half_peak, parameter: "
+      "omega}\n"));
   ASSERT_TRUE(stated.forcing_calibration.has_value());
   EXPECT_EQ(stated.forcing_calibration->prior_sigma, 0.02);
   EXPECT_EQ(stated.forcing_calibration->held_out_dwells, HeldOutDwells::kBelowHalfPeak);
+  EXPECT_EQ(stated.forcing_calibration->parameter, CalibratedParameter::kNaturalFrequency);
   const IdentifyConfig reloaded = LoadIdentifyConfig(dir.WriteConfig(ConfigToYaml(stated)));
   ASSERT_TRUE(reloaded.forcing_calibration.has_value());
   EXPECT_EQ(reloaded.forcing_calibration->prior_sigma, 0.02);
   EXPECT_EQ(reloaded.forcing_calibration->held_out_dwells, HeldOutDwells::kBelowHalfPeak);
+  EXPECT_EQ(reloaded.forcing_calibration->parameter, CalibratedParameter::kNaturalFrequency);
+  const InputError parameter = LoadError(
+      dir, std::string(kValidConfig) + "forcing_calibration: {parameter: mu1}\n", &path_first);
+  EXPECT_THAT(parameter.what(), HasSubstr("give eta_e (the forcing) or omega"));
   std::string path;
   const InputError negative =
       LoadError(dir, std::string(kValidConfig) + "forcing_calibration: {prior_sigma: -1}\n", &path);

@@ -40,6 +40,7 @@ TEST(RigConfigReader, ReadsEveryBlock) {
   EXPECT_EQ(config.rig.channels.response_filter_cutoff_hz, 250.0);
   EXPECT_EQ(config.rig.channels.base_filter_cutoff_hz, 0.0);
   EXPECT_EQ(config.rig.noise_relative_sigma, 0.005);
+  EXPECT_FALSE(config.rig.base_noise_relative_sigma.has_value());  // the response's
   EXPECT_EQ(config.rig.noise_seed, 9u);
   EXPECT_EQ(config.rig.gauge.boundary, BeamBoundary::kClampedClamped);
   EXPECT_EQ(config.rig.gauge.length_m, 0.5);
@@ -48,6 +49,23 @@ TEST(RigConfigReader, ReadsEveryBlock) {
   EXPECT_FALSE(config.processing.correct_channels);
   EXPECT_EQ(config.processing.channels.skew_samples, 0.5);
   EXPECT_EQ(config.processing.gauge.thickness_m, 1e-3);
+}
+
+TEST(RigConfigReader, TheBaseChannelMayHaveItsOwnNoise) {
+  std::string text = kRig;
+  const std::string noise = "noise: {relative_sigma: 0.005, seed: 9}";
+  text.replace(text.find(noise), noise.size(),
+               "noise: {relative_sigma: 0.005, base_relative_sigma: 0, seed: 9}");
+  const RigConfig config = ParseRigConfig(text, "rig.yaml");
+  ASSERT_TRUE(config.rig.base_noise_relative_sigma.has_value());
+  EXPECT_EQ(*config.rig.base_noise_relative_sigma, 0.0);
+  text.replace(text.find("base_relative_sigma: 0,"), 23, "base_relative_sigma: 2,");
+  try {
+    ParseRigConfig(text, "rig.yaml");
+    ADD_FAILURE() << "a base noise of 200 % was accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("noise base_relative_sigma must lie in [0, 1), got 2"));
+  }
 }
 
 TEST(RigConfigReader, ErrorsNameTheLineAndTheKey) {

@@ -98,5 +98,67 @@ TEST(ForcingCalibration, AHeldOutSweepsScaleComesFromItsDwellsBeforeTheJump) {
   EXPECT_NE(why.find("prior_sigma"), std::string::npos) << why;
 }
 
+// The "F" sweeps of a structure whose natural frequency drifted by `factor`
+// between sweeps: they are simulated at w * factor, the others at w.
+std::vector<Sweep> DriftedDataset(double factor) {
+  ParameterVector drifted = kThesisTruth;
+  drifted[kNaturalFrequency] *= factor;
+  const std::vector<Sweep> shifted = SimulateDataset(drifted, 0.0, 1);
+  std::vector<Sweep> sweeps = SimulateDataset(kThesisTruth, 0.0, 1);
+  for (size_t k = 0; k < sweeps.size(); ++k) {
+    if (sweeps[k].id == "F") sweeps[k] = shifted[k];
+  }
+  return sweeps;
+}
+
+TEST(ForcingCalibration, ThePriorOnTheNaturalFrequencyMatchesFiniteDifferences) {
+  const ForcingScalePrior prior(2, 0, 3.0, kNaturalFrequency);
+  ParameterVector shared = kThesisTruth;
+  std::vector<double> omegas = {1.01 * kThesisTruth[kNaturalFrequency], 250.0};
+  ceres::NumericDiffOptions numeric;
+  const std::vector<const ceres::Manifold*>* euclidean = nullptr;
+  ceres::GradientChecker checker(&prior, euclidean, numeric);
+  ceres::GradientChecker::ProbeResults results;
+  std::vector<double*> blocks = {shared.data(), omegas.data()};
+  EXPECT_TRUE(checker.Probe(blocks.data(), 1e-9, &results)) << results.error_log;
+  double residual = 0.0;
+  const double* values[] = {shared.data(), omegas.data()};
+  ASSERT_TRUE(prior.Evaluate(values, &residual, nullptr));
+  EXPECT_NEAR(residual, 3.0 * 0.01, 1e-15);
+}
+
+// With omega calibrated, each sweep gets its own w: the drifted sweeps' w_k
+// come out `factor` times the others', the other parameters true, and a
+// held-out drifted sweep's scale from its dwells before the jump is `factor`.
+TEST(ForcingCalibration, ADriftedNaturalFrequencyIsFoundPerSweep) {
+  const double factor = 1.003;
+  const std::vector<Sweep> sweeps = DriftedDataset(factor);
+  IdentificationOptions options;
+  options.initial = kThesisTruth;
+  options.initial[kEtaE] *= 1.02;
+  options.initial[kDelta] *= 0.9;
+  ForcingCalibrationOptions calibration;
+  calibration.parameter = CalibratedParameter::kNaturalFrequency;
+  const CalibratedIdentification result =
+      IdentifyWithForcingCalibration(Pointers(sweeps), options, calibration, 1e-9);
+  ASSERT_TRUE(result.fit.IsSolutionUsable()) << result.fit.message;
+  ASSERT_EQ(result.scales.size(), sweeps.size());
+  for (size_t k = 0; k < sweeps.size(); ++k) {
+    const double expected = sweeps[k].id == "F" ? factor : 1.0;
+    EXPECT_NEAR(result.scales[k] / result.scales.back(), expected, 1e-6) << sweeps[k].Name();
+  }
+  for (ParameterIndex i : {kEtaE, kMu1, kMu2, kDelta, kAlpha}) {
+    EXPECT_NEAR(result.fit.parameters[i] / kThesisTruth[i], 1.0, 1e-6) << ParameterName(i);
+  }
+  const Sweep& up = sweeps[0];
+  ASSERT_EQ(up.Name(), "F/up");
+  std::string why;
+  calibration.held_out_dwells = HeldOutDwells::kBelowHalfPeak;
+  EXPECT_NEAR(CalibrateHeldOutScale(up, kThesisTruth, options, calibration, 1e-8, &why), factor,
+              1e-6)
+      << why;
+  EXPECT_STREQ(CalibratedParameterName(calibration.parameter), "omega");
+}
+
 }  // namespace
 }  // namespace dwellfit

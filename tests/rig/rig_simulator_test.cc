@@ -231,6 +231,45 @@ TEST(RigSimulator, SettingsThatGiveNoUsableRecordAreRefused) {
   EXPECT_THAT(refusal(rig), HasSubstr("the simulated response channel is not finite"));
 }
 
+// The base channel's own noise: at 0 its samples are the noise-free run's,
+// at twice the response's its noise is twice the shared run's, and the
+// response channel's samples stay those of the run with one sigma for both.
+TEST(RigSimulator, TheBaseChannelTakesItsOwnNoiseFromTheSameDraws) {
+  DwellPlan plan;
+  plan.truth = kTruth;
+  plan.sweeps = {FrequencySweep("F0.01", 0.01, 39.0, 41.0, 1.0, {SweepDirection::kUp})};
+  RigOptions rig = ShortRig();
+  rig.record_periods = 4;
+  const RigRun clean = SimulateRig(plan, rig);
+  rig.noise_relative_sigma = 0.001;
+  rig.noise_seed = 5;
+  const RigRun shared = SimulateRig(plan, rig);
+  rig.base_noise_relative_sigma = 0.0;
+  const RigRun quiet_base = SimulateRig(plan, rig);
+  rig.base_noise_relative_sigma = 0.002;
+  const RigRun loud_base = SimulateRig(plan, rig);
+  ASSERT_EQ(clean.traces.size(), 3u);
+  for (std::size_t d = 0; d < clean.traces.size(); ++d) {
+    const DwellTrace& c = clean.traces[d];
+    EXPECT_EQ(quiet_base.traces[d].base, c.base);
+    EXPECT_EQ(quiet_base.traces[d].response, shared.traces[d].response);
+    EXPECT_EQ(loud_base.traces[d].response, shared.traces[d].response);
+    double noise = 0.0;
+    for (std::size_t i = 0; i < c.base.size(); ++i) {
+      const double shared_noise = shared.traces[d].base[i] - c.base[i];
+      const double loud_noise = loud_base.traces[d].base[i] - c.base[i];
+      EXPECT_NEAR(loud_noise, 2.0 * shared_noise, 1e-6 * std::abs(c.base[i]) + 1e-9)
+          << d << " " << i;
+      noise = std::max(noise, std::abs(shared_noise));
+    }
+    EXPECT_GT(noise, 0.0);
+  }
+  rig.base_noise_relative_sigma = 1.5;
+  std::string error;
+  EXPECT_FALSE(rig.IsValid(&error));
+  EXPECT_THAT(error, HasSubstr("noise base_relative_sigma must lie in [0, 1), got 1.5"));
+}
+
 // Harmonic balance (eqs. 3.12-3.13) on traces of ten dwells with 0.1 % noise
 // recovers eta_e, w and the effective nonlinearity within 1 % (with 0.5 %,
 // ten dwells are too few for the nonlinearity: datasets/virtual-beam has 456).
