@@ -27,20 +27,29 @@ std::vector<Sweep> MisleveledDataset(double factor) {
   return sweeps;
 }
 
-TEST(ForcingCalibration, ThePriorsJacobianMatchesFiniteDifferences) {
-  const ForcingScalePrior prior(3, 1, 7.0);
+// The prior's residual at the shared truth and `own`, after checking its
+// Jacobian against finite differences there.
+double CheckedPriorResidual(const ForcingScalePrior& prior, std::vector<double> own) {
   ParameterVector shared = kThesisTruth;
-  std::vector<double> etas = {95.0, 104.0, 99.0};
   ceres::NumericDiffOptions numeric;
   const std::vector<const ceres::Manifold*>* euclidean = nullptr;
   ceres::GradientChecker checker(&prior, euclidean, numeric);
   ceres::GradientChecker::ProbeResults results;
-  std::vector<double*> blocks = {shared.data(), etas.data()};
+  std::vector<double*> blocks = {shared.data(), own.data()};
   EXPECT_TRUE(checker.Probe(blocks.data(), 1e-9, &results)) << results.error_log;
   double residual = 0.0;
-  const double* values[] = {shared.data(), etas.data()};
-  ASSERT_TRUE(prior.Evaluate(values, &residual, nullptr));
-  EXPECT_DOUBLE_EQ(residual, 7.0 * (104.0 / 100.0 - 1.0));
+  const double* values[] = {shared.data(), own.data()};
+  EXPECT_TRUE(prior.Evaluate(values, &residual, nullptr));
+  return residual;
+}
+
+TEST(ForcingCalibration, ThePriorsJacobianMatchesFiniteDifferences) {
+  EXPECT_DOUBLE_EQ(CheckedPriorResidual(ForcingScalePrior(3, 1, 7.0), {95.0, 104.0, 99.0}),
+                   7.0 * (104.0 / 100.0 - 1.0));
+  // On the natural frequency: w_k / w - 1.
+  EXPECT_NEAR(CheckedPriorResidual(ForcingScalePrior(2, 0, 3.0, kNaturalFrequency),
+                                   {1.01 * kThesisTruth[kNaturalFrequency], 250.0}),
+              3.0 * 0.01, 1e-15);
 }
 
 TEST(ForcingCalibration, TheCalibratedFitFindsTheLevelErrorAndTheTrueParameters) {
@@ -109,22 +118,6 @@ std::vector<Sweep> DriftedDataset(double factor) {
     if (sweeps[k].id == "F") sweeps[k] = shifted[k];
   }
   return sweeps;
-}
-
-TEST(ForcingCalibration, ThePriorOnTheNaturalFrequencyMatchesFiniteDifferences) {
-  const ForcingScalePrior prior(2, 0, 3.0, kNaturalFrequency);
-  ParameterVector shared = kThesisTruth;
-  std::vector<double> omegas = {1.01 * kThesisTruth[kNaturalFrequency], 250.0};
-  ceres::NumericDiffOptions numeric;
-  const std::vector<const ceres::Manifold*>* euclidean = nullptr;
-  ceres::GradientChecker checker(&prior, euclidean, numeric);
-  ceres::GradientChecker::ProbeResults results;
-  std::vector<double*> blocks = {shared.data(), omegas.data()};
-  EXPECT_TRUE(checker.Probe(blocks.data(), 1e-9, &results)) << results.error_log;
-  double residual = 0.0;
-  const double* values[] = {shared.data(), omegas.data()};
-  ASSERT_TRUE(prior.Evaluate(values, &residual, nullptr));
-  EXPECT_NEAR(residual, 3.0 * 0.01, 1e-15);
 }
 
 // With omega calibrated, each sweep gets its own w: the drifted sweeps' w_k
