@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "dwellfit/estimator/analysis/level_noise.h"
 #include "dwellfit/estimator/analysis/profile_likelihood.h"
 #include "dwellfit/estimator/common/name_table.h"
 #include "dwellfit/estimator/common/string_printf.h"
@@ -231,6 +232,52 @@ void SetEffectiveNonlinearity(ParameterUncertainty* u) {
       u->effective_nonlinearity + u->interval_quantile * u->effective_nonlinearity_standard_error;
 }
 
+// The level's noise (level_noise.h) into `c`: its covariance, standard
+// errors, intervals and noise. Returns the term (groups 0: none).
+LevelNoise AddLevelNoise(const std::vector<const Sweep*>& fitted,
+                         const IdentificationOptions& options, const ParameterVector& estimate,
+                         BlockCovariance* c, ParameterUncertainty* u) {
+  const LevelNoise level =
+      EstimateLevelNoise(fitted, options, estimate, c->covariance, c->noise_sigma, c->data_cost,
+                         c->degrees_of_freedom, c->all_standardised);
+  if (!level.warning.empty()) u->warnings.push_back(level.warning);
+  if (level.groups == 0) return level;
+  c->covariance += level.added;
+  c->noise_sigma = level.noise_sigma;
+  for (int j : c->free) {
+    c->standard_error[j] = std::sqrt(std::max(c->covariance(j, j), 0.0));
+    c->ci95_low[j] = c->values[j] - c->interval_quantile * c->standard_error[j];
+    c->ci95_high[j] = c->values[j] + c->interval_quantile * c->standard_error[j];
+  }
+  c->message += StringPrintf("; with the measured level's noise (%d level draws)", level.groups);
+  return level;
+}
+
+// A profile interval's ends moved out by the level's variance `added` (the
+// profile holds the residuals' scatter only): each half-width h becomes
+// sqrt(h^2 + q^2 added).
+void WidenBy(double estimate, double added, double q, double* low, double* high) {
+  const auto widen = [&](double half) {
+    return std::sqrt(std::max(half * half + q * q * added, 0.0));
+  };
+  if (std::isfinite(*low)) *low = estimate - widen(estimate - *low);
+  if (std::isfinite(*high)) *high = estimate + widen(*high - estimate);
+}
+
+void WidenProfileByLevel(const LevelNoise& level, const ParameterVector& estimate,
+                         ParameterUncertainty* u) {
+  for (int j = 0; j < kNumParameters; ++j) {
+    if (level.added(j, j) == 0.0) continue;
+    WidenBy(estimate[j], level.added(j, j), u->interval_quantile, &u->ci95_low[j],
+            &u->ci95_high[j]);
+  }
+  Eigen::Matrix<double, kNumParameters, 1> g = Eigen::Matrix<double, kNumParameters, 1>::Zero();
+  g[kDelta] = -(2.0 / 3.0) * u->omega_ref_rad_s * u->omega_ref_rad_s;
+  g[kAlpha] = 1.0;
+  WidenBy(u->effective_nonlinearity, g.dot(level.added * g), u->interval_quantile,
+          &u->effective_nonlinearity_ci95_low, &u->effective_nonlinearity_ci95_high);
+}
+
 // Warnings: weakly separated pairs, parameters held by their bound.
 void AddPairAndBoundWarnings(const std::vector<int>& free, const ParameterVector& estimate,
                              ParameterUncertainty* u) {
@@ -442,10 +489,13 @@ ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted
   if (!std::isfinite(u.effective_nonlinearity)) u.effective_nonlinearity = 0.0;
 
   const BlockCovariance data_only = PenalisedCovariance(fitted, options, estimate, 1.0, {});
-  const BlockCovariance c =
+  const BlockCovariance without_level =
       method == IntervalMethod::kDataOnly || !data_only.available
           ? data_only
           : PenaltyCovariance(fitted, options, estimate, summary, data_only, &u);
+  BlockCovariance c = without_level;
+  const LevelNoise level =
+      c.available ? AddLevelNoise(fitted, options, estimate, &c, &u) : LevelNoise();
   CopyCounts(c, &u);
   if (c.evaluated) WarnAboutDwellsPastTheirBranchEnd(fitted, estimate, &u);
   if (!c.available) {
@@ -467,11 +517,15 @@ ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted
   u.available = true;
   u.message = c.message;
   if (method == IntervalMethod::kProfile) {
-    ProfileIntervals(fitted, options, estimate, summary, c, threads, &u);
+    ProfileIntervals(fitted, options, estimate, summary, without_level, threads, &u);
   }
   if (u.interval_kind == "profile_likelihood") {
     u.message +=
         StringPrintf("; profile-likelihood intervals from %d constrained fits", u.profile.fits);
+    if (level.groups > 0) {
+      WidenProfileByLevel(level, estimate, &u);
+      u.message += ", widened by the level's noise";
+    }
   }
   if (!u.warnings.empty())
     u.message += StringPrintf("; %d warning(s)", static_cast<int>(u.warnings.size()));

@@ -117,6 +117,7 @@ void QuantityMap::Apply(Sweep* sweep) const {
     point.amplitude = Amplitude(point.amplitude, omega);
     if (point.sigma) point.sigma = Amplitude(*point.sigma, omega);
     point.a_base = Level(point.a_base, omega);
+    if (point.a_base_sigma) point.a_base_sigma = Level(*point.a_base_sigma, omega);
     if (point.phase_rad) point.phase_rad = Phase(*point.phase_rad);
   }
   for (MissingDwell& row : sweep->missing)

@@ -31,6 +31,10 @@ struct DwellPoint {
   std::optional<double> sigma;         // standard deviation of `amplitude`, when given
   Branch branch = Branch::kOnly;       // stable branch it was measured on
   int source_line = 0;                 // 1-based line in the source file (0: generated)
+  // Standard deviation of `a_base` (data's unit), when known: the measured
+  // level's own noise (estimator/analysis/level_noise.h). A frequency sweep's
+  // dwells share one level and so one error.
+  std::optional<double> a_base_sigma;
 };
 
 // A jump between two consecutive dwells: the model's fold lies between the two

@@ -246,13 +246,19 @@ void BuildSweeps(const std::vector<DwellTrace>& dwells, const TraceProcessingOpt
     // Omega, a_base = |A_1|, a = |U_1| and the lag.
     out->sweeps[it->second].points.push_back(
         DwellPoint{dwells[i].drive_frequency_rad_s, std::abs(h.base[1]), std::abs(h.u[1]), Lag(h)});
+    if (base_noise[i] > 0.0)
+      out->sweeps[it->second].points.back().a_base_sigma = std::abs(h.base[1]) * base_noise[i];
     members[it->second].push_back(i);
   }
   for (std::size_t s = 0; s < out->sweeps.size(); ++s) {
     Sweep& sweep = out->sweeps[s];
     if (sweep.kind != SweepKind::kFrequency) continue;
-    double mean = 0.0;
-    for (const DwellPoint& point : sweep.points) mean += point.a_base / sweep.points.size();
+    double mean = 0.0, mean_variance = 0.0;  // the mean level and its error's variance
+    const double n = static_cast<double>(sweep.points.size());
+    for (const DwellPoint& point : sweep.points) {
+      mean += point.a_base / n;
+      mean_variance += std::pow(point.a_base_sigma.value_or(0.0) / n, 2);
+    }
     for (std::size_t j = 0; j < sweep.points.size(); ++j) {
       const double change = sweep.points[j].a_base / mean - 1.0;
       const double limit =
@@ -264,6 +270,8 @@ void BuildSweeps(const std::vector<DwellTrace>& dwells, const TraceProcessingOpt
                          dwells[members[s][j]].Describe().c_str(), 100 * change));
       }
       sweep.points[j].a_base = mean;
+      sweep.points[j].a_base_sigma.reset();
+      if (mean_variance > 0.0) sweep.points[j].a_base_sigma = std::sqrt(mean_variance);
     }
   }
 }

@@ -29,6 +29,10 @@
 //               more than 5 standard deviations of its noise.
 // The sweeps CSV needs one base level per frequency sweep: its dwells get the
 // mean of their measured levels; amplitude sweeps keep each dwell's own.
+// Each level's standard deviation (DwellPoint::a_base_sigma) comes from the
+// base channel's noise outside the harmonics: |A_1| s_b sqrt(2 / N) for one
+// dwell (s_b the noise per sample relative to |A_1|, N samples), and
+// sqrt(sum_j sigma_j^2) / n for the mean of a frequency sweep's n dwells.
 #ifndef DWELLFIT_ESTIMATOR_TRACES_TRACE_PROCESSING_H_
 #define DWELLFIT_ESTIMATOR_TRACES_TRACE_PROCESSING_H_
 

@@ -270,6 +270,54 @@ TEST(RigSimulator, TheBaseChannelTakesItsOwnNoiseFromTheSameDraws) {
   EXPECT_THAT(error, HasSubstr("noise base_relative_sigma must lie in [0, 1), got 1.5"));
 }
 
+// The levels process_traces reports carry their noise: an amplitude sweep's
+// dwells the rig's per-dwell sigma (0.5 % of the level: rig_simulator.h),
+// whose measured errors (against the noise-free run) spread as stated, and a
+// frequency sweep's mean level that sigma over sqrt(n).
+TEST(RigSimulator, ProcessedLevelsStateTheBaseChannelsNoise) {
+  DwellPlan plan;
+  plan.truth = kTruth;
+  plan.sweeps = {FrequencySweep("F0.01", 0.01, 36.0, 38.9, 0.1, {SweepDirection::kUp}),
+                 AmplitudeSweep("A37", 37.0, 0.005, 0.0109, 0.0001, {SweepDirection::kUp})};
+  RigOptions rig = ShortRig();
+  TraceProcessingOptions options;
+  options.gauge = rig.gauge;
+  const ProcessedTraces clean = ProcessTraces(SimulateRig(plan, rig).traces, options);
+  rig.noise_relative_sigma = 0.005;
+  rig.noise_seed = 11;
+  const ProcessedTraces noisy = ProcessTraces(SimulateRig(plan, rig).traces, options);
+  ASSERT_EQ(noisy.sweeps.size(), 2u);
+  const Sweep& frequency = noisy.sweeps[0];
+  const Sweep& amplitude = noisy.sweeps[1];
+  ASSERT_EQ(frequency.points.size(), 30u);
+  ASSERT_EQ(amplitude.points.size(), 60u);
+  // Each sigma is estimated from the few noise bins of a short record: its
+  // mean is near the rig's, each within half of it.
+  double z2 = 0.0, mean = 0.0;
+  for (std::size_t i = 0; i < amplitude.points.size(); ++i) {
+    const DwellPoint& point = amplitude.points[i];
+    ASSERT_TRUE(point.a_base_sigma.has_value()) << i;
+    const double relative = *point.a_base_sigma / point.a_base;
+    EXPECT_NEAR(relative, 0.005, 0.0025) << i;
+    mean += relative / amplitude.points.size();
+    const double error = point.a_base - clean.sweeps[1].points[i].a_base;
+    z2 += std::pow(error / *point.a_base_sigma, 2) / amplitude.points.size();
+  }
+  EXPECT_NEAR(mean, 0.005, 0.0005);
+  EXPECT_GT(std::sqrt(z2), 0.7);  // 60 draws: the RMS of z is 1 +/- 0.09
+  EXPECT_LT(std::sqrt(z2), 1.3);
+  for (const DwellPoint& point : frequency.points) {
+    ASSERT_TRUE(point.a_base_sigma.has_value());
+    EXPECT_NEAR(*point.a_base_sigma / point.a_base, 0.005 / std::sqrt(30.0),
+                0.15 * 0.005 / std::sqrt(30.0));
+  }
+  // Without noise what is left is the window's leakage (4 periods, 27.7
+  // samples per period, whole to within half a sample): well below the noise.
+  for (const DwellPoint& point : clean.sweeps[1].points) {
+    EXPECT_LT(point.a_base_sigma.value_or(0.0) / point.a_base, 0.4 * 0.005);
+  }
+}
+
 // Harmonic balance (eqs. 3.12-3.13) on traces of ten dwells with 0.1 % noise
 // recovers eta_e, w and the effective nonlinearity within 1 % (with 0.5 %,
 // ten dwells are too few for the nonlinearity: datasets/virtual-beam has 456).
