@@ -28,13 +28,15 @@ DEFINE_string(set, "",
               "Overrides config values as identify's --set: key.path=value[,...], e.g. "
               "\"fixed=[mu2, delta],initial_guess.delta=0\"");
 DEFINE_string(output, "", "Markdown file to write (empty: stdout)");
+DEFINE_bool(leave_one_level_out, false,
+            "Hold out each fitted and validated level in turn, fitting all the others");
 
 int main(int argc, char** argv) {
   const dwellfit::ToolSpec tool = {
       "forcing_calibration",
       "held-out errors with and without per-sweep forcing calibration.\n"
       "  forcing_calibration --config CFG [--set K=V --prior_sigma S --held_out_dwells before_jump|"
-      "below_half_peak --parameter eta_e|omega --output FILE]",
+      "below_half_peak --parameter eta_e|omega --leave_one_level_out --output FILE]",
       __FILE__};
   return dwellfit::RunTool(argc, argv, tool, [] {
     if (!FLAGS_output.empty()) dwellfit::CheckOutputFile(FLAGS_output, "--output", {FLAGS_config});
@@ -57,8 +59,12 @@ int main(int argc, char** argv) {
       throw dwellfit::InputError("--parameter", 0, "",
                                  "give eta_e or omega, got '" + FLAGS_parameter + "'");
     }
-    const std::string markdown = dwellfit::ForcingCalibrationMarkdown(
-        dwellfit::CompareForcingCalibration(config, calibration));
+    const std::string markdown =
+        FLAGS_leave_one_level_out
+            ? dwellfit::LeaveOneLevelOutMarkdown(config, calibration,
+                                                 dwellfit::LeaveOneLevelOut(config, calibration))
+            : dwellfit::ForcingCalibrationMarkdown(
+                  dwellfit::CompareForcingCalibration(config, calibration));
     if (FLAGS_output.empty()) {
       std::cout << markdown;
     } else {

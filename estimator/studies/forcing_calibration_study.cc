@@ -1,5 +1,6 @@
 #include "dwellfit/estimator/studies/forcing_calibration_study.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -10,6 +11,7 @@
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/run/resolved_run.h"
+#include "dwellfit/estimator/studies/model_selection.h"
 
 namespace dwellfit {
 namespace {
@@ -43,6 +45,27 @@ int FreeParameters(const IdentificationOptions& options) {
 
 std::string Percent(double value) {
   return std::isfinite(value) ? StringPrintf("%+.3g", value) : std::string("-");
+}
+
+// The held-out table's header, its rows (without those measuring neither
+// quantity when `skip_empty`) and the medians of every row given.
+void HeldOutTable(const std::vector<HeldOutSweepErrors>& without,
+                  const std::vector<HeldOutSweepErrors>& with, bool skip_empty,
+                  std::ostringstream* out) {
+  *out << "| held-out sweep | s_v | jump-down % without | with | upper branch % without | "
+          "with |\n|---|---|---|---|---|---|\n";
+  for (size_t v = 0; v < with.size(); ++v) {
+    const HeldOutSweepErrors& a = without[v];
+    const HeldOutSweepErrors& b = with[v];
+    if (skip_empty && std::isnan(a.jump_down_percent) && std::isnan(a.upper_branch_percent))
+      continue;
+    *out << "| " << a.sweep << " | " << StringPrintf("%.4f", b.scale) << " | "
+         << Percent(a.jump_down_percent) << " | " << Percent(b.jump_down_percent) << " | "
+         << Percent(a.upper_branch_percent) << " | " << Percent(b.upper_branch_percent) << " |\n";
+  }
+  *out << StringPrintf("| **median \\|error\\|** | | %.3g | %.3g | %.3g | %.3g |\n\n",
+                       MedianAbsoluteError(without, true), MedianAbsoluteError(with, true),
+                       MedianAbsoluteError(without, false), MedianAbsoluteError(with, false));
 }
 
 }  // namespace
@@ -111,25 +134,70 @@ std::string ForcingCalibrationMarkdown(const ForcingCalibrationComparison& c) {
     out << StringPrintf(" %s %.4f%s", c.fitted[k].c_str(), c.with.scales[k],
                         k + 1 < c.fitted.size() ? "," : ".");
   }
-  out << "\n\n| held-out sweep | s_v | jump-down % without | with | upper branch % without | "
-         "with |\n|---|---|---|---|---|---|\n";
-  for (size_t v = 0; v < c.errors_with.size(); ++v) {
-    const HeldOutSweepErrors& a = c.errors_without[v];
-    const HeldOutSweepErrors& b = c.errors_with[v];
-    out << "| " << a.sweep << " | " << StringPrintf("%.4f", b.scale) << " | "
-        << Percent(a.jump_down_percent) << " | " << Percent(b.jump_down_percent) << " | "
-        << Percent(a.upper_branch_percent) << " | " << Percent(b.upper_branch_percent) << " |\n";
-  }
-  out << StringPrintf(
-      "| **median \\|error\\|** | | %.3g | %.3g | %.3g | %.3g |\n\n",
-      MedianAbsoluteError(c.errors_without, true), MedianAbsoluteError(c.errors_with, true),
-      MedianAbsoluteError(c.errors_without, false), MedianAbsoluteError(c.errors_with, false));
+  out << "\n\n";
+  HeldOutTable(c.errors_without, c.errors_with, false, &out);
   if (c.held_out_dwells == HeldOutDwells::kBeforeJump) {
     out << "With the calibration, an up-sweep's upper-branch dwells are among those its scale is "
            "calibrated on: their amplitude is fitted there, not predicted (below_half_peak "
            "keeps it a prediction).\n\n";
   }
   for (const std::string& note : c.notes) out << "- " << note << "\n";
+  return out.str();
+}
+
+std::vector<LevelOutErrors> LeaveOneLevelOut(const IdentifyConfig& config,
+                                             const ForcingCalibrationOptions& calibration) {
+  // The fitted and validated levels in data order, as select_model takes them.
+  std::vector<std::string> levels;
+  {
+    const ResolvedRun run = ResolveRun(config);
+    for (const std::vector<const Sweep*>* list : {&run.fitted, &run.validation}) {
+      for (const Sweep* sweep : *list) {
+        if (std::find(levels.begin(), levels.end(), sweep->id) == levels.end())
+          levels.push_back(sweep->id);
+      }
+    }
+    std::vector<std::string> ordered;
+    for (const Sweep& sweep : run.sweeps) {
+      if (std::find(levels.begin(), levels.end(), sweep.id) != levels.end() &&
+          std::find(ordered.begin(), ordered.end(), sweep.id) == ordered.end())
+        ordered.push_back(sweep.id);
+    }
+    levels = ordered;
+  }
+  std::vector<LevelOutErrors> folds;
+  for (int out = 0; out < static_cast<int>(levels.size()); ++out) {
+    IdentifyConfig fold = config;
+    fold.fit_sweeps = ConfigTraining(config, levels, out);
+    fold.validate_sweeps = {SweepSelection{levels[out], std::nullopt}};
+    ForcingCalibrationComparison c;
+    try {
+      c = CompareForcingCalibration(fold, calibration);
+    } catch (const InputError& e) {
+      throw InputError(levels[out] + " held out: " + e.what());
+    }
+    folds.push_back({levels[out], c.errors_without, c.errors_with, c.notes});
+  }
+  return folds;
+}
+
+std::string LeaveOneLevelOutMarkdown(const IdentifyConfig& config,
+                                     const ForcingCalibrationOptions& calibration,
+                                     const std::vector<LevelOutErrors>& folds) {
+  std::ostringstream out;
+  out << "## `" << config.config_path << "`, leave one level out, "
+      << CalibratedParameterName(calibration.parameter) << " per sweep, prior sigma "
+      << calibration.prior_sigma << ", held-out scales from "
+      << HeldOutDwellsName(calibration.held_out_dwells) << "\n\n";
+  std::vector<HeldOutSweepErrors> without, with;
+  for (const LevelOutErrors& fold : folds) {
+    without.insert(without.end(), fold.without.begin(), fold.without.end());
+    with.insert(with.end(), fold.with.begin(), fold.with.end());
+  }
+  HeldOutTable(without, with, true, &out);
+  for (const LevelOutErrors& fold : folds) {
+    for (const std::string& note : fold.notes) out << "- " << fold.level << ": " << note << "\n";
+  }
   return out.str();
 }
 

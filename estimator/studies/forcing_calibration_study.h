@@ -47,6 +47,28 @@ double MedianAbsoluteError(const std::vector<HeldOutSweepErrors>& errors, bool j
 // The comparison as Markdown: fits, fitted scales, per held-out sweep, medians.
 std::string ForcingCalibrationMarkdown(const ForcingCalibrationComparison& comparison);
 
+// Leave-one-level-out as select_model's `training: config` does it
+// (docs/model-selection.md): each level (sweep id) of the config's fit and
+// validate lists held out in turn, the config's fit sweeps fitted with a
+// held-out one replaced by the nearest level not fitted (ConfigTraining), its
+// sweeps predicted with and without the calibration as above.
+struct LevelOutErrors {
+  std::string level;  // the held-out sweep id
+  std::vector<HeldOutSweepErrors> without, with;
+  std::vector<std::string> notes;
+};
+
+// Throws InputError as CompareForcingCalibration does (a fold whose fit
+// fails names its level).
+std::vector<LevelOutErrors> LeaveOneLevelOut(const IdentifyConfig& config,
+                                             const ForcingCalibrationOptions& calibration);
+
+// The folds as Markdown: per level, then the medians over levels of each
+// quantity's |error| (every held-out sweep's, pooled).
+std::string LeaveOneLevelOutMarkdown(const IdentifyConfig& config,
+                                     const ForcingCalibrationOptions& calibration,
+                                     const std::vector<LevelOutErrors>& folds);
+
 }  // namespace dwellfit
 
 #endif  // DWELLFIT_ESTIMATOR_STUDIES_FORCING_CALIBRATION_STUDY_H_

@@ -112,29 +112,6 @@ int TrainingIndex(const std::vector<SweepSelection>& set, Plan* plan) {
   return static_cast<int>(plan->training.size()) - 1;
 }
 
-// The training set of `level` under `training: config`: the config's fit
-// sweeps, the level's own replaced by the nearest pool level not fitted.
-std::vector<SweepSelection> ConfigTraining(const IdentifyConfig& config,
-                                           const std::vector<std::string>& levels, int level) {
-  std::set<std::string> fitted;
-  for (const SweepSelection& s : config.fit_sweeps) fitted.insert(s.sweep_id);
-  if (!fitted.count(levels[level])) return config.fit_sweeps;
-  const int count = static_cast<int>(levels.size());
-  for (int distance = 1; distance < count; ++distance) {
-    for (int candidate : {level - distance, level + distance}) {
-      if (candidate < 0 || candidate >= count || fitted.count(levels[candidate])) continue;
-      std::vector<SweepSelection> set = config.fit_sweeps;
-      for (SweepSelection& s : set) {
-        if (s.sweep_id == levels[level]) s.sweep_id = levels[candidate];
-      }
-      return set;
-    }
-  }
-  throw InputError(config.config_path, 0, "model_selection.pool",
-                   "every pool level is fitted, so level '" + levels[level] +
-                       "' has no unfitted level to stand in for it; widen the pool");
-}
-
 // The pool's sweeps (checked to exist) and their levels in data order.
 std::vector<const Sweep*> PoolSweeps(const IdentifyConfig& config,
                                      const std::vector<SweepSelection>& pool,
@@ -508,6 +485,29 @@ int Choose(const ModelSelectionReport& report, const std::vector<int>& candidate
 }
 
 }  // namespace
+
+// The training set of `level` under `training: config`: the config's fit
+// sweeps, the level's own replaced by the nearest pool level not fitted.
+std::vector<SweepSelection> ConfigTraining(const IdentifyConfig& config,
+                                           const std::vector<std::string>& levels, int level) {
+  std::set<std::string> fitted;
+  for (const SweepSelection& s : config.fit_sweeps) fitted.insert(s.sweep_id);
+  if (!fitted.count(levels[level])) return config.fit_sweeps;
+  const int count = static_cast<int>(levels.size());
+  for (int distance = 1; distance < count; ++distance) {
+    for (int candidate : {level - distance, level + distance}) {
+      if (candidate < 0 || candidate >= count || fitted.count(levels[candidate])) continue;
+      std::vector<SweepSelection> set = config.fit_sweeps;
+      for (SweepSelection& s : set) {
+        if (s.sweep_id == levels[level]) s.sweep_id = levels[candidate];
+      }
+      return set;
+    }
+  }
+  throw InputError(config.config_path, 0, "model_selection.pool",
+                   "every pool level is fitted, so level '" + levels[level] +
+                       "' has no unfitted level to stand in for it; widen the pool");
+}
 
 void RecommendVariant(ModelSelectionReport* report) {
   std::vector<int> eligible, stable;

@@ -90,6 +90,13 @@ struct ParameterSpread {
   double relative_range = 0.0;                // (max - min) / |median|; inf when median is 0
 };
 
+// The training set of leave-one-level-out fold `level` under `training:
+// config`: the config's fit sweeps, the held-out level's own replaced by the
+// nearest level of `levels` (data order) that is not fitted, the lower on a
+// tie. Throws InputError when every level is fitted.
+std::vector<SweepSelection> ConfigTraining(const IdentifyConfig& config,
+                                           const std::vector<std::string>& levels, int level);
+
 struct VariantResult {
   ModelVariant variant;
   int free_parameters = 0;
