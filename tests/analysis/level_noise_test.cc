@@ -170,5 +170,41 @@ TEST_F(LevelNoiseThesisNumerical, TheAmplitudesOwnNoiseIsSeparatedFromTheLevels)
   EXPECT_THAT(u.warnings, ::testing::Each(::testing::Not(::testing::HasSubstr("a_base_sigma"))));
 }
 
+// The reported profile intervals: each side's half-width h (the profile's,
+// without the level) becomes sqrt(h^2 + q^2 dC_jj), dC the level's term of
+// the linearised covariance; alpha_e's likewise with g^T dC g.
+TEST_F(LevelNoiseThesisNumerical, ProfileIntervalsAreWidenedByTheLevelsTerm) {
+  const ParameterVector estimate = Fit(options_.initial);
+  const ParameterUncertainty profile0 =
+      EstimateUncertainty(run_.fitted, options_, estimate, 0.0, nullptr, IntervalMethod::kProfile);
+  const ParameterUncertainty linear0 = EstimateUncertainty(run_.fitted, options_, estimate, 0.0,
+                                                           nullptr, IntervalMethod::kLinearised);
+  for (Sweep& sweep : run_.sweeps) {
+    for (DwellPoint& point : sweep.points) point.a_base_sigma = 0.005 * point.a_base;
+  }
+  const ParameterUncertainty profile1 =
+      EstimateUncertainty(run_.fitted, options_, estimate, 0.0, nullptr, IntervalMethod::kProfile);
+  const ParameterUncertainty linear1 = EstimateUncertainty(run_.fitted, options_, estimate, 0.0,
+                                                           nullptr, IntervalMethod::kLinearised);
+  ASSERT_EQ(profile0.interval_kind, "profile_likelihood") << profile0.message;
+  ASSERT_EQ(profile1.interval_kind, "profile_likelihood") << profile1.message;
+  EXPECT_THAT(profile1.message, ::testing::HasSubstr("widened by the level's noise"));
+  const double q = profile1.interval_quantile;
+  const auto widened = [q](double half, double added) {
+    return std::sqrt(half * half + q * q * added);
+  };
+  for (int j = 0; j < kNumParameters; ++j) {
+    if (options_.fixed[j]) continue;
+    const double added = linear1.covariance(j, j) - linear0.covariance(j, j);
+    EXPECT_GT(added, 0.0) << ParameterName(j);
+    const double low = widened(estimate[j] - profile0.ci95_low[j], added);
+    const double high = widened(profile0.ci95_high[j] - estimate[j], added);
+    EXPECT_NEAR(estimate[j] - profile1.ci95_low[j], low, 1e-6 * low) << ParameterName(j);
+    EXPECT_NEAR(profile1.ci95_high[j] - estimate[j], high, 1e-6 * high) << ParameterName(j);
+  }
+  EXPECT_GT(profile1.effective_nonlinearity_ci95_high - profile1.effective_nonlinearity_ci95_low,
+            profile0.effective_nonlinearity_ci95_high - profile0.effective_nonlinearity_ci95_low);
+}
+
 }  // namespace
 }  // namespace dwellfit
