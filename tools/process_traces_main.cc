@@ -39,7 +39,8 @@
 DEFINE_string(rig, "", "YAML rig: channels, beam and gauge, processing (required).");
 DEFINE_string(traces, "", "Folder holding traces.csv and traces.f32 (or give --uff).");
 DEFINE_string(uff, "", "UFF index CSV naming each dwell's data sets 58 (instead of --traces).");
-DEFINE_string(out, "", "Sweeps CSV to write (sweep,direction,freq_hz,a_base,a,phase_rad).");
+DEFINE_string(out, "",
+              "Sweeps CSV to write (sweep,direction,freq_hz,a_base,a,phase_rad,a_base_sigma).");
 DEFINE_string(harmonic_balance, "", "If set, also identify by harmonic balance into this YAML.");
 DEFINE_double(reference_hz, 0.0, "Omega_ref [Hz] of the effective nonlinearity (0: identified w).");
 DEFINE_bool(allow_unsettled, false, "Write the results even when a dwell looks unsettled.");

@@ -30,11 +30,12 @@ constexpr char kAmplitudeColumn[] = "a";
 constexpr char kPhaseDegColumn[] = "phase_deg";
 constexpr char kPhaseRadColumn[] = "phase_rad";
 constexpr char kSigmaColumn[] = "sigma";
-constexpr int kNumColumns = 8;
+constexpr char kABaseSigmaColumn[] = "a_base_sigma";
+constexpr int kNumColumns = 9;
 
 constexpr char kAllowedColumns[] =
     "allowed columns are sweep, direction, freq_hz, a_base, a (required) and phase_deg or "
-    "phase_rad, sigma (optional)";
+    "phase_rad, sigma, a_base_sigma (optional)";
 
 constexpr double kRadiansPerDegree = kTwoPi / 360.0;
 
@@ -70,6 +71,8 @@ const Range kAmplitudeRange = {
     "give a in a unit that puts it inside the range, or write 0 for a missing measurement"};
 const Range kSigmaRange = {1e-20, 1e20, "the standard deviation sigma", "sigma^2",
                            "sigma is in the unit of a"};
+const Range kABaseSigmaRange = {1e-20, 1e20, "the standard deviation a_base_sigma",
+                                "a_base_sigma^2", "a_base_sigma is in the unit of a_base"};
 
 // Parses the whole of `text` as a finite double, locale-independently.
 double ParseNumber(const Location& where, const char* column, const char* text) {
@@ -151,7 +154,7 @@ int ReadHeader(const std::string& path, CsvReader* reader) {
   try {
     reader->read_header(io::ignore_missing_column, kSweepColumn, kDirectionColumn, kFrequencyColumn,
                         kABaseColumn, kAmplitudeColumn, kPhaseDegColumn, kPhaseRadColumn,
-                        kSigmaColumn);
+                        kSigmaColumn, kABaseSigmaColumn);
   } catch (const io::error::header_missing&) {
     throw InputError(path, 1, "",
                      "the file is empty; expected a header row naming the columns (" +
@@ -191,7 +194,7 @@ bool ReadRow(const std::string& path, CsvReader* reader, RowFields* row) {
   *row = RowFields();
   try {
     return reader->read_row(row->sweep, row->direction, row->freq_hz, row->a_base, row->a,
-                            row->phase_deg, row->phase_rad, row->sigma);
+                            row->phase_deg, row->phase_rad, row->sigma, row->a_base_sigma);
   } catch (const io::error::too_few_columns&) {
     throw InputError(path, static_cast<int>(reader->get_file_line()), "",
                      "row has fewer fields than the header; give one value per header column");
@@ -220,6 +223,7 @@ struct RowValues {
   double amplitude = 0.0;  // <= 0: a missing measurement
   std::optional<double> phase_rad;
   std::optional<double> sigma;
+  std::optional<double> a_base_sigma;  // standard deviation of a_base (a_base's unit)
 };
 
 RowValues ParseRow(const Location& where, const RowFields& row) {
@@ -247,6 +251,10 @@ RowValues ParseRow(const Location& where, const RowFields& row) {
   }
   if (row.sigma != nullptr)
     values.sigma = ParseInRange(where, kSigmaColumn, row.sigma, kSigmaRange);
+  if (row.a_base_sigma != nullptr) {
+    values.a_base_sigma =
+        ParseInRange(where, kABaseSigmaColumn, row.a_base_sigma, kABaseSigmaRange);
+  }
   return values;
 }
 
@@ -258,7 +266,12 @@ struct SweepBuilder {
   double first_a_base = 0.0;
   int freq_change_line = 0;    // first line whose freq_hz differs from the first row's
   int a_base_change_line = 0;  // likewise for a_base
-  RowValues last;              // the sweep's previous row
+  RowValues first;             // the sweep's first row
+  // The first line whose a_base_sigma differs from the first row's (0: none
+  // yet), and its value.
+  int a_base_sigma_change_line = 0;
+  std::optional<double> changed_a_base_sigma;
+  RowValues last;  // the sweep's previous row
 };
 
 // Records a row's controls; throws when the second control starts to vary.
@@ -287,6 +300,40 @@ void TrackControls(const Location& where, double freq_hz, double a_base, SweepBu
   }
 }
 
+// Text of an optional a_base_sigma for messages.
+std::string LevelSigmaText(const std::optional<double>& sigma) {
+  return sigma ? FormatRoundTrip(*sigma) : std::string("none");
+}
+
+// Throws when the frequency sweep (one level a_base) of `builder` states two
+// values of a_base_sigma, naming the first row whose value differs.
+void CheckSharedLevelSigma(const std::string& path, const SweepBuilder& builder) {
+  if (builder.a_base_sigma_change_line == 0) return;
+  throw InputError(
+      path, builder.a_base_sigma_change_line, kABaseSigmaColumn,
+      "sweep '" + EscapeForMessage(builder.sweep.Name()) +
+          "' is a frequency sweep (one level a_base), but its a_base_sigma changes from " +
+          LevelSigmaText(builder.first.a_base_sigma) + " (line " +
+          std::to_string(builder.first.line) + ") to " +
+          LevelSigmaText(builder.changed_a_base_sigma) +
+          "; the rows of a frequency sweep share one level and so one level error: give each "
+          "of them the same a_base_sigma (the standard deviation of the sweep's level)");
+}
+
+// Records where a row's a_base_sigma first differs from its sweep's first
+// row's; throws once freq_hz varies too (the sweep is a frequency sweep).
+void TrackLevelSigma(const Location& where, const RowValues& row, SweepBuilder* builder) {
+  if (builder->num_rows == 1) {
+    builder->first = row;
+    return;
+  }
+  if (builder->a_base_sigma_change_line == 0 && row.a_base_sigma != builder->first.a_base_sigma) {
+    builder->a_base_sigma_change_line = where.line;
+    builder->changed_a_base_sigma = row.a_base_sigma;
+  }
+  if (builder->freq_change_line > 0) CheckSharedLevelSigma(where.file, *builder);
+}
+
 // Throws when `row` moves its sweep's control against the sweep's direction
 // (a frequency sweep's freq_hz, an amplitude sweep's a_base; only one varies).
 void CheckOrder(const Location& where, const RowValues& row, const SweepBuilder& builder) {
@@ -313,7 +360,8 @@ void CheckOrder(const Location& where, const RowValues& row, const SweepBuilder&
 void CheckNotACopy(const Location& where, const RowValues& row, const SweepBuilder& builder) {
   const RowValues& last = builder.last;
   if (!(row.amplitude > 0.0) || row.amplitude != last.amplitude || row.freq_hz != last.freq_hz ||
-      row.a_base != last.a_base || row.phase_rad != last.phase_rad || row.sigma != last.sigma) {
+      row.a_base != last.a_base || row.phase_rad != last.phase_rad || row.sigma != last.sigma ||
+      row.a_base_sigma != last.a_base_sigma) {
     return;
   }
   throw InputError(where.file, where.line, "",
@@ -327,6 +375,7 @@ void CheckNotACopy(const Location& where, const RowValues& row, const SweepBuild
 // Adds a checked row to its sweep: a dwell, or a missing measurement (a <= 0).
 void AddRow(const Location& where, const RowValues& row, SweepBuilder* builder) {
   TrackControls(where, row.freq_hz, row.a_base, builder);
+  TrackLevelSigma(where, row, builder);
   if (builder->num_rows > 1) {
     CheckOrder(where, row, *builder);
     CheckNotACopy(where, row, *builder);
@@ -340,7 +389,8 @@ void AddRow(const Location& where, const RowValues& row, SweepBuilder* builder) 
     return;
   }
   sweep.points.push_back(DwellPoint{HzToRadPerSecond(row.freq_hz), row.a_base, row.amplitude,
-                                    row.phase_rad, row.sigma, Branch::kOnly, row.line});
+                                    row.phase_rad, row.sigma, Branch::kOnly, row.line,
+                                    row.a_base_sigma});
 }
 
 void WarnAboutDroppedRows(const std::string& path, const std::vector<SweepBuilder>& builders) {
@@ -456,6 +506,10 @@ LoadedSweeps LoadSweepsFromRows(const std::string& path, int header_line,
   if (builders.empty()) {
     throw InputError(path, header_line, "",
                      "the file has a header but no data rows; add one row per dwell");
+  }
+  // A sweep whose controls never varied is a frequency sweep too.
+  for (const SweepBuilder& builder : builders) {
+    if (builder.a_base_change_line == 0) CheckSharedLevelSigma(path, builder);
   }
   WarnAboutDroppedRows(path, builders);
   return Collect(&builders);

@@ -13,6 +13,13 @@
 //              any finite number, not used by the fit)
 //   sigma      optional standard deviation of `a` (same unit as a), in
 //              [1e-20, 1e20]
+//   a_base_sigma  optional standard deviation of `a_base` (same unit as
+//              a_base), in [1e-20, 1e20]: the measured level's noise, which
+//              the intervals then count (estimator/analysis/level_noise.h).
+//              A frequency sweep's rows share one level and so one error:
+//              they must all state the same a_base_sigma (an error names
+//              the first row that differs); an amplitude sweep's rows each
+//              state their own
 // Columns may come in any order; any other column is an error. Fields are
 // separated by commas; a field may be double-quoted ("A,1" is one field) and
 // is trimmed of spaces and tabs; numbers take a '.' decimal point; blank lines
@@ -78,6 +85,7 @@ struct SweepRowFields {
   char* phase_deg = nullptr;
   char* phase_rad = nullptr;
   char* sigma = nullptr;
+  char* a_base_sigma = nullptr;
 };
 
 // Fills the next row and its 1-based position `line` (named in errors);

@@ -31,9 +31,36 @@ std::string FormatFrequencyHz(double omega_rad_s) {
   return FormatRoundTrip(hz);
 }
 
-void WriteSweepsCsv(const std::vector<Sweep>& sweeps, std::ostream* out) {
+namespace {
+
+// The optional columns the points carry.
+struct OptionalColumns {
+  bool phase = false;
+  bool sigma = false;
+  bool level_sigma = false;  // a_base_sigma
+};
+
+// Throws when a frequency sweep's dwells (one a_base, as the reader sees a
+// sweep whose a_base never changes) state more than one a_base_sigma.
+void CheckSharedLevelSigma(const Sweep& sweep) {
+  for (const DwellPoint& point : sweep.points) {
+    if (point.a_base != sweep.points.front().a_base) return;  // an amplitude sweep
+  }
+  for (const DwellPoint& point : sweep.points) {
+    if (point.a_base_sigma == sweep.points.front().a_base_sigma) continue;
+    throw InputError("sweep '" + sweep.Name() +
+                     "' has one level a_base but dwells with different a_base_sigma; a frequency "
+                     "sweep's dwells share one level and so one level error: give them the "
+                     "same a_base_sigma");
+  }
+}
+
+// Checks that the sweeps can be written and which optional columns they need:
+// each is all or nothing.
+OptionalColumns CheckSweeps(const std::vector<Sweep>& sweeps) {
   int with_sigma = 0;
   int with_phase = 0;
+  int with_level_sigma = 0;
   int points = 0;
   for (const Sweep& sweep : sweeps) {
     if (sweep.id.empty() || sweep.id.find_first_of(",\"\r\n") != std::string::npos) {
@@ -45,26 +72,35 @@ void WriteSweepsCsv(const std::vector<Sweep>& sweeps, std::ostream* out) {
       ++points;
       if (point.sigma.has_value()) ++with_sigma;
       if (point.phase_rad.has_value()) ++with_phase;
+      if (point.a_base_sigma.has_value()) ++with_level_sigma;
     }
+    CheckSharedLevelSigma(sweep);
   }
   for (const auto& [count, what] :
-       {std::pair(with_sigma, "a sigma"), std::pair(with_phase, "a phase")}) {
+       {std::pair(with_sigma, "a sigma"), std::pair(with_phase, "a phase"),
+        std::pair(with_level_sigma, "a level sigma (a_base_sigma)")}) {
     if (count != 0 && count != points) {
       throw InputError(std::to_string(count) + " of " + std::to_string(points) + " dwells carry " +
                        what + "; give every dwell " + what + " or none");
     }
   }
-  const bool sigma_column = with_sigma > 0;
-  const bool phase_column = with_phase > 0;
-  *out << "sweep,direction,freq_hz,a_base,a" << (phase_column ? ",phase_rad" : "")
-       << (sigma_column ? ",sigma" : "") << "\n";
+  return {with_phase > 0, with_sigma > 0, with_level_sigma > 0};
+}
+
+}  // namespace
+
+void WriteSweepsCsv(const std::vector<Sweep>& sweeps, std::ostream* out) {
+  const OptionalColumns columns = CheckSweeps(sweeps);
+  *out << "sweep,direction,freq_hz,a_base,a" << (columns.phase ? ",phase_rad" : "")
+       << (columns.sigma ? ",sigma" : "") << (columns.level_sigma ? ",a_base_sigma" : "") << "\n";
   for (const Sweep& sweep : sweeps) {
     const char* direction = SweepDirectionName(sweep.direction);
     for (const DwellPoint& point : sweep.points) {
       *out << sweep.id << ',' << direction << ',' << FormatFrequencyHz(point.drive_frequency_rad_s)
            << ',' << FormatRoundTrip(point.a_base) << ',' << FormatRoundTrip(point.amplitude);
-      if (phase_column) *out << ',' << FormatRoundTrip(*point.phase_rad);
-      if (sigma_column) *out << ',' << FormatRoundTrip(*point.sigma);
+      if (columns.phase) *out << ',' << FormatRoundTrip(*point.phase_rad);
+      if (columns.sigma) *out << ',' << FormatRoundTrip(*point.sigma);
+      if (columns.level_sigma) *out << ',' << FormatRoundTrip(*point.a_base_sigma);
       *out << '\n';
     }
   }

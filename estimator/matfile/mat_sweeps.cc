@@ -24,8 +24,9 @@ namespace dwellfit {
 namespace {
 
 // The CSV's columns, in SweepRowFields' order; the first two are text.
-constexpr std::array<const char*, 8> kColumns = {"sweep", "direction", "freq_hz",   "a_base",
-                                                 "a",     "phase_deg", "phase_rad", "sigma"};
+constexpr std::array<const char*, 9> kColumns = {"sweep",     "direction", "freq_hz",
+                                                 "a_base",    "a",         "phase_deg",
+                                                 "phase_rad", "sigma",     "a_base_sigma"};
 constexpr int kNumRequired = 5;
 constexpr int kNumText = 2;
 // The longest a v7.3 file's reading process may take (a file of 24,576 rows
@@ -34,8 +35,8 @@ constexpr std::chrono::seconds kV73ReadLimit{60};
 
 constexpr char kLayout[] =
     "a sweeps MAT file holds the cell arrays sweep and direction and the double vectors "
-    "freq_hz, a_base, a (required), phase_deg or phase_rad, sigma (optional), one value per "
-    "row (docs/matlab.md)";
+    "freq_hz, a_base, a (required), phase_deg or phase_rad, sigma, a_base_sigma (optional), one "
+    "value per row (docs/matlab.md)";
 
 // Each column's values as text, one per row; empty for a column not given.
 using Table = std::array<std::vector<std::string>, kColumns.size()>;
@@ -313,7 +314,7 @@ LoadedSweeps LoadSweepsMat(const std::string& path) {
   std::array<char * SweepRowFields::*, kColumns.size()> members = {
       &SweepRowFields::sweep,     &SweepRowFields::direction, &SweepRowFields::freq_hz,
       &SweepRowFields::a_base,    &SweepRowFields::a,         &SweepRowFields::phase_deg,
-      &SweepRowFields::phase_rad, &SweepRowFields::sigma};
+      &SweepRowFields::phase_rad, &SweepRowFields::sigma,     &SweepRowFields::a_base_sigma};
   try {
     return LoadSweepsFromRows(path, 0, [&](SweepRowFields* row, int* line) {
       if (next == table[0].size()) return false;

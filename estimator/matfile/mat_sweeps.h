@@ -6,7 +6,7 @@
 //   sweep, direction     cell arrays of char strings (ids; 'up' or 'down'), or
 //                        char matrices of one row each (padding cut off)
 //   freq_hz, a_base, a   double vectors (freq_hz in Hz)
-//   phase_deg | phase_rad, sigma   optional double vectors
+//   phase_deg | phase_rad, sigma, a_base_sigma   optional double vectors
 // Vectors may be columns or rows; all have the same length. Any other
 // variable is an error, as any other CSV column is. Row i of the variables is
 // the CSV's row i: the rows pass the same checks and give the same sweeps,

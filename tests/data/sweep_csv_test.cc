@@ -81,6 +81,7 @@ TEST(SweepCsvTest, LoadsFrequencySweepInHzAsRadPerSecond) {
   EXPECT_EQ(sweep.points[2].source_line, 4);
   EXPECT_FALSE(sweep.points[0].phase_rad.has_value());
   EXPECT_FALSE(sweep.points[0].sigma.has_value());
+  EXPECT_FALSE(sweep.points[0].a_base_sigma.has_value());
   EXPECT_EQ(sweep.points[0].branch, Branch::kOnly);
 }
 
@@ -148,6 +149,40 @@ TEST(SweepCsvTest, ConvertsPhaseDegreesToRadiansAndReadsSigma) {
   EXPECT_DOUBLE_EQ(*points[1].phase_rad, -kPi / 4.0);
   ASSERT_TRUE(points[1].sigma.has_value());
   EXPECT_DOUBLE_EQ(*points[1].sigma, 2e-5);
+}
+
+// a_base_sigma is the level's standard deviation in a_base's unit: read as
+// written (not converted, not mixed up with sigma). A frequency sweep's rows
+// state one value; an amplitude sweep's rows each their own, repeats of a
+// level included.
+TEST(SweepCsvTest, ReadsTheLevelsStandardDeviationInTheUnitOfABase) {
+  const std::string path = WriteCsv("a_base_sigma",
+                                    "a_base_sigma,sweep,direction,freq_hz,a_base,a,sigma\n"
+                                    "2.5e-5,F,up,40,0.01,1e-3,1e-5\n"
+                                    "2.5e-5,F,up,41,0.01,2e-3,1e-5\n"
+                                    "2.5e-5,F,up,42,0.01,0,1e-5\n"
+                                    "1e-5,A,up,41.5,0.01,1e-3,1e-5\n"
+                                    "2e-5,A,up,41.5,0.01,1.1e-3,1e-5\n"
+                                    "3e-5,A,up,41.5,0.03,3e-3,1e-5\n"
+                                    "4e-5,A,up,41.5,0.05,4e-3,1e-5\n");
+  const LoadedSweeps loaded = LoadSweepsCsv(path);
+  ASSERT_EQ(loaded.sweeps.size(), 2u);
+  const Sweep& frequency = loaded.sweeps[0];
+  EXPECT_EQ(frequency.kind, SweepKind::kFrequency);
+  ASSERT_EQ(frequency.points.size(), 2u);
+  for (const DwellPoint& point : frequency.points) {
+    ASSERT_TRUE(point.a_base_sigma.has_value());
+    EXPECT_EQ(*point.a_base_sigma, 2.5e-5);
+    EXPECT_EQ(point.a_base, 0.01);
+    EXPECT_EQ(point.sigma, 1e-5);
+  }
+  const Sweep& amplitude = loaded.sweeps[1];
+  EXPECT_EQ(amplitude.kind, SweepKind::kAmplitude);
+  ASSERT_EQ(amplitude.points.size(), 4u);
+  const double expected[] = {1e-5, 2e-5, 3e-5, 4e-5};
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(amplitude.points[i].a_base_sigma, expected[i]) << i;
+  }
 }
 
 TEST(SweepCsvTest, ReadsPhaseInRadiansUnchanged) {
@@ -503,7 +538,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCsvCase{"semicolon_separated", "sweep;direction;freq_hz;a_base;a\nF;up;40,5;0,01;1e-3\n",
                    1, "sweep;direction;freq_hz;a_base;a",
                    "unknown column; allowed columns are sweep, direction, freq_hz, a_base, a "
-                   "(required) and phase_deg or phase_rad, sigma (optional); the header reads as "
+                   "(required) and phase_deg or phase_rad, sigma, a_base_sigma (optional); the "
+                   "header reads as "
                    "one column: this file seems to separate fields by ';', but a sweeps CSV "
                    "separates them by commas (and writes numbers with a '.' decimal point): save "
                    "it as comma-separated"},
@@ -535,6 +571,64 @@ INSTANTIATE_TEST_SUITE_P(
                    2, "a",
                    "value 'x123456789x123456789x123456789x123456789... (60 bytes in all)' is not a "
                    "number"}),
+    [](const ::testing::TestParamInfo<BadCsvCase>& info) { return std::string(info.param.name); });
+
+// a_base_sigma: checked like sigma; one value per frequency sweep, the first
+// row that differs named (even when the sweep turns out to be a frequency
+// sweep only later, or never varies a control).
+INSTANTIATE_TEST_SUITE_P(
+    LevelSigma, SweepCsvErrorTest,
+    ::testing::Values(
+        BadCsvCase{"zero", "sweep,direction,freq_hz,a_base,a,a_base_sigma\nF,up,40,0.01,1e-3,0\n",
+                   2, "a_base_sigma", "the standard deviation a_base_sigma must be > 0, got 0"},
+        BadCsvCase{"negative",
+                   "sweep,direction,freq_hz,a_base,a,a_base_sigma\nF,up,40,0.01,1e-3,-1e-4\n", 2,
+                   "a_base_sigma", "the standard deviation a_base_sigma must be > 0, got -1e-4"},
+        BadCsvCase{"nan", "sweep,direction,freq_hz,a_base,a,a_base_sigma\nF,up,40,0.01,1e-3,nan\n",
+                   2, "a_base_sigma", "value 'nan' is not finite"},
+        BadCsvCase{"infinite",
+                   "sweep,direction,freq_hz,a_base,a,a_base_sigma\nF,up,40,0.01,1e-3,inf\n", 2,
+                   "a_base_sigma", "value 'inf' is not finite"},
+        BadCsvCase{"text", "sweep,direction,freq_hz,a_base,a,a_base_sigma\nF,up,40,0.01,1e-3,low\n",
+                   2, "a_base_sigma", "value 'low' is not a number"},
+        BadCsvCase{"empty", "sweep,direction,freq_hz,a_base,a,a_base_sigma\nF,up,40,0.01,1e-3,\n",
+                   2, "a_base_sigma", "value is empty"},
+        BadCsvCase{"huge",
+                   "sweep,direction,freq_hz,a_base,a,a_base_sigma\nF,up,40,0.01,1e-3,1e21\n", 2,
+                   "a_base_sigma",
+                   "the standard deviation a_base_sigma 1e21 is outside the accepted range "
+                   "[1e-20, 1e+20], beyond which the model's powers (a_base_sigma^2) and squared "
+                   "residuals overflow or underflow; a_base_sigma is in the unit of a_base"},
+        BadCsvCase{"subnormal",
+                   "sweep,direction,freq_hz,a_base,a,a_base_sigma\nF,up,40,0.01,1e-3,1e-320\n", 2,
+                   "a_base_sigma",
+                   "the standard deviation a_base_sigma 1e-320 is outside the accepted range"},
+        BadCsvCase{"differs_in_a_frequency_sweep",
+                   "sweep,direction,freq_hz,a_base,a,a_base_sigma\n"
+                   "F,up,40,0.01,1e-3,2e-5\n"
+                   "F,up,41,0.01,2e-3,2e-5\n"
+                   "F,up,42,0.01,3e-3,3e-5\n",
+                   4, "a_base_sigma",
+                   "sweep 'F/up' is a frequency sweep (one level a_base), but its a_base_sigma "
+                   "changes from 2e-05 (line 2) to 3e-05; the rows of a frequency sweep share one "
+                   "level and so one level error: give each of them the same a_base_sigma"},
+        BadCsvCase{"differs_before_the_frequency_steps",
+                   "sweep,direction,freq_hz,a_base,a,a_base_sigma\n"
+                   "F,up,40,0.01,1e-3,2e-5\n"
+                   "F,up,40,0.01,1.1e-3,3e-5\n"
+                   "F,up,41,0.01,2e-3,3e-5\n",
+                   3, "a_base_sigma", "changes from 2e-05 (line 2) to 3e-05"},
+        BadCsvCase{"differs_in_repeated_dwells",
+                   "sweep,direction,freq_hz,a_base,a,a_base_sigma\n"
+                   "F,up,40,0.01,1e-3,2e-5\n"
+                   "G,up,40,0.02,1e-3,9e-5\n"
+                   "F,up,40,0.01,1.1e-3,3e-5\n",
+                   4, "a_base_sigma", "sweep 'F/up' is a frequency sweep"},
+        BadCsvCase{"differs_on_a_missing_row",
+                   "sweep,direction,freq_hz,a_base,a,a_base_sigma\n"
+                   "F,down,41,0.01,1e-3,2e-5\n"
+                   "F,down,40,0.01,0,3e-5\n",
+                   3, "a_base_sigma", "changes from 2e-05 (line 2) to 3e-05"}),
     [](const ::testing::TestParamInfo<BadCsvCase>& info) { return std::string(info.param.name); });
 
 }  // namespace

@@ -49,6 +49,11 @@ void MatSweepsBody(const std::uint8_t* data, std::size_t size) {
               sweep, at + "a control or the amplitude");
       Require(!point.phase_rad || std::isfinite(*point.phase_rad), sweep, at + "phase");
       Require(!point.sigma || PositiveFinite(*point.sigma), sweep, at + "sigma");
+      Require(!point.a_base_sigma || PositiveFinite(*point.a_base_sigma), sweep,
+              at + "a_base_sigma");
+      Require(sweep.kind != SweepKind::kFrequency ||
+                  point.a_base_sigma == sweep.points.front().a_base_sigma,
+              sweep, at + "a frequency sweep's a_base_sigma differs from its first dwell's");
       Require(point.source_line >= 1, sweep, at + "row before the first");
     }
   }

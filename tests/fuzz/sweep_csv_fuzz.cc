@@ -23,7 +23,8 @@ void Require(bool holds, const Sweep& sweep, const std::string& what) {
 
 // What sweep_csv.h promises of an accepted file: every sweep kept has dwells,
 // whose controls and amplitudes are positive and finite (in rad/s for the
-// frequency), optional values finite, and lines after the header.
+// frequency), optional values finite (standard deviations positive, one
+// a_base_sigma per frequency sweep), and lines after the header.
 void CheckLoadedSweeps(const LoadedSweeps& loaded) {
   int missing_rows = 0;
   for (const Sweep& sweep : loaded.sweeps) {
@@ -39,6 +40,11 @@ void CheckLoadedSweeps(const LoadedSweeps& loaded) {
       Require(PositiveFinite(point.amplitude), sweep, at + "amplitude");
       Require(!point.phase_rad || std::isfinite(*point.phase_rad), sweep, at + "phase");
       Require(!point.sigma || PositiveFinite(*point.sigma), sweep, at + "sigma");
+      Require(!point.a_base_sigma || PositiveFinite(*point.a_base_sigma), sweep,
+              at + "a_base_sigma");
+      Require(sweep.kind != SweepKind::kFrequency ||
+                  point.a_base_sigma == sweep.points.front().a_base_sigma,
+              sweep, at + "a frequency sweep's a_base_sigma differs from its first dwell's");
       Require(point.source_line >= 2, sweep, at + "source line before the first data row");
     }
     for (const MissingDwell& row : sweep.missing) {

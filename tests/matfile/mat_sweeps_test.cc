@@ -5,6 +5,7 @@
 #include <matio.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <fstream>
@@ -158,6 +159,7 @@ TEST_P(MatSweepsEqualCsvTest, LoadsTheSweepsOfTheCsv) {
       EXPECT_EQ(a.amplitude, e.amplitude);
       EXPECT_EQ(a.phase_rad, e.phase_rad);
       EXPECT_EQ(a.sigma, e.sigma);
+      EXPECT_EQ(a.a_base_sigma, e.a_base_sigma);
       EXPECT_EQ(a.source_line, e.source_line - 1);
     }
   }
@@ -229,6 +231,38 @@ TEST(MatSweepsTest, DamagedFile) {
   EXPECT_THAT(LoadError(path),
               HasSubstr(path + ": the file is damaged (an element claims more bytes than the file "
                                "gives it); save it again"));
+}
+
+// The level's standard deviation, a_base_sigma, loads like the CSV column:
+// the same double, in v5 and v7.3.
+TEST(MatSweepsTest, LevelSigmaLoadsAsTheSameDouble) {
+  const double level_sigma = 0.005 * 0.01 / std::sqrt(3.0);
+  std::vector<Column> table = SmallTable();
+  table.push_back({"a_base_sigma", {level_sigma, level_sigma, level_sigma}});
+  for (mat_ft version : {MAT_FT_MAT5, MAT_FT_MAT73}) {
+    const LoadedSweeps loaded =
+        LoadSweepsMat(WriteMat("level_sigma_" + std::to_string(version), Vars(table), version));
+    ASSERT_EQ(loaded.sweeps.size(), 1u);
+    ASSERT_EQ(loaded.sweeps[0].points.size(), 3u);
+    for (const DwellPoint& point : loaded.sweeps[0].points) {
+      ASSERT_TRUE(point.a_base_sigma.has_value()) << version;
+      EXPECT_EQ(*point.a_base_sigma, level_sigma) << version;
+    }
+  }
+}
+
+TEST(MatSweepsTest, LevelSigmaIsCheckedLikeTheCsvColumnAndNamesItsRow) {
+  std::vector<Column> table = SmallTable();
+  table.push_back({"a_base_sigma", {2e-5, 2e-5, 0.0}});
+  std::string path = WriteMat("level_sigma_zero", Vars(table));
+  EXPECT_THAT(LoadError(path), HasSubstr(path + ": variable 'a_base_sigma', row 3: the standard "
+                                                "deviation a_base_sigma must be > 0, got 0"));
+  table.back().numbers = {2e-5, 2e-5, 3e-5};
+  path = WriteMat("level_sigma_differs", Vars(table));
+  EXPECT_THAT(LoadError(path),
+              HasSubstr(path + ": variable 'a_base_sigma', row 3: sweep 'F1/up' is a frequency "
+                               "sweep (one level a_base), but its a_base_sigma changes from "
+                               "2e-05 (row 1) to 3e-05"));
 }
 
 TEST(MatSweepsTest, MissingVariable) {
