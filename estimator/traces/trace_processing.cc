@@ -19,6 +19,9 @@ using Spectrum = std::vector<Complex>;
 
 // A change counts only beyond this many standard deviations of the noise.
 constexpr double kNoiseSigmas = 5.0;
+// The smallest relative level sigma stated (exactly periodic noise-free
+// samples would give 0, which the sweeps CSV refuses).
+constexpr double kLevelSigmaFloor = 1e-12;
 
 // The frequency [Hz] of FFT bin k of n samples at rate fs (negative above n/2).
 double BinFrequencyHz(int k, int n, double fs) { return (2 * k <= n ? k : k - n) * fs / n; }
@@ -246,8 +249,10 @@ void BuildSweeps(const std::vector<DwellTrace>& dwells, const TraceProcessingOpt
     // Omega, a_base = |A_1|, a = |U_1| and the lag.
     out->sweeps[it->second].points.push_back(
         DwellPoint{dwells[i].drive_frequency_rad_s, std::abs(h.base[1]), std::abs(h.u[1]), Lag(h)});
-    if (base_noise[i] > 0.0)
-      out->sweeps[it->second].points.back().a_base_sigma = std::abs(h.base[1]) * base_noise[i];
+    // Every dwell states one (the sweeps CSV takes the column whole): at least
+    // kLevelSigmaFloor of the level, far below any recorded noise.
+    out->sweeps[it->second].points.back().a_base_sigma =
+        std::abs(h.base[1]) * std::max(base_noise[i], kLevelSigmaFloor);
     members[it->second].push_back(i);
   }
   for (std::size_t s = 0; s < out->sweeps.size(); ++s) {
@@ -257,7 +262,7 @@ void BuildSweeps(const std::vector<DwellTrace>& dwells, const TraceProcessingOpt
     const double n = static_cast<double>(sweep.points.size());
     for (const DwellPoint& point : sweep.points) {
       mean += point.a_base / n;
-      mean_variance += std::pow(point.a_base_sigma.value_or(0.0) / n, 2);
+      mean_variance += std::pow(*point.a_base_sigma / n, 2);
     }
     for (std::size_t j = 0; j < sweep.points.size(); ++j) {
       const double change = sweep.points[j].a_base / mean - 1.0;
@@ -270,8 +275,7 @@ void BuildSweeps(const std::vector<DwellTrace>& dwells, const TraceProcessingOpt
                          dwells[members[s][j]].Describe().c_str(), 100 * change));
       }
       sweep.points[j].a_base = mean;
-      sweep.points[j].a_base_sigma.reset();
-      if (mean_variance > 0.0) sweep.points[j].a_base_sigma = std::sqrt(mean_variance);
+      sweep.points[j].a_base_sigma = std::sqrt(mean_variance);
     }
   }
 }
