@@ -57,19 +57,31 @@ double SettleSeconds(const ParameterVector& p, double k, double a_now, double a_
   return (k + std::log1p(d)) / rate_per_s;
 }
 
-// The gain of the dwells whose rows are G: see the header.
-double Gain(const DesignBasis& basis, const CandidateRows& rows, const ParameterGradient& c,
-            double s2, bool d_optimal) {
+// The gain of the dwells whose rows are G and noise covariance N: see the header.
+double Gain(const DesignBasis& basis, const CandidateRows& rows, const Eigen::MatrixXd& noise,
+            const ParameterGradient& c, bool d_optimal) {
   const CandidateRows u = rows * basis.covariance;  // G C (C symmetric)
-  const Eigen::MatrixXd gcg = u * rows.transpose();
-  const int n = static_cast<int>(rows.rows());
+  const Eigen::MatrixXd m = noise + u * rows.transpose();
   if (d_optimal) {
-    const Eigen::MatrixXd a = Eigen::MatrixXd::Identity(n, n) + gcg / s2;
-    return Eigen::LDLT<Eigen::MatrixXd>(a).vectorD().array().log().sum();
+    return Eigen::LDLT<Eigen::MatrixXd>(m).vectorD().array().log().sum() -
+           Eigen::LDLT<Eigen::MatrixXd>(noise).vectorD().array().log().sum();
   }
   const Eigen::VectorXd w = u * c;
-  const Eigen::MatrixXd m = s2 * Eigen::MatrixXd::Identity(n, n) + gcg;
   return w.dot(Eigen::LDLT<Eigen::MatrixXd>(m).solve(w));
+}
+
+// N of a candidate's dwells with level slopes h: see DesignBasis.
+Eigen::MatrixXd CandidateNoise(const DesignBasis& basis, const Candidate& candidate,
+                               const Eigen::VectorXd& h) {
+  const int n = static_cast<int>(h.size());
+  const double kappa = basis.level_relative_sigma;
+  Eigen::MatrixXd noise = basis.noise_sigma * basis.noise_sigma * Eigen::MatrixXd::Identity(n, n);
+  if (candidate.level_step != 0.0) {  // each dwell its own level
+    noise.diagonal() += (kappa * h).cwiseAbs2();
+  } else {  // one level, the mean of n measured ones
+    noise += (kappa * kappa / n) * h * h.transpose();
+  }
+  return noise;
 }
 
 // Single dwells at every grid point but the present one, then (with
@@ -246,7 +258,7 @@ bool LandingPoint(const ParameterVector& p, Branch from, double a_now, double fr
 }
 
 bool ResidualGradient(const DesignBasis& basis, double frequency_hz, double level, Branch branch,
-                      double amplitude, ParameterGradient* g) {
+                      double amplitude, ParameterGradient* g, double* level_slope) {
   const std::unique_ptr<ceres::CostFunction> cost(
       VerticalErrorResidual::Create(HzToRadPerSecond(frequency_hz), level, amplitude, branch,
                                     basis.residual.error, 1.0, basis.residual.amplitude_floor));
@@ -256,6 +268,10 @@ bool ResidualGradient(const DesignBasis& basis, double frequency_hz, double leve
   double* jacobians[] = {row};
   if (!cost->Evaluate(parameters, &residual, jacobians)) return false;
   for (int j = 0; j < kNumParameters; ++j) (*g)(j) = basis.fixed[j] ? 0.0 : row[j];
+  if (level_slope != nullptr) {
+    *level_slope = basis.estimate[kEtaE] * row[kEtaE];
+    if (!std::isfinite(*level_slope)) return false;
+  }
   return g->allFinite();
 }
 
@@ -283,8 +299,10 @@ bool QuantityGradient(const DesignBasis& basis, const DesignTarget& target, doub
 }
 
 bool WalkCandidate(const DesignBasis& basis, Branch from, double a_now,
-                   const DesignOptions& options, Candidate* candidate, CandidateRows* rows) {
+                   const DesignOptions& options, Candidate* candidate, CandidateRows* rows,
+                   Eigen::MatrixXd* noise) {
   rows->resize(candidate->dwells, kNumParameters);
+  Eigen::VectorXd h(candidate->dwells);
   candidate->settle_seconds = 0.0;
   for (int k = 0; k < candidate->dwells; ++k) {
     const double f = candidate->frequency_hz + k * candidate->frequency_step_hz;
@@ -294,7 +312,7 @@ bool WalkCandidate(const DesignBasis& basis, Branch from, double a_now,
     bool jumps;
     ParameterGradient g;
     if (!LandingPoint(basis.estimate, from, a_now, f, level, &branch, &a, &jumps) ||
-        !ResidualGradient(basis, f, level, branch, a, &g)) {
+        !ResidualGradient(basis, f, level, branch, a, &g, &h[k])) {
       return false;
     }
     if (k == 0) {
@@ -309,15 +327,14 @@ bool WalkCandidate(const DesignBasis& basis, Branch from, double a_now,
     a_now = a;
   }
   candidate->record_seconds = candidate->dwells * options.recording_seconds;
+  *noise = CandidateNoise(basis, *candidate, h);
   return true;
 }
 
 ParameterMatrix CovarianceAfter(const ParameterMatrix& covariance, const CandidateRows& rows,
-                                double noise_sigma) {
+                                const Eigen::MatrixXd& noise) {
   const CandidateRows u = rows * covariance;
-  const int n = static_cast<int>(rows.rows());
-  const Eigen::MatrixXd m =
-      noise_sigma * noise_sigma * Eigen::MatrixXd::Identity(n, n) + u * rows.transpose();
+  const Eigen::MatrixXd m = noise + u * rows.transpose();
   return covariance - u.transpose() * Eigen::LDLT<Eigen::MatrixXd>(m).solve(u);
 }
 
@@ -358,12 +375,12 @@ Recommendation RecommendNextDwell(const DesignBasis& given, const RigState& stat
         "the estimate has no damping (mu1 = mu2 = 0), so no settling time: fit "
         "more dwells, or fix mu1 at a value from a decay test");
   }
-  const double s2 = basis.noise_sigma * basis.noise_sigma;
   const bool d_optimal = options.target.kind == TargetKind::kDOptimal;
   CandidateRows rows;
+  Eigen::MatrixXd noise;
   for (Candidate candidate : CandidateShapes(state, limits, options)) {
-    if (!WalkCandidate(basis, state.branch, now.a, options, &candidate, &rows)) continue;
-    candidate.gain = Gain(basis, rows, c, s2, d_optimal);
+    if (!WalkCandidate(basis, state.branch, now.a, options, &candidate, &rows, &noise)) continue;
+    candidate.gain = Gain(basis, rows, noise, c, d_optimal);
     candidate.gain_per_second =
         candidate.gain / (candidate.settle_seconds + candidate.record_seconds);
     out.ranked.push_back(candidate);

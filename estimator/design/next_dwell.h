@@ -17,10 +17,12 @@
 //                   c = dq/dtheta at theta
 //
 // A segment of n dwells (a short stepped sweep in one direction) adds the
-// rows G (n x k) at once; with M = s^2 I_n + G C G^T the same formulas read
-// gain = log det(I_n + G C G^T / s^2) and gain = (G C c)^T M^-1 (G C c)
-// [Woodbury], C' = C - (G C)^T M^-1 (G C); its test time is the sum of its
-// dwells', each settling from the one before.
+// rows G (n x k) at once. With their noise covariance N (s^2 I_n, plus the
+// measured level's term when DesignBasis::level_relative_sigma is set) and
+// M = N + G C G^T the same formulas read gain = log det M - log det N and
+// gain = (G C c)^T M^-1 (G C c) [Woodbury], C' = C - (G C)^T M^-1 (G C); a
+// single dwell is n = 1. Its test time is the sum of its dwells', each
+// settling from the one before.
 //
 // Test time of a candidate (seconds): settle + record, with
 //
@@ -124,7 +126,12 @@ struct DesignBasis {
   double noise_sigma = 0.0;         // s, the residual's unit
   double interval_quantile = 1.96;  // of the reported 95 % intervals
   ResidualOptions residual;         // error measure and floor of the dwells' residual
-  double omega_ref_rad_s = 0.0;     // Omega_ref of alpha_e
+  // kappa: the relative standard deviation of one new dwell's measured level
+  // (0: exact). A candidate's residuals then carry, besides s^2, the level's
+  // kappa^2 h h^T (h_i = dr_i / d ln a_b): shared by a frequency segment's
+  // dwells (one mean level, kappa^2 / n), each dwell's own in a level segment.
+  double level_relative_sigma = 0.0;
+  double omega_ref_rad_s = 0.0;  // Omega_ref of alpha_e
 };
 
 // A single dwell, or a segment of `dwells` dwells: the first at
@@ -166,8 +173,9 @@ bool LandingPoint(const ParameterVector& p, Branch from, double a_now, double fr
 
 // g = dr/dtheta of one dwell whose model amplitude is `amplitude` on `branch`,
 // at the estimate; zero on the fixed parameters. False where undefined.
+// `level_slope`, when given: h = dr / d ln a_b = eta_e dr / d eta_e.
 bool ResidualGradient(const DesignBasis& basis, double frequency_hz, double level, Branch branch,
-                      double amplitude, ParameterGradient* g);
+                      double amplitude, ParameterGradient* g, double* level_slope = nullptr);
 
 // c = dq/dtheta of the target's quantity and its value (central differences
 // for omega(a) and the jump frequency); zero on fixed parameters. False where
@@ -177,14 +185,17 @@ bool QuantityGradient(const DesignBasis& basis, const DesignTarget& target, doub
 
 // Walks a candidate's dwells from the present branch and amplitude: sets
 // its branch, jump, amplitude and settling and recording times (`options`'
-// cost model) and returns its rows. False where a dwell has no stable root or
-// its row is undefined.
+// cost model) and returns its rows, and its residuals' noise covariance N
+// (s^2 I plus the level's term above). False where a dwell has no stable root
+// or its row is undefined.
 bool WalkCandidate(const DesignBasis& basis, Branch from, double a_now,
-                   const DesignOptions& options, Candidate* candidate, CandidateRows* rows);
+                   const DesignOptions& options, Candidate* candidate, CandidateRows* rows,
+                   Eigen::MatrixXd* noise);
 
-// The covariance after adding the dwells whose rows are G (Woodbury).
+// The covariance after adding the dwells whose rows are G with noise
+// covariance N (Woodbury: C - (G C)^T (N + G C G^T)^-1 G C).
 ParameterMatrix CovarianceAfter(const ParameterMatrix& covariance, const CandidateRows& rows,
-                                double noise_sigma);
+                                const Eigen::MatrixXd& noise);
 
 // Ranks every candidate of the limits' grid from `state`. Options and limits
 // must be valid (IsValid); throws InputError when the target's quantity is

@@ -7,7 +7,9 @@
 #include <map>
 #include <sstream>
 
+#include "dwellfit/estimator/analysis/level_noise.h"
 #include "dwellfit/estimator/analysis/parameter_uncertainty.h"
+#include "dwellfit/estimator/analysis/prediction_intervals.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/string_printf.h"
 #include "dwellfit/estimator/run/resolved_run.h"
@@ -162,6 +164,23 @@ RigLimits OverrideLimits(RigLimits limits, const std::string& text, const std::s
   return limits;
 }
 
+namespace {
+
+// kappa of one new dwell's level from the fitted dwells' stated sigmas
+// (level_noise.h): the median over the level draws of kappa_g sqrt(n_g), a
+// draw of n dwells being the mean of n measured levels; 0 when none states one.
+double SingleDwellLevelSigma(const std::vector<const Sweep*>& fitted) {
+  std::vector<double> kappas;
+  for (const std::vector<const DwellPoint*>& draw : LevelDraws(fitted)) {
+    const DwellPoint& first = *draw.front();
+    kappas.push_back(*first.a_base_sigma / first.a_base *
+                     std::sqrt(static_cast<double>(draw.size())));
+  }
+  return kappas.empty() ? 0.0 : MedianOf(kappas);
+}
+
+}  // namespace
+
 bool DesignBasisFromFit(const std::vector<const Sweep*>& fitted,
                         const IdentificationOptions& options, const ParameterVector& estimate,
                         double omega_ref_rad_s, DesignBasis* basis, std::string* why) {
@@ -178,6 +197,7 @@ bool DesignBasisFromFit(const std::vector<const Sweep*>& fitted,
   basis->interval_quantile = u.interval_quantile;
   basis->residual = options.solve.residual;
   basis->omega_ref_rad_s = u.omega_ref_rad_s;
+  basis->level_relative_sigma = SingleDwellLevelSigma(fitted);
   return true;
 }
 
@@ -238,8 +258,10 @@ void PrintRecommendation(const Recommendation& rec, int top, std::ostream& out) 
                         c.amplitude, SegmentText(c).c_str(), c.settle_seconds, c.record_seconds,
                         c.gain, c.gain_per_second);
     CandidateRows rows;
-    WalkCandidate(basis, rec.state.branch, rec.present_amplitude, DesignOptions(), &c, &rows);
-    after.push_back(CovarianceAfter(basis.covariance, rows, basis.noise_sigma));
+    Eigen::MatrixXd noise;
+    WalkCandidate(basis, rec.state.branch, rec.present_amplitude, DesignOptions(), &c, &rows,
+                  &noise);
+    after.push_back(CovarianceAfter(basis.covariance, rows, noise));
   }
   out << "\nexpected 95 % intervals: estimate +/- half-width in % now, then the half-width\n"
          "after the candidate of each rank alone:\n";

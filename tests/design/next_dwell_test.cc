@@ -6,11 +6,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include "Eigen/Dense"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/design/next_dwell_run.h"
+#include "dwellfit/residuals/functors/vertical_error_residual.h"
 #include "gtest/gtest.h"
 
 namespace dwellfit {
@@ -235,9 +237,8 @@ TEST(RecommendNextDwell, FiniteDifferenceFisherInformationGivesTheSameRanking) {
   }
 }
 
-// A quantity's gain is the Sherman-Morrison drop of its variance: the same as
-// the variance from the information with the dwell added, inverted.
-TEST(RecommendNextDwell, QuantityGainIsTheVarianceDropOfTheUpdatedInformation) {
+// The truth, w fixed, 1 % relative noise and a diagonal covariance.
+DesignBasis DiagonalBasis() {
   DesignBasis basis;
   basis.estimate = Truth();
   basis.fixed = {false, false, false, false, false, true};
@@ -246,6 +247,13 @@ TEST(RecommendNextDwell, QuantityGainIsTheVarianceDropOfTheUpdatedInformation) {
   basis.omega_ref_rad_s = kTwoPi * 41.5;
   const Eigen::Matrix<double, 5, 1> scale(1.0, 0.1, 100.0, 3e3, 1e8);
   basis.covariance.topLeftCorner<5, 5>() = (scale.asDiagonal() * 0.01).toDenseMatrix();
+  return basis;
+}
+
+// A quantity's gain is the Sherman-Morrison drop of its variance: the same as
+// the variance from the information with the dwell added, inverted.
+TEST(RecommendNextDwell, QuantityGainIsTheVarianceDropOfTheUpdatedInformation) {
+  DesignBasis basis = DiagonalBasis();
   DesignOptions options;
   options.target.kind = TargetKind::kEffectiveNonlinearity;
   const Recommendation rec = RecommendNextDwell(basis, Upper(), Limits(), options);
@@ -262,6 +270,51 @@ TEST(RecommendNextDwell, QuantityGainIsTheVarianceDropOfTheUpdatedInformation) {
   c(4) = 1.0;
   EXPECT_NEAR(best.gain, c.dot(c0 * c) - c.dot(after * c), 1e-6 * c.dot(c0 * c));
   EXPECT_NEAR(rec.quantity, 9e8 - (2.0 / 3.0) * 1e4 * std::pow(kTwoPi * 41.5, 2), 1.0);
+}
+
+// With the measured level's noise (level_relative_sigma kappa) a single
+// dwell's D-optimal gain is log(1 + g^T C g / (s^2 + kappa^2 h^2)), h the
+// residual's slope in ln a_b: here h from central differences of the
+// residual in the level itself (not the eta_e identity the code uses). The
+// level's noise lowers every gain, most where the amplitude is steepest in
+// the level.
+TEST(RecommendNextDwell, TheLevelsNoiseEntersEachCandidatesNoise) {
+  DesignBasis basis = DiagonalBasis();
+  const Recommendation exact = RecommendNextDwell(basis, Upper(), Limits(), DesignOptions());
+  basis.level_relative_sigma = 0.02;
+  const Recommendation noisy = RecommendNextDwell(basis, Upper(), Limits(), DesignOptions());
+  ASSERT_EQ(noisy.ranked.size(), exact.ranked.size());
+  int checked = 0;
+  double largest_drop = 0.0;
+  for (const Candidate& c : noisy.ranked) {
+    if (c.dwells != 1) continue;
+    const auto residual = [&](double level) {
+      const std::unique_ptr<ceres::CostFunction> cost(
+          VerticalErrorResidual::Create(kTwoPi * c.frequency_hz, level, c.amplitude, c.branch,
+                                        basis.residual.error, 1.0, basis.residual.amplitude_floor));
+      const double* parameters[] = {basis.estimate.data()};
+      double r = 0.0;
+      EXPECT_TRUE(cost->Evaluate(parameters, &r, nullptr));
+      return r;
+    };
+    const double e = 1e-6;
+    const double h = (residual(c.level * (1 + e)) - residual(c.level * (1 - e))) / (2 * e);
+    ParameterGradient g;
+    ASSERT_TRUE(ResidualGradient(basis, c.frequency_hz, c.level, c.branch, c.amplitude, &g));
+    const double variance = 1e-4 + 0.02 * 0.02 * h * h;
+    EXPECT_NEAR(c.gain, std::log1p(g.dot(basis.covariance * g) / variance),
+                1e-5 * std::max(c.gain, 1e-3))
+        << c.frequency_hz << " Hz, level " << c.level;
+    for (const Candidate& e0 : exact.ranked) {
+      if (e0.dwells == 1 && e0.frequency_hz == c.frequency_hz && e0.level == c.level) {
+        EXPECT_LE(c.gain, e0.gain * (1 + 1e-12));
+        largest_drop = std::max(largest_drop, 1.0 - c.gain / e0.gain);
+      }
+    }
+    ++checked;
+  }
+  EXPECT_GT(checked, 10);
+  EXPECT_GT(largest_drop, 0.1);
 }
 
 // The backbone omega(a) = sqrt((4 w^2 + 3 alpha a^2) / (4 + 2 delta a^2))
