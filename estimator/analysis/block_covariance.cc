@@ -229,12 +229,7 @@ bool ComputeCovariance(const FitDescription& fit, double factor,
 
 void SetIntervals(BlockCovariance* c) {
   c->interval_quantile = IntervalQuantile(c->all_standardised, c->degrees_of_freedom);
-  for (size_t i = 0; i < c->values.size(); ++i) c->ci95_low[i] = c->ci95_high[i] = c->values[i];
-  for (int i : c->free) {
-    c->standard_error[i] = std::sqrt(std::max(c->covariance(i, i), 0.0));
-    c->ci95_low[i] = c->values[i] - c->interval_quantile * c->standard_error[i];
-    c->ci95_high[i] = c->values[i] + c->interval_quantile * c->standard_error[i];
-  }
+  IntervalsFromCovariance(c);
   c->available = true;
   c->message = StringPrintf(
       "%d points, %d free parameters, %d degrees of freedom; noise sigma %.3g (%s); "
@@ -247,6 +242,15 @@ void SetIntervals(BlockCovariance* c) {
 }
 
 }  // namespace
+
+void IntervalsFromCovariance(BlockCovariance* c) {
+  for (size_t i = 0; i < c->values.size(); ++i) c->ci95_low[i] = c->ci95_high[i] = c->values[i];
+  for (int i : c->free) {
+    c->standard_error[i] = std::sqrt(std::max(c->covariance(i, i), 0.0));
+    c->ci95_low[i] = c->values[i] - c->interval_quantile * c->standard_error[i];
+    c->ci95_high[i] = c->values[i] + c->interval_quantile * c->standard_error[i];
+  }
+}
 
 bool BlockCovarianceOptions::IsValid(std::string* error) const {
   if (chunk_rows >= 1) return true;

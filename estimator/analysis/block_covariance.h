@@ -80,6 +80,10 @@ struct BlockCovariance {
   Eigen::VectorXd unit_scale;      // physical change per unit of each free normalised coordinate
 };
 
+// Standard errors sqrt(C_jj) and intervals value -/+ q se of the free
+// entries from `covariance` and `interval_quantile`; fixed entries [value, value].
+void IntervalsFromCovariance(BlockCovariance* c);
+
 // The covariance of every described entry at the blocks' current values.
 // Never throws or aborts.
 BlockCovariance EstimateBlockCovariance(const FitDescription& fit, const ResidualOptions& residual,

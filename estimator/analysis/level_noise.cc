@@ -32,7 +32,7 @@ bool AddDwell(const ProblemBuilder& builder, const DwellPoint& point,
   double* jacobians[] = {row};
   if (!cost->Evaluate(parameters, &residual, jacobians)) return false;
   const double kappa = *point.a_base_sigma / point.a_base;
-  const double h = estimate[kEtaE] * row[kEtaE];  // dr / d ln a_b
+  const double h = LevelSlope(estimate, row[kEtaE]);
   Vector6 j;
   for (int p = 0; p < kNumParameters; ++p) j[p] = options.fixed[p] ? 0.0 : row[p];
   if (!(std::isfinite(h) && j.allFinite())) return false;

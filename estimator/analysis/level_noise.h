@@ -56,6 +56,12 @@ struct LevelNoise {
   std::string warning;       // set when s'^2 was held at its floor
 };
 
+// h = dr / d ln a_b of a dwell's residual at `p` from its derivative in
+// eta_e: the model sees the forcing only through eta_e a_b.
+inline double LevelSlope(const ParameterVector& p, double dr_d_eta_e) {
+  return p[kEtaE] * dr_d_eta_e;
+}
+
 // The level draws of `fitted` (see above): a frequency sweep's dwells that
 // state a_base_sigma form one, each such dwell of an amplitude sweep one of
 // its own. Dwells without a_base_sigma (or with a_base <= 0) are in none.

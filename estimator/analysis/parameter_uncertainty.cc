@@ -218,12 +218,18 @@ void CopyIntervals(const BlockCovariance& c, ParameterUncertainty* u) {
   }
 }
 
-// alpha_e = alpha - (2/3) delta Omega_ref^2: variance g^T C g.
+// g = d alpha_e / dp, alpha_e = alpha - (2/3) delta Omega_ref^2.
+Eigen::Matrix<double, kNumParameters, 1> EffectiveNonlinearityGradient(double omega_ref_rad_s) {
+  Eigen::Matrix<double, kNumParameters, 1> g = Eigen::Matrix<double, kNumParameters, 1>::Zero();
+  g[kDelta] = -(2.0 / 3.0) * omega_ref_rad_s * omega_ref_rad_s;
+  g[kAlpha] = 1.0;
+  return g;
+}
+
+// alpha_e's variance g^T C g.
 void SetEffectiveNonlinearity(ParameterUncertainty* u) {
-  Eigen::Matrix<double, kNumParameters, 1> gradient =
-      Eigen::Matrix<double, kNumParameters, 1>::Zero();
-  gradient[kDelta] = -(2.0 / 3.0) * u->omega_ref_rad_s * u->omega_ref_rad_s;
-  gradient[kAlpha] = 1.0;
+  const Eigen::Matrix<double, kNumParameters, 1> gradient =
+      EffectiveNonlinearityGradient(u->omega_ref_rad_s);
   u->effective_nonlinearity_standard_error =
       std::sqrt(std::max(gradient.dot(u->covariance * gradient), 0.0));
   u->effective_nonlinearity_ci95_low =
@@ -244,11 +250,7 @@ LevelNoise AddLevelNoise(const std::vector<const Sweep*>& fitted,
   if (level.groups == 0) return level;
   c->covariance += level.added;
   c->noise_sigma = level.noise_sigma;
-  for (int j : c->free) {
-    c->standard_error[j] = std::sqrt(std::max(c->covariance(j, j), 0.0));
-    c->ci95_low[j] = c->values[j] - c->interval_quantile * c->standard_error[j];
-    c->ci95_high[j] = c->values[j] + c->interval_quantile * c->standard_error[j];
-  }
+  IntervalsFromCovariance(c);
   c->message += StringPrintf("; with the measured level's noise (%d level draws)", level.groups);
   return level;
 }
@@ -271,9 +273,8 @@ void WidenProfileByLevel(const LevelNoise& level, const ParameterVector& estimat
     WidenBy(estimate[j], level.added(j, j), u->interval_quantile, &u->ci95_low[j],
             &u->ci95_high[j]);
   }
-  Eigen::Matrix<double, kNumParameters, 1> g = Eigen::Matrix<double, kNumParameters, 1>::Zero();
-  g[kDelta] = -(2.0 / 3.0) * u->omega_ref_rad_s * u->omega_ref_rad_s;
-  g[kAlpha] = 1.0;
+  const Eigen::Matrix<double, kNumParameters, 1> g =
+      EffectiveNonlinearityGradient(u->omega_ref_rad_s);
   WidenBy(u->effective_nonlinearity, g.dot(level.added * g), u->interval_quantile,
           &u->effective_nonlinearity_ci95_low, &u->effective_nonlinearity_ci95_high);
 }

@@ -6,6 +6,7 @@
 
 #include "Eigen/Dense"
 #include "ceres/cost_function.h"
+#include "dwellfit/estimator/analysis/level_noise.h"
 #include "dwellfit/estimator/analysis/modal_properties.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/string_printf.h"
@@ -269,7 +270,7 @@ bool ResidualGradient(const DesignBasis& basis, double frequency_hz, double leve
   if (!cost->Evaluate(parameters, &residual, jacobians)) return false;
   for (int j = 0; j < kNumParameters; ++j) (*g)(j) = basis.fixed[j] ? 0.0 : row[j];
   if (level_slope != nullptr) {
-    *level_slope = basis.estimate[kEtaE] * row[kEtaE];
+    *level_slope = LevelSlope(basis.estimate, row[kEtaE]);
     if (!std::isfinite(*level_slope)) return false;
   }
   return g->allFinite();
