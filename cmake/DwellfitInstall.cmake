@@ -46,6 +46,7 @@ set(DWELLFIT_PUBLIC_HEADERS
     estimator/fit/staged_solve.h
     estimator/simulation/dwell_simulator.h
     residuals/functors/error_measure.h
+    residuals/model/amplitude_roots.h
     residuals/model/bracketed_newton.h
     residuals/model/model_parameters.h
     residuals/model/response_model.h

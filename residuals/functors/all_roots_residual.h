@@ -7,7 +7,7 @@
 //
 // where a_model is found by solving the sextic of eq. (3.11),
 //   G(a; Omega_i, p) - a_base_i^2 = c6 a^6 + c4 a^4 + c3 a^3 + c2 a^2 - a_base_i^2 = 0,
-// for all six roots (Eigen's companion-matrix solver, sextic_roots.h),
+// for all six roots (Eigen's companion-matrix solver, amplitude_roots.h),
 // dropping the negative and complex ones and the unstable middle one
 // (dG/da <= 0), and taking the stable root nearest the measured a_i: the
 // measurement chooses the branch, as in the chapter (no branch label is used).
@@ -26,7 +26,7 @@
 #include "dwellfit/residuals/functors/vertical_error_residual.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 #include "dwellfit/residuals/model/response_model.h"
-#include "dwellfit/residuals/model/sextic_roots.h"
+#include "dwellfit/residuals/model/amplitude_roots.h"
 #include "dwellfit/residuals/model/stable_root.h"
 
 namespace dwellfit {

@@ -5,7 +5,7 @@
 // two real roots at the dwell before the jump and have lost them (a complex
 // pair) at the dwell after it.
 //
-// With r1, r2 the two roots of that pair (FoldRootPair, sextic_roots.h) at a
+// With r1, r2 the two roots of that pair (FoldRootPair, amplitude_roots.h) at a
 // control value c, D(c) = (r1 - r2)^2 is real on both sides of the fold:
 // positive while the pair is real, -4 Im(r1)^2 once it is complex, and
 // continuous through zero at the fold. Two residuals:
@@ -38,7 +38,7 @@
 #include "ceres/sized_cost_function.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 #include "dwellfit/residuals/model/response_model.h"
-#include "dwellfit/residuals/model/sextic_roots.h"
+#include "dwellfit/residuals/model/amplitude_roots.h"
 #include "dwellfit/residuals/model/sweep_vocabulary.h"
 
 namespace dwellfit {
@@ -58,7 +58,7 @@ inline bool SeparationOfFoldPair(const double* p, double omega_drive_rad_s, doub
   const auto kj = ResponseCoefficients<Jet>::FromParameters(jp.data(), omega_drive_rad_s);
   const ResponseCoefficients<double> k = ScalarCoefficients(kj);
   std::complex<double> r[2];
-  if (!FoldRootPair(SexticRoots(k, a_base, a_jump), upper_branch_end, a_jump, &r[0], &r[1])) {
+  if (!FoldRootPair(AmplitudeRoots(k, a_base, a_jump), upper_branch_end, a_jump, &r[0], &r[1])) {
     return false;
   }
   using C = std::complex<double>;

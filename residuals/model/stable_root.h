@@ -14,10 +14,15 @@
 #ifndef DWELLFIT_RESIDUALS_MODEL_STABLE_ROOT_H_
 #define DWELLFIT_RESIDUALS_MODEL_STABLE_ROOT_H_
 
+#include <algorithm>
 #include <cmath>
+#include <complex>
 #include <limits>
 #include <string>
+#include <vector>
 
+#include "Eigen/Core"
+#include "dwellfit/residuals/model/amplitude_roots.h"
 #include "dwellfit/residuals/model/bracketed_newton.h"
 #include "dwellfit/residuals/model/response_model.h"
 
@@ -55,11 +60,55 @@ double ExpandUntil(double hi, const Predicate& positive) {
 
 }  // namespace internal
 
+namespace internal {
+
+// The turning points of a member with the family's terms (k.higher_order),
+// where h = (dG/da)/a is of degree eight and may have four positive roots:
+// the positive real roots of h (companion matrix, in the variable a / a_s
+// with a_s = (c2 / c_top)^(1 / top), c_top the leading coefficient of G),
+// polished by Newton steps on h. G rises from 0 to the first (a local
+// maximum: a_lower_end) and from the last (a local minimum: a_upper_end) on;
+// a stable branch between a second and a third turning point has no name and
+// is never returned.
+inline TurningPoints FindTurningPointsOfFamily(const ResponseCoefficients<double>& k) {
+  TurningPoints tp;
+  const double c[11] = {0.0,    0.0, k.c2(), k.c3(), k.c4(), k.c5(),
+                        k.c6(), 0.0, k.c8(), 0.0,    k.c10()};
+  int top = 10;
+  while (top > 2 && c[top] == 0.0) --top;
+  if (top <= 3 || !(c[2] > 0.0)) return tp;  // G = c2 a^2 + c3 a^3 rises on a > 0
+  const double scale = std::pow(c[2] / std::abs(c[top]), 1.0 / (top - 2));
+  // h(a) = sum_n n c_n a^(n-2), in x = a / scale, divided by 2 c2.
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(top - 1);
+  for (int n = 2; n <= top; ++n) b[n - 2] = n * c[n] * std::pow(scale, n - 2) / (2.0 * c[2]);
+  std::vector<double> ends;
+  for (const std::complex<double>& z : ScaledPolynomialRoots(b, scale)) {
+    if (!(z.real() > 0.0) || !IsRealRoot(z)) continue;
+    double a = z.real();
+    for (int i = 0; i < 4; ++i) {
+      const double slope = k.dh(a);
+      if (!(slope != 0.0) || !std::isfinite(slope)) break;
+      a -= k.h(a) / slope;
+    }
+    if (a > 0.0 && std::isfinite(a)) ends.push_back(a);
+  }
+  std::sort(ends.begin(), ends.end());
+  if (ends.size() < 2) return tp;
+  tp.a_lower_end = ends.front();
+  tp.a_upper_end = ends.back();
+  tp.exist = true;
+  return tp;
+}
+
+}  // namespace internal
+
 // The turning points of G on a > 0; `branch` names the one wanted (kLower:
 // a_lower_end alone, kUpper: a_upper_end alone, the other left 0; kOnly:
-// both). A turning point computed is the same value either way.
+// both). A turning point computed is the same value either way. A member
+// with the family's terms has both computed (FindTurningPointsOfFamily).
 inline TurningPoints FindTurningPoints(const ResponseCoefficients<double>& k,
                                        Branch branch = Branch::kOnly) {
+  if (k.higher_order) return internal::FindTurningPointsOfFamily(k);
   TurningPoints tp;
   const double c4 = k.c4();
   const double c6 = k.c6();
@@ -115,7 +164,7 @@ inline StableRoot SolveStableRoot(const ResponseCoefficients<double>& k, double 
                                   Branch branch, double a_guess) {
   StableRoot root;
   const double target = a_base * a_base;
-  if (!(target > 0.0) || !std::isfinite(k.k1 + k.k2 + k.k3 + k.k4)) return root;
+  if (!(target > 0.0) || !std::isfinite(k.k1 + k.k2 + k.k3 + k.k4 + k.k5 + k.k6)) return root;
   auto residual = [&k, target](double a, double* value, double* slope) {
     k.GMinusAndSlope(a, target, value, slope);
   };
@@ -202,7 +251,9 @@ inline bool CertifiedOnBranch(const ResponseCoefficients<double>& k, double r, B
 // requested one even where G is monotone.
 inline StableRoot SolveStableRootNear(const ResponseCoefficients<double>& k, double a_base,
                                       Branch branch, double a_guess) {
-  if (branch != Branch::kOnly && a_guess > 0.0) {
+  // The certificate is the sextic's; a member with the family's terms always
+  // brackets its branch between turning points.
+  if (branch != Branch::kOnly && a_guess > 0.0 && !k.higher_order) {
     const double target = a_base * a_base;
     double a = a_guess;
     for (int i = 0; i < 30; ++i) {
@@ -244,7 +295,12 @@ auto ScalarPart(const J& x) -> decltype(x.a) {
 // The coefficients' scalar parts (themselves for double).
 template <typename T>
 ResponseCoefficients<double> ScalarCoefficients(const ResponseCoefficients<T>& k) {
-  return {ScalarPart(k.k1), ScalarPart(k.k2), ScalarPart(k.k3), ScalarPart(k.k4)};
+  ResponseCoefficients<double> scalar{ScalarPart(k.k1), ScalarPart(k.k2), ScalarPart(k.k3),
+                                      ScalarPart(k.k4)};
+  scalar.k5 = ScalarPart(k.k5);
+  scalar.k6 = ScalarPart(k.k6);
+  scalar.higher_order = k.higher_order;
+  return scalar;
 }
 
 // The model's amplitude at one dwell (double precision convenience).

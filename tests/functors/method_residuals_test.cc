@@ -1,5 +1,5 @@
 // The chapter's earlier methods at the functor level: the sextic's roots
-// (sextic_roots.h), the all-roots residual, the root-transition penalty and
+// (amplitude_roots.h), the all-roots residual, the root-transition penalty and
 // the phase-lag residuals, with their Jacobians checked by
 // ceres::GradientChecker.
 #include <cmath>
@@ -13,7 +13,7 @@
 #include "dwellfit/residuals/functors/root_transition_penalty.h"
 #include "dwellfit/residuals/functors/vertical_error_residual.h"
 #include "dwellfit/residuals/model/fold_point.h"
-#include "dwellfit/residuals/model/sextic_roots.h"
+#include "dwellfit/residuals/model/amplitude_roots.h"
 #include "gtest/gtest.h"
 
 namespace dwellfit {
@@ -58,10 +58,10 @@ void ExpectJacobianMatches(const ceres::CostFunction& cost, ParameterVector p, d
   }
 }
 
-TEST(SexticRoots, FindsTheThreeFixedPointsWhereTheResponseIsTripleValued) {
+TEST(AmplitudeRoots, FindsTheThreeFixedPointsWhereTheResponseIsTripleValued) {
   // 42.2 Hz at a_base 0.01: just below the frequency jump-down (42.215 Hz).
   const auto k = At(Truth(), 42.2);
-  const std::vector<std::complex<double>> roots = SexticRoots(k, 0.01, 1e-3);
+  const std::vector<std::complex<double>> roots = AmplitudeRoots(k, 0.01, 1e-3);
   ASSERT_EQ(roots.size(), 6u);
   const std::vector<double> real = PositiveRealRoots(k, 0.01, roots);
   ASSERT_EQ(real.size(), 3u);
@@ -73,7 +73,7 @@ TEST(SexticRoots, FindsTheThreeFixedPointsWhereTheResponseIsTripleValued) {
   EXPECT_LT(k.dG(real[1]), 0.0);  // the saddle
   // Past the fold only the lower root is left.
   EXPECT_EQ(
-      PositiveRealRoots(At(Truth(), 42.3), 0.01, SexticRoots(At(Truth(), 42.3), 0.01, 1e-3)).size(),
+      PositiveRealRoots(At(Truth(), 42.3), 0.01, AmplitudeRoots(At(Truth(), 42.3), 0.01, 1e-3)).size(),
       1u);
 }
 

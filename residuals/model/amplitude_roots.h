@@ -1,17 +1,19 @@
-// All six roots of the frequency-response sextic (3.11) at one dwell, by
+// All roots of the frequency-response polynomial (3.11) at one dwell, by
 // Eigen's companion-matrix polynomial solver, and what the chapter's
 // all-roots algorithm (section 3.2.2) reads from them: the stable positive
 // real roots, and which pair of roots is the saddle and the node of a fold.
 //
-//   F(a) = G(a) - a_base^2 = c6 a^6 + c4 a^4 + c3 a^3 + c2 a^2 - a_base^2
+//   F(a) = G(a) - a_base^2 = c10 a^10 + c8 a^8 + c6 a^6 + c5 a^5 + c4 a^4
+//          + c3 a^3 + c2 a^2 - a_base^2
 //
-// (docs/model.md, "Fixed points"). The polynomial is solved in the scaled
-// variable x = a / a_scale (a_scale: an amplitude of the data, e.g. the
-// measured one), so its coefficients c_n a_scale^n / a_base^2 are of order
-// one. Roots found real are polished by Newton steps on G in double, which the
-// companion matrix leaves at some 1e-12 relative.
-#ifndef DWELLFIT_RESIDUALS_MODEL_SEXTIC_ROOTS_H_
-#define DWELLFIT_RESIDUALS_MODEL_SEXTIC_ROOTS_H_
+// a sextic for the chapter's member (c5 = c8 = c10 = 0; docs/model.md, "Fixed
+// points"), of degree ten with the family's terms k5 and k6. The polynomial is
+// solved in the scaled variable x = a / a_scale (a_scale: an amplitude of the
+// data, e.g. the measured one), so its coefficients c_n a_scale^n / a_base^2
+// are of order one. Roots found real are polished by Newton steps on G in
+// double, which the companion matrix leaves at some 1e-12 relative.
+#ifndef DWELLFIT_RESIDUALS_MODEL_AMPLITUDE_ROOTS_H_
+#define DWELLFIT_RESIDUALS_MODEL_AMPLITUDE_ROOTS_H_
 
 #include <algorithm>
 #include <cmath>
@@ -30,30 +32,47 @@ namespace dwellfit {
 // double root to ~1e-8).
 inline constexpr double kRealRootTolerance = 1e-7;
 
-// The roots of F(a) = G(a) - a_base^2 in a, complex, in no particular order;
-// fewer than six where c6 (then also c4) vanishes. Empty when the
-// coefficients are not finite or the polynomial is constant.
-inline std::vector<std::complex<double>> SexticRoots(const ResponseCoefficients<double>& k,
-                                                     double a_base, double a_scale) {
-  const double target = a_base * a_base;
-  Eigen::Matrix<double, 7, 1> b;
-  b << -1.0, 0.0, k.c2(), k.c3(), k.c4(), 0.0, k.c6();
-  double s = 1.0;
-  for (int n = 2; n <= 6; ++n) {
-    s *= n == 2 ? a_scale * a_scale : a_scale;
-    b[n] *= s / target;
-  }
+// The roots of the polynomial sum_n b[n] x^n (b[n] = coefficient of x^n),
+// complex, in no particular order, after dropping vanishing leading
+// coefficients; `x_scale` multiplies each root. Empty when a coefficient is
+// not finite or the polynomial is constant.
+inline std::vector<std::complex<double>> ScaledPolynomialRoots(Eigen::VectorXd b, double x_scale) {
   if (!b.allFinite()) return {};
-  int degree = 6;
+  Eigen::Index degree = b.size() - 1;
   while (degree > 0 && b[degree] == 0.0) --degree;
   if (degree < 1) return {};
   Eigen::PolynomialSolver<double, Eigen::Dynamic> solver;
   solver.compute(Eigen::VectorXd(b.head(degree + 1)));
   std::vector<std::complex<double>> roots;
   for (Eigen::Index i = 0; i < solver.roots().size(); ++i) {
-    roots.push_back(solver.roots()[i] * a_scale);
+    roots.push_back(solver.roots()[i] * x_scale);
   }
   return roots;
+}
+
+// The roots of F(a) = G(a) - a_base^2 in a, complex, in no particular order;
+// fewer than the degree where the leading coefficients vanish. Empty when the
+// coefficients are not finite or the polynomial is constant.
+inline std::vector<std::complex<double>> AmplitudeRoots(const ResponseCoefficients<double>& k,
+                                                        double a_base, double a_scale) {
+  const double target = a_base * a_base;
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(k.higher_order ? 11 : 7);
+  b[0] = -1.0;
+  b[2] = k.c2();
+  b[3] = k.c3();
+  b[4] = k.c4();
+  b[5] = k.c5();
+  b[6] = k.c6();
+  if (k.higher_order) {
+    b[8] = k.c8();
+    b[10] = k.c10();
+  }
+  double s = 1.0;
+  for (int n = 2; n < b.size(); ++n) {
+    s *= n == 2 ? a_scale * a_scale : a_scale;
+    b[n] *= s / target;
+  }
+  return ScaledPolynomialRoots(b, a_scale);
 }
 
 inline bool IsRealRoot(const std::complex<double>& z) {
@@ -90,10 +109,11 @@ inline std::vector<double> PositiveRealRoots(const ResponseCoefficients<double>&
 
 // The stable root nearest `a_measured` (section 3.2.2): among the positive
 // real roots, the stable ones (dG/da > 0: the smallest and the largest of
-// three) and the nearest of them. False when there is none.
+// three, and every other one of five) and the nearest of them. False when there is none.
 inline bool NearestStableRoot(const ResponseCoefficients<double>& k, double a_base,
                               double a_measured, double* root) {
-  const std::vector<double> real = PositiveRealRoots(k, a_base, SexticRoots(k, a_base, a_measured));
+  const std::vector<double> real =
+      PositiveRealRoots(k, a_base, AmplitudeRoots(k, a_base, a_measured));
   bool found = false;
   for (double a : real) {
     if (!(k.dG(a) > 0.0)) continue;  // the saddle (unstable middle root)
@@ -105,7 +125,7 @@ inline bool NearestStableRoot(const ResponseCoefficients<double>& k, double a_ba
 
 // The two roots that meet at a fold (section 3.2.3: "the saddle and the
 // node"): for the end of the upper branch (a jump-down) the two largest
-// positive real roots when there are three, for the end of the lower branch
+// positive real roots when there are three or more, for the end of the lower branch
 // (a jump-up) the two smallest; where there are fewer, the pair has already
 // turned complex, and it is the conjugate pair whose upper member is nearest
 // `a_jump` (the measured amplitude before the jump). False when there is no
@@ -140,4 +160,4 @@ inline bool FoldRootPair(const std::vector<std::complex<double>>& roots, bool up
 
 }  // namespace dwellfit
 
-#endif  // DWELLFIT_RESIDUALS_MODEL_SEXTIC_ROOTS_H_
+#endif  // DWELLFIT_RESIDUALS_MODEL_AMPLITUDE_ROOTS_H_

@@ -1,0 +1,200 @@
+// The response model with the family's terms k5 (P gains k5 a^3) and k6 (Q
+// gains k6 a^5): G of degree ten, its derivatives, its roots, its turning
+// points and the stable roots on the named branches, against truths that do
+// not use the code under test (the product of P's and Q's coefficient vectors,
+// central differences, and sign changes of a fine grid refined by bisection).
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <functional>
+#include <vector>
+
+#include "ceres/autodiff_cost_function.h"
+#include "ceres/gradient_checker.h"
+#include "ceres/jet.h"
+#include "dwellfit/residuals/model/amplitude_roots.h"
+#include "dwellfit/residuals/model/response_model.h"
+#include "dwellfit/residuals/model/stable_root.h"
+#include "gtest/gtest.h"
+
+namespace dwellfit {
+namespace {
+
+// A hardening cubic and a softening quintic: Q/a = k3 + k4 a^2 + k6 a^4 = -1 +
+// 3 a^2 - a^4 vanishes at a = 0.618 and 1.618, so with light damping G has a
+// local maximum, a minimum, a maximum and a minimum on a > 0.
+template <typename T = double>
+ResponseCoefficients<T> TwoFoldPairs(const T& k5 = T(0.004), const T& k6 = T(-1.0)) {
+  ResponseCoefficients<T> k{T(0.02), T(0.01), T(-1.0), T(3.0)};
+  k.k5 = k5;
+  k.k6 = k6;
+  k.higher_order = true;
+  return k;
+}
+
+// The roots of f on (lo, hi): sign changes on `n` grid points, refined by
+// bisection.
+std::vector<double> GridRoots(const std::function<double(double)>& f, double lo, double hi, int n) {
+  std::vector<double> roots;
+  double x0 = lo, f0 = f(lo);
+  for (int i = 1; i <= n; ++i) {
+    const double x1 = lo + (hi - lo) * i / n;
+    const double f1 = f(x1);
+    if ((f0 < 0.0) != (f1 < 0.0)) {
+      double a = x0, b = x1, fa = f0;
+      for (int j = 0; j < 200 && b - a > 1e-15 * b; ++j) {
+        const double m = 0.5 * (a + b);
+        const double fm = f(m);
+        if ((fm < 0.0) == (fa < 0.0)) {
+          a = m;
+          fa = fm;
+        } else {
+          b = m;
+        }
+      }
+      roots.push_back(0.5 * (a + b));
+    }
+    x0 = x1;
+    f0 = f1;
+  }
+  return roots;
+}
+
+TEST(FamilyTerms, GIsTheProductOfPAndQsCoefficientVectors) {
+  const ResponseCoefficients<double> k = TwoFoldPairs();
+  // P = a (k1 + k2 a + k5 a^2), Q = a (k3 + k4 a^2 + k6 a^4), as polynomials.
+  const std::vector<double> p = {0.0, k.k1, k.k2, k.k5};
+  const std::vector<double> q = {0.0, k.k3, 0.0, k.k4, 0.0, k.k6};
+  std::vector<double> g(11, 0.0);
+  for (size_t i = 0; i < p.size(); ++i)
+    for (size_t j = 0; j < p.size(); ++j) g[i + j] += p[i] * p[j];
+  for (size_t i = 0; i < q.size(); ++i)
+    for (size_t j = 0; j < q.size(); ++j) g[i + j] += q[i] * q[j];
+  const double c[11] = {0.0,    0.0, k.c2(), k.c3(), k.c4(), k.c5(),
+                        k.c6(), 0.0, k.c8(), 0.0,    k.c10()};
+  for (int n = 0; n <= 10; ++n) EXPECT_NEAR(c[n], g[n], 1e-15) << "c" << n;
+  for (double a : {0.1, 0.7, 1.3, 2.2}) {
+    double expanded = 0.0;
+    for (int n = 10; n >= 0; --n) expanded = expanded * a + g[n];
+    EXPECT_NEAR(k.G(a), expanded, 1e-12 * expanded) << a;
+  }
+}
+
+TEST(FamilyTerms, DerivativesAgreeWithCentralDifferences) {
+  const ResponseCoefficients<double> k = TwoFoldPairs();
+  const double e = 1e-5;
+  for (double a : {0.15, 0.6, 1.1, 1.9}) {
+    EXPECT_NEAR(k.dP(a), (k.P(a + e) - k.P(a - e)) / (2 * e), 1e-7) << a;
+    EXPECT_NEAR(k.dQ(a), (k.Q(a + e) - k.Q(a - e)) / (2 * e), 1e-7) << a;
+    EXPECT_NEAR(k.dG(a), (k.G(a + e) - k.G(a - e)) / (2 * e), 1e-6 * (1 + std::abs(k.dG(a))));
+    EXPECT_NEAR(k.d2G(a), (k.dG(a + e) - k.dG(a - e)) / (2 * e), 1e-6 * (1 + std::abs(k.d2G(a))));
+    EXPECT_NEAR(k.h(a), k.dG(a) / a, 1e-12 * (1 + std::abs(k.h(a)))) << a;
+    EXPECT_NEAR(k.dh(a), (k.h(a + e) - k.h(a - e)) / (2 * e), 1e-6 * (1 + std::abs(k.dh(a))));
+    EXPECT_NEAR(k.d2h(a), (k.dh(a + e) - k.dh(a - e)) / (2 * e), 1e-5 * (1 + std::abs(k.d2h(a))));
+  }
+}
+
+TEST(FamilyTerms, TurningPointsAreTheFirstAndLastSignChangesOfTheSlope) {
+  const ResponseCoefficients<double> k = TwoFoldPairs();
+  const std::vector<double> turning =
+      GridRoots([&k](double a) { return k.dG(a); }, 1e-6, 3.0, 300000);
+  ASSERT_EQ(turning.size(), 4u);
+  const TurningPoints tp = FindTurningPoints(k);
+  ASSERT_TRUE(tp.exist);
+  EXPECT_NEAR(tp.a_lower_end, turning.front(), 1e-12);
+  EXPECT_NEAR(tp.a_upper_end, turning.back(), 1e-12);
+}
+
+TEST(FamilyTerms, FindsAllFiveFixedPointsAndTheStableRootsOfTheNamedBranches) {
+  const ResponseCoefficients<double> k = TwoFoldPairs();
+  auto dg = [&k](double a) { return k.dG(a); };
+  const std::vector<double> turning = GridRoots(dg, 1e-6, 3.0, 300000);
+  ASSERT_EQ(turning.size(), 4u);
+  // A level between the larger local minimum and the smaller local maximum.
+  const double g_low = std::max(k.G(turning[1]), k.G(turning[3]));
+  const double g_high = std::min(k.G(turning[0]), k.G(turning[2]));
+  ASSERT_LT(g_low, g_high);
+  const double a_base = std::sqrt(0.5 * (g_low + g_high));
+  const std::vector<double> fixed =
+      GridRoots([&](double a) { return k.G(a) - a_base * a_base; }, 1e-6, 3.0, 300000);
+  ASSERT_EQ(fixed.size(), 5u);
+
+  const std::vector<double> found =
+      PositiveRealRoots(k, a_base, AmplitudeRoots(k, a_base, fixed[2]));
+  ASSERT_EQ(found.size(), 5u);
+  for (int i = 0; i < 5; ++i) EXPECT_NEAR(found[i], fixed[i], 1e-12 * fixed[i]) << i;
+
+  // The lower branch is the smallest root, the upper the largest, from any guess.
+  for (double guess : {0.05, fixed[2], 2.5}) {
+    const StableRoot lower = SolveStableRoot(k, a_base, Branch::kLower, guess);
+    const StableRoot upper = SolveStableRootNear(k, a_base, Branch::kUpper, guess);
+    EXPECT_EQ(lower.status, RootStatus::kOnBranch);
+    EXPECT_EQ(upper.status, RootStatus::kOnBranch);
+    EXPECT_NEAR(lower.a, fixed.front(), 1e-12 * fixed.front()) << guess;
+    EXPECT_NEAR(upper.a, fixed.back(), 1e-12 * fixed.back()) << guess;
+  }
+  // Above the lower branch's maximum the lower branch ends at its turning point.
+  const double above = std::sqrt(1.01 * k.G(turning[0]));
+  const StableRoot end = SolveStableRoot(k, above, Branch::kLower, 0.1);
+  EXPECT_EQ(end.status, RootStatus::kBranchEnd);
+  EXPECT_NEAR(end.a, turning[0], 1e-12);
+}
+
+TEST(FamilyTerms, WithoutTheFamilysTermsTheGeneralPathFindsTheSexticsAnswers) {
+  // Table 3.1 truth with w = 2 pi 40 rad/s: the sextic's own bracketing
+  // (higher_order false) is the independent answer.
+  const ParameterVector p = {100.0, 0.2, 300.0, 1e4, 9e8, HzToRadPerSecond(40.0)};
+  for (double hz : {41.2, 41.5, 42.3, 43.0}) {
+    const auto sextic = ResponseCoefficients<double>::FromParameters(p.data(), kTwoPi * hz);
+    ResponseCoefficients<double> general = sextic;
+    general.higher_order = true;
+    const TurningPoints a = FindTurningPoints(sextic);
+    const TurningPoints b = FindTurningPoints(general);
+    ASSERT_EQ(a.exist, b.exist) << hz;
+    if (!a.exist) continue;
+    EXPECT_NEAR(b.a_lower_end, a.a_lower_end, 1e-12 * a.a_lower_end) << hz;
+    EXPECT_NEAR(b.a_upper_end, a.a_upper_end, 1e-12 * a.a_upper_end) << hz;
+    const double a_base = std::sqrt(0.5 * (sextic.G(a.a_lower_end) + sextic.G(a.a_upper_end)));
+    for (Branch branch : {Branch::kLower, Branch::kUpper}) {
+      const StableRoot x = SolveStableRoot(sextic, a_base, branch, a.a_upper_end);
+      const StableRoot y = SolveStableRoot(general, a_base, branch, a.a_upper_end);
+      EXPECT_NEAR(y.a, x.a, 1e-12 * x.a) << hz << " " << BranchName(branch);
+    }
+  }
+}
+
+// The upper-branch root as a function of (k5, k6), through LiftRoot.
+struct UpperRootOfFamily {
+  explicit UpperRootOfFamily(double a_base) : a_base(a_base) {}
+  template <typename T>
+  bool operator()(const T* const k56, T* residual) const {
+    const ResponseCoefficients<T> k = TwoFoldPairs<T>(k56[0], k56[1]);
+    const StableRoot root = SolveStableRoot(ScalarCoefficients(k), a_base, Branch::kUpper, 2.0);
+    if (root.status == RootStatus::kFailed) return false;
+    residual[0] = LiftRoot(k, a_base, root);
+    return true;
+  }
+  double a_base;
+};
+
+TEST(FamilyTerms, TheLiftedRootsDerivativeInTheNewTermsPassesTheGradientChecker) {
+  const ResponseCoefficients<double> k = TwoFoldPairs();
+  const std::vector<double> turning =
+      GridRoots([&k](double a) { return k.dG(a); }, 1e-6, 3.0, 300000);
+  ASSERT_EQ(turning.size(), 4u);
+  const double a_base = std::sqrt(2.0 * k.G(turning[3]));  // on the upper branch
+  ceres::AutoDiffCostFunction<UpperRootOfFamily, 1, 2> cost(new UpperRootOfFamily(a_base));
+  ceres::NumericDiffOptions numeric;
+  numeric.ridders_relative_initial_step_size = 1e-4;
+  const std::vector<const ceres::Manifold*>* euclidean = nullptr;
+  ceres::GradientChecker checker(&cost, euclidean, numeric);
+  double k56[2] = {0.004, -1.0};
+  const double* parameters[] = {k56};
+  ceres::GradientChecker::ProbeResults results;
+  EXPECT_TRUE(checker.Probe(parameters, 1e-7, &results)) << results.error_log;
+  // The root moves: the derivative is not zero.
+  EXPECT_GT(std::abs(results.jacobians[0](0, 1)), 1e-3);
+}
+
+}  // namespace
+}  // namespace dwellfit
