@@ -11,6 +11,7 @@
 #include <pybind11/stl.h>
 
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -66,10 +67,14 @@ py::object Column(const std::vector<Row>& rows, Value value) {
   }
 }
 
-// The dwells of `sweeps` as columns: names as lists, numbers as arrays.
+// The dwells of `sweeps` as columns: names as lists, numbers as arrays; the
+// optional columns (sigma, a_base_sigma, phase_rad) NaN where a dwell has none.
 py::dict SweepColumns(const std::vector<const Sweep*>& sweeps) {
   std::vector<std::string> id, direction, kind;
-  std::vector<double> freq_hz, a_base, a;
+  std::vector<double> freq_hz, a_base, a, sigma, a_base_sigma, phase_rad;
+  const auto or_nan = [](const std::optional<double>& value) {
+    return value.value_or(std::numeric_limits<double>::quiet_NaN());
+  };
   for (const Sweep* sweep : sweeps) {
     for (const DwellPoint& point : sweep->points) {
       id.push_back(sweep->id);
@@ -78,6 +83,9 @@ py::dict SweepColumns(const std::vector<const Sweep*>& sweeps) {
       freq_hz.push_back(RadPerSecondToHz(point.drive_frequency_rad_s));
       a_base.push_back(point.a_base);
       a.push_back(point.amplitude);
+      sigma.push_back(or_nan(point.sigma));
+      a_base_sigma.push_back(or_nan(point.a_base_sigma));
+      phase_rad.push_back(or_nan(point.phase_rad));
     }
   }
   py::dict out;
@@ -87,6 +95,9 @@ py::dict SweepColumns(const std::vector<const Sweep*>& sweeps) {
   out["freq_hz"] = py::array(py::cast(freq_hz));
   out["a_base"] = py::array(py::cast(a_base));
   out["a"] = py::array(py::cast(a));
+  out["sigma"] = py::array(py::cast(sigma));
+  out["a_base_sigma"] = py::array(py::cast(a_base_sigma));
+  out["phase_rad"] = py::array(py::cast(phase_rad));
   return out;
 }
 

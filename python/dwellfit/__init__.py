@@ -52,7 +52,8 @@ def identify(config, *, overrides=None, output_dir=None, figures=False, base_dir
 
 def load_sweeps(path):
     """The dwells of a sweeps CSV or .mat file (docs/matlab.md) as columns (sweep, direction, kind: lists;
-    freq_hz, a_base, a: NumPy arrays), checked as identify checks them."""
+    freq_hz, a_base, a, and the optional sigma, a_base_sigma, phase_rad: NumPy arrays, NaN where the
+    file gives none), checked as identify checks them."""
     return _dwellfit.load_sweeps(os.fspath(path))
 
 

@@ -169,6 +169,23 @@ def test_next_dwell_ranks_as_the_tool(tmp_path):
         dwellfit.next_dwell(THESIS, "f_hz=41.5")
 
 
+def test_load_sweeps_gives_the_optional_columns_and_nan_where_absent(tmp_path):
+    path = tmp_path / "sweeps.csv"
+    path.write_text("sweep,direction,freq_hz,a_base,a,sigma,a_base_sigma,phase_rad\n"
+                    "F1,up,40.0,0.01,2e-4,3e-6,5e-5,0.25\n"
+                    "F1,up,40.5,0.01,3e-4,4e-6,5e-5,0.5\n"
+                    "A1,up,41.0,0.02,4e-4,6e-6,1e-4,1.0\n")
+    sweeps = dwellfit.load_sweeps(path)
+    assert list(sweeps["sigma"]) == [3e-6, 4e-6, 6e-6]
+    assert list(sweeps["a_base_sigma"]) == [5e-5, 5e-5, 1e-4]
+    assert list(sweeps["phase_rad"]) == [0.25, 0.5, 1.0]
+    thesis = dwellfit.load_sweeps(os.path.join(SOURCE, "datasets", "thesis-numerical", "sweeps.csv"))
+    for column in ("sigma", "a_base_sigma"):
+        assert thesis[column].shape == thesis["a"].shape
+        assert np.isnan(thesis[column]).all(), column
+    assert np.isfinite(thesis["phase_rad"]).all()
+
+
 def test_load_sweeps_reads_a_mat_file_as_its_csv(tmp_path):
     scipy_io = pytest.importorskip("scipy.io")
     path = os.path.join(SOURCE, "datasets", "thesis-numerical", "sweeps.csv")
