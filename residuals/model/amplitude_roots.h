@@ -3,11 +3,11 @@
 // all-roots algorithm (section 3.2.2) reads from them: the stable positive
 // real roots, and which pair of roots is the saddle and the node of a fold.
 //
-//   F(a) = G(a) - a_base^2 = c10 a^10 + c8 a^8 + c6 a^6 + c5 a^5 + c4 a^4
-//          + c3 a^3 + c2 a^2 - a_base^2
+//   F(a) = G(a) - a_base^2 = c10 a^10 + c8 a^8 + c7 a^7 + c6 a^6 + c5 a^5
+//          + c4 a^4 + c3 a^3 + c2 a^2 - a_base^2
 //
 // a sextic for the chapter's member (c5 = c8 = c10 = 0; docs/model.md, "Fixed
-// points"), of degree ten with the family's terms k5 and k6. The polynomial is
+// points"), of degree ten with the terms k5, k6 and k7. The polynomial is
 // solved in the scaled variable x = a / a_scale (a_scale: an amplitude of the
 // data, e.g. the measured one), so its coefficients c_n a_scale^n / a_base^2
 // are of order one. Roots found real are polished by Newton steps on G in
@@ -64,6 +64,7 @@ inline std::vector<std::complex<double>> AmplitudeRoots(const ResponseCoefficien
   b[5] = k.c5();
   b[6] = k.c6();
   if (k.higher_order) {
+    b[7] = k.c7();
     b[8] = k.c8();
     b[10] = k.c10();
   }

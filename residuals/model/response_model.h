@@ -12,9 +12,8 @@
 // frequency-response function (3.11):
 //   G(a) = P(a)^2 + Q(a)^2,  and a fixed point satisfies G(a) = a_base^2.
 // Stability: a fixed point is stable iff dG/da > 0; folds (jumps) have dG/da = 0.
-// Members of the model family beyond the chapter's add k5 a^3 to P and k6 a^5
-// to Q (ResponseCoefficients::higher_order; docs/model.md, "Terms beyond the
-// chapter's").
+// Models beyond the chapter's add k5 a^3 and k7 a^4 to P and k6 a^5 to Q
+// (ResponseCoefficients::higher_order; docs/model.md, "Terms beyond the chapter's").
 #ifndef DWELLFIT_RESIDUALS_MODEL_RESPONSE_MODEL_H_
 #define DWELLFIT_RESIDUALS_MODEL_RESPONSE_MODEL_H_
 
@@ -52,12 +51,12 @@ struct ParameterTerms {
 template <typename T>
 struct ResponseCoefficients {
   T k1, k2, k3, k4;
-  // Terms of the model family beyond eq. (3.3) (docs/model.md, "Terms beyond
-  // the chapter's"), read only where `higher_order` is set, so that the
-  // chapter's member evaluates exactly the expressions above:
-  //   P(a) = (k1 + k2 a + k5 a^2) a,   Q(a) = (k3 + k4 a^2 + k6 a^4) a,
+  // Terms beyond eq. (3.3) (docs/model.md, "Terms beyond the chapter's"),
+  // read only where `higher_order` is set, so that the chapter's member
+  // evaluates exactly the expressions above:
+  //   P(a) = (k1 + k2 a + k5 a^2 + k7 a^3) a,   Q(a) = (k3 + k4 a^2 + k6 a^4) a,
   // and G = P^2 + Q^2 is of degree ten.
-  T k5 = T(0.0), k6 = T(0.0);
+  T k5 = T(0.0), k6 = T(0.0), k7 = T(0.0);
   bool higher_order = false;
 
   // `p` is the parameter block (ParameterIndex layout); `omega_drive` in rad/s.
@@ -82,7 +81,7 @@ struct ResponseCoefficients {
   // derivative part carried for it.
   template <typename A>
   T P(const A& a) const {
-    if (higher_order) return (k1 + (k2 + k5 * a) * a) * a;
+    if (higher_order) return (k1 + (k2 + (k5 + k7 * a) * a) * a) * a;
     return (k1 + k2 * a) * a;
   }
   template <typename A>
@@ -92,7 +91,7 @@ struct ResponseCoefficients {
   }
   template <typename A>
   T dP(const A& a) const {
-    if (higher_order) return k1 + (2.0 * k2 + 3.0 * k5 * a) * a;
+    if (higher_order) return k1 + (2.0 * k2 + (3.0 * k5 + 4.0 * k7 * a) * a) * a;
     return k1 + 2.0 * k2 * a;
   }
   template <typename A>
@@ -123,14 +122,14 @@ struct ResponseCoefficients {
     *value = p * p + q * q - target;
     *slope = 2.0 * (p * dP(a) + q * dQ(a));
   }
-  // d2G/da2 = 2 (P'^2 + P P'' + Q'^2 + Q Q'') with P'' = 2 k2 (+ 6 k5 a),
-  // Q'' = 6 k4 a (+ 20 k6 a^3).
+  // d2G/da2 = 2 (P'^2 + P P'' + Q'^2 + Q Q'') with P'' = 2 k2 (+ 6 k5 a +
+  // 12 k7 a^2), Q'' = 6 k4 a (+ 20 k6 a^3).
   template <typename A>
   T d2G(const A& a) const {
     const T dp = dP(a);
     const T dq = dQ(a);
     if (higher_order) {
-      const T ddp = 2.0 * k2 + 6.0 * k5 * a;
+      const T ddp = 2.0 * k2 + (6.0 * k5 + 12.0 * k7 * a) * a;
       const T ddq = (6.0 * k4 + 20.0 * k6 * a * a) * a;
       return 2.0 * (dp * dp + P(a) * ddp + dq * dq + Q(a) * ddq);
     }
@@ -138,11 +137,12 @@ struct ResponseCoefficients {
   }
 
   // h(a) = (dG/da) / a = 2 c2 + 3 c3 a + 4 c4 a^2 + 5 c5 a^3 + 6 c6 a^4
-  // + 8 c8 a^6 + 10 c10 a^8, written through P and Q for conditioning; its
+  // + 7 c7 a^5 + 8 c8 a^6 + 10 c10 a^8, written through P and Q for conditioning; its
   // positive roots are the turning points of G.
   T h(const T& a) const {
     if (higher_order) {
-      return 2.0 * ((k1 + (k2 + k5 * a) * a) * dP(a) + (k3 + (k4 + k6 * a * a) * a * a) * dQ(a));
+      return 2.0 * ((k1 + (k2 + (k5 + k7 * a) * a) * a) * dP(a) +
+                    (k3 + (k4 + k6 * a * a) * a * a) * dQ(a));
     }
     return 2.0 *
            ((k1 + k2 * a) * (k1 + 2.0 * k2 * a) + (k3 + k4 * a * a) * (k3 + 3.0 * k4 * a * a));
@@ -151,7 +151,7 @@ struct ResponseCoefficients {
     if (higher_order) {
       const T a2 = a * a;
       return 3.0 * c3() + a * (8.0 * c4() + a * (15.0 * c5() + 24.0 * c6() * a)) +
-             a2 * a2 * a * (48.0 * c8() + 80.0 * c10() * a2);
+             a2 * a2 * (35.0 * c7() + a * (48.0 * c8() + 80.0 * c10() * a2));
     }
     return 2.0 *
            (3.0 * k1 * k2 + 4.0 * k2 * k2 * a + 8.0 * k3 * k4 * a + 12.0 * k4 * k4 * a * a * a);
@@ -160,25 +160,26 @@ struct ResponseCoefficients {
     if (higher_order) {
       const T a2 = a * a;
       return 8.0 * c4() + a * (30.0 * c5() + 72.0 * c6() * a) +
-             a2 * a2 * (240.0 * c8() + 560.0 * c10() * a2);
+             a2 * a * (140.0 * c7() + a * (240.0 * c8() + 560.0 * c10() * a2));
     }
     return 2.0 * (4.0 * k2 * k2 + 8.0 * k3 * k4 + 36.0 * k4 * k4 * a * a);
   }
 
-  // Coefficients of G = c10 a^10 + c8 a^8 + c6 a^6 + c5 a^5 + c4 a^4 + c3 a^3
-  // + c2 a^2 (a sextic for the chapter's member: c5 = c8 = c10 = 0).
+  // Coefficients of G = c10 a^10 + c8 a^8 + c7 a^7 + c6 a^6 + c5 a^5 + c4 a^4
+  // + c3 a^3 + c2 a^2 (a sextic for the chapter's member: c5 = c7 = c8 = c10 = 0).
   T c2() const { return k1 * k1 + k3 * k3; }
   T c3() const { return 2.0 * k1 * k2; }
   T c4() const {
     if (higher_order) return k2 * k2 + 2.0 * k3 * k4 + 2.0 * k1 * k5;
     return k2 * k2 + 2.0 * k3 * k4;
   }
-  T c5() const { return higher_order ? T(2.0 * k2 * k5) : T(0.0); }
+  T c5() const { return higher_order ? T(2.0 * (k1 * k7 + k2 * k5)) : T(0.0); }
   T c6() const {
-    if (higher_order) return k4 * k4 + k5 * k5 + 2.0 * k3 * k6;
+    if (higher_order) return k4 * k4 + k5 * k5 + 2.0 * (k2 * k7 + k3 * k6);
     return k4 * k4;
   }
-  T c8() const { return higher_order ? T(2.0 * k4 * k6) : T(0.0); }
+  T c7() const { return higher_order ? T(2.0 * k5 * k7) : T(0.0); }
+  T c8() const { return higher_order ? T(k7 * k7 + 2.0 * k4 * k6) : T(0.0); }
   T c10() const { return higher_order ? T(k6 * k6) : T(0.0); }
 };
 

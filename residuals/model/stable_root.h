@@ -58,11 +58,7 @@ double ExpandUntil(double hi, const Predicate& positive) {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-}  // namespace internal
-
-namespace internal {
-
-// The turning points of a member with the family's terms (k.higher_order),
+// The turning points of a model with terms beyond the chapter's (k.higher_order),
 // where h = (dG/da)/a is of degree eight and may have four positive roots:
 // the positive real roots of h (companion matrix, in the variable a / a_s
 // with a_s = (c2 / c_top)^(1 / top), c_top the leading coefficient of G),
@@ -72,8 +68,8 @@ namespace internal {
 // is never returned.
 inline TurningPoints FindTurningPointsOfFamily(const ResponseCoefficients<double>& k) {
   TurningPoints tp;
-  const double c[11] = {0.0,    0.0, k.c2(), k.c3(), k.c4(), k.c5(),
-                        k.c6(), 0.0, k.c8(), 0.0,    k.c10()};
+  const double c[11] = {0.0,    0.0,    k.c2(), k.c3(), k.c4(), k.c5(),
+                        k.c6(), k.c7(), k.c8(), 0.0,    k.c10()};
   int top = 10;
   while (top > 2 && c[top] == 0.0) --top;
   if (top <= 3 || !(c[2] > 0.0)) return tp;  // G = c2 a^2 + c3 a^3 rises on a > 0
@@ -105,7 +101,7 @@ inline TurningPoints FindTurningPointsOfFamily(const ResponseCoefficients<double
 // The turning points of G on a > 0; `branch` names the one wanted (kLower:
 // a_lower_end alone, kUpper: a_upper_end alone, the other left 0; kOnly:
 // both). A turning point computed is the same value either way. A member
-// with the family's terms has both computed (FindTurningPointsOfFamily).
+// with terms beyond the chapter's has both computed (FindTurningPointsOfFamily).
 inline TurningPoints FindTurningPoints(const ResponseCoefficients<double>& k,
                                        Branch branch = Branch::kOnly) {
   if (k.higher_order) return internal::FindTurningPointsOfFamily(k);
@@ -164,7 +160,8 @@ inline StableRoot SolveStableRoot(const ResponseCoefficients<double>& k, double 
                                   Branch branch, double a_guess) {
   StableRoot root;
   const double target = a_base * a_base;
-  if (!(target > 0.0) || !std::isfinite(k.k1 + k.k2 + k.k3 + k.k4 + k.k5 + k.k6)) return root;
+  if (!(target > 0.0) || !std::isfinite(k.k1 + k.k2 + k.k3 + k.k4 + k.k5 + k.k6 + k.k7))
+    return root;
   auto residual = [&k, target](double a, double* value, double* slope) {
     k.GMinusAndSlope(a, target, value, slope);
   };
@@ -251,7 +248,7 @@ inline bool CertifiedOnBranch(const ResponseCoefficients<double>& k, double r, B
 // requested one even where G is monotone.
 inline StableRoot SolveStableRootNear(const ResponseCoefficients<double>& k, double a_base,
                                       Branch branch, double a_guess) {
-  // The certificate is the sextic's; a member with the family's terms always
+  // The certificate is the sextic's; a model with terms beyond the chapter's always
   // brackets its branch between turning points.
   if (branch != Branch::kOnly && a_guess > 0.0 && !k.higher_order) {
     const double target = a_base * a_base;
@@ -299,6 +296,7 @@ ResponseCoefficients<double> ScalarCoefficients(const ResponseCoefficients<T>& k
                                       ScalarPart(k.k4)};
   scalar.k5 = ScalarPart(k.k5);
   scalar.k6 = ScalarPart(k.k6);
+  scalar.k7 = ScalarPart(k.k7);
   scalar.higher_order = k.higher_order;
   return scalar;
 }

@@ -1,8 +1,8 @@
-// The response model with the family's terms k5 (P gains k5 a^3) and k6 (Q
-// gains k6 a^5): G of degree ten, its derivatives, its roots, its turning
-// points and the stable roots on the named branches, against truths that do
-// not use the code under test (the product of P's and Q's coefficient vectors,
-// central differences, and sign changes of a fine grid refined by bisection).
+// The response model with the terms beyond the chapter's, k5 and k7 (P gains
+// k5 a^3 + k7 a^4) and k6 (Q gains k6 a^5): G of degree ten, its derivatives, its roots, its
+// turning points and the stable roots on the named branches, against truths that do not use the
+// code under test (the product of P's and Q's coefficient vectors, central differences, and sign
+// changes of a fine grid refined by bisection).
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -24,10 +24,12 @@ namespace {
 // 3 a^2 - a^4 vanishes at a = 0.618 and 1.618, so with light damping G has a
 // local maximum, a minimum, a maximum and a minimum on a > 0.
 template <typename T = double>
-ResponseCoefficients<T> TwoFoldPairs(const T& k5 = T(0.004), const T& k6 = T(-1.0)) {
+ResponseCoefficients<T> TwoFoldPairs(const T& k5 = T(0.004), const T& k6 = T(-1.0),
+                                     const T& k7 = T(0.002)) {
   ResponseCoefficients<T> k{T(0.02), T(0.01), T(-1.0), T(3.0)};
   k.k5 = k5;
   k.k6 = k6;
+  k.k7 = k7;
   k.higher_order = true;
   return k;
 }
@@ -62,16 +64,17 @@ std::vector<double> GridRoots(const std::function<double(double)>& f, double lo,
 
 TEST(FamilyTerms, GIsTheProductOfPAndQsCoefficientVectors) {
   const ResponseCoefficients<double> k = TwoFoldPairs();
-  // P = a (k1 + k2 a + k5 a^2), Q = a (k3 + k4 a^2 + k6 a^4), as polynomials.
-  const std::vector<double> p = {0.0, k.k1, k.k2, k.k5};
+  // P = a (k1 + k2 a + k5 a^2 + k7 a^3), Q = a (k3 + k4 a^2 + k6 a^4), as
+  // polynomials.
+  const std::vector<double> p = {0.0, k.k1, k.k2, k.k5, k.k7};
   const std::vector<double> q = {0.0, k.k3, 0.0, k.k4, 0.0, k.k6};
   std::vector<double> g(11, 0.0);
   for (size_t i = 0; i < p.size(); ++i)
     for (size_t j = 0; j < p.size(); ++j) g[i + j] += p[i] * p[j];
   for (size_t i = 0; i < q.size(); ++i)
     for (size_t j = 0; j < q.size(); ++j) g[i + j] += q[i] * q[j];
-  const double c[11] = {0.0,    0.0, k.c2(), k.c3(), k.c4(), k.c5(),
-                        k.c6(), 0.0, k.c8(), 0.0,    k.c10()};
+  const double c[11] = {0.0,    0.0,    k.c2(), k.c3(), k.c4(), k.c5(),
+                        k.c6(), k.c7(), k.c8(), 0.0,    k.c10()};
   for (int n = 0; n <= 10; ++n) EXPECT_NEAR(c[n], g[n], 1e-15) << "c" << n;
   for (double a : {0.1, 0.7, 1.3, 2.2}) {
     double expanded = 0.0;
@@ -163,12 +166,12 @@ TEST(FamilyTerms, WithoutTheFamilysTermsTheGeneralPathFindsTheSexticsAnswers) {
   }
 }
 
-// The upper-branch root as a function of (k5, k6), through LiftRoot.
+// The upper-branch root as a function of (k5, k6, k7), through LiftRoot.
 struct UpperRootOfFamily {
   explicit UpperRootOfFamily(double a_base) : a_base(a_base) {}
   template <typename T>
-  bool operator()(const T* const k56, T* residual) const {
-    const ResponseCoefficients<T> k = TwoFoldPairs<T>(k56[0], k56[1]);
+  bool operator()(const T* const k567, T* residual) const {
+    const ResponseCoefficients<T> k = TwoFoldPairs<T>(k567[0], k567[1], k567[2]);
     const StableRoot root = SolveStableRoot(ScalarCoefficients(k), a_base, Branch::kUpper, 2.0);
     if (root.status == RootStatus::kFailed) return false;
     residual[0] = LiftRoot(k, a_base, root);
@@ -183,13 +186,13 @@ TEST(FamilyTerms, TheLiftedRootsDerivativeInTheNewTermsPassesTheGradientChecker)
       GridRoots([&k](double a) { return k.dG(a); }, 1e-6, 3.0, 300000);
   ASSERT_EQ(turning.size(), 4u);
   const double a_base = std::sqrt(2.0 * k.G(turning[3]));  // on the upper branch
-  ceres::AutoDiffCostFunction<UpperRootOfFamily, 1, 2> cost(new UpperRootOfFamily(a_base));
+  ceres::AutoDiffCostFunction<UpperRootOfFamily, 1, 3> cost(new UpperRootOfFamily(a_base));
   ceres::NumericDiffOptions numeric;
   numeric.ridders_relative_initial_step_size = 1e-4;
   const std::vector<const ceres::Manifold*>* euclidean = nullptr;
   ceres::GradientChecker checker(&cost, euclidean, numeric);
-  double k56[2] = {0.004, -1.0};
-  const double* parameters[] = {k56};
+  double k567[3] = {0.004, -1.0, 0.002};
+  const double* parameters[] = {k567};
   ceres::GradientChecker::ProbeResults results;
   EXPECT_TRUE(checker.Probe(parameters, 1e-7, &results)) << results.error_log;
   // The root moves: the derivative is not zero.
