@@ -44,6 +44,9 @@ struct TurningPoints {
   bool exist = false;
   double a_lower_end = 0.0;  // local maximum of G: the lower branch ends here
   double a_upper_end = 0.0;  // local minimum of G: the upper branch ends here
+  // Where the upper branch ends going up: a third turning point (a local
+  // maximum of G, only with terms beyond the chapter's), else infinity.
+  double a_upper_limit = std::numeric_limits<double>::infinity();
 };
 
 namespace internal {
@@ -63,9 +66,12 @@ double ExpandUntil(double hi, const Predicate& positive) {
 // the positive real roots of h (companion matrix, in the variable a / a_s
 // with a_s = (c2 / c_top)^(1 / top), c_top the leading coefficient of G),
 // polished by Newton steps on h. G rises from 0 to the first (a local
-// maximum: a_lower_end) and from the last (a local minimum: a_upper_end) on;
-// a stable branch between a second and a third turning point has no name and
-// is never returned.
+// maximum: a_lower_end) and from the second (a local minimum: a_upper_end) to
+// the third (a_upper_limit) or on: the branches of the first fold pair, the
+// chapter's two. A branch beyond a second fold pair has no name and is never
+// returned; where the terms are a second-order correction (docs/model.md),
+// that pair lies beyond the correction's validity (a softening cubic with the
+// quintic k6 > 0 that the correction adds folds back at large amplitude).
 inline TurningPoints FindTurningPointsOfFamily(const ResponseCoefficients<double>& k) {
   TurningPoints tp;
   const double c[11] = {0.0,    0.0,    k.c2(), k.c3(), k.c4(), k.c5(),
@@ -90,8 +96,9 @@ inline TurningPoints FindTurningPointsOfFamily(const ResponseCoefficients<double
   }
   std::sort(ends.begin(), ends.end());
   if (ends.size() < 2) return tp;
-  tp.a_lower_end = ends.front();
-  tp.a_upper_end = ends.back();
+  tp.a_lower_end = ends[0];
+  tp.a_upper_end = ends[1];
+  if (ends.size() > 2) tp.a_upper_limit = ends[2];
   tp.exist = true;
   return tp;
 }
@@ -179,14 +186,20 @@ inline StableRoot SolveStableRoot(const ResponseCoefficients<double>& k, double 
   }
   // Whether each branch reaches a_base, once each (the branch whose turning
   // point was not found is never asked for).
+  // An upper branch capped by a third turning point (terms beyond the
+  // chapter's) reaches a_base only if its top, G(a_upper_limit), is above it;
+  // if not, it ends there.
+  const bool capped = std::isfinite(tp.a_upper_limit);
+  const bool below_top = !capped || k.G(tp.a_upper_limit) > target;
   const bool lower_exists = branch != Branch::kUpper && k.G(tp.a_lower_end) > target;
-  const bool upper_exists = branch != Branch::kLower && k.G(tp.a_upper_end) < target;
+  const bool upper_exists = branch != Branch::kLower && k.G(tp.a_upper_end) < target && below_top;
   // The root on branch `on` (kLower or kUpper), or the turning point where it ends.
   auto solve = [&](Branch on) {
     const bool upper = on == Branch::kUpper;
-    const double end = upper ? tp.a_upper_end : tp.a_lower_end;
+    const double end = upper ? (below_top ? tp.a_upper_end : tp.a_upper_limit) : tp.a_lower_end;
     if (!(upper ? upper_exists : lower_exists)) return StableRoot{end, RootStatus::kBranchEnd, on};
-    const double hi = upper ? upper_bracket_end(std::max(2.0 * end, guess)) : end;
+    const double hi =
+        upper ? (capped ? tp.a_upper_limit : upper_bracket_end(std::max(2.0 * end, guess))) : end;
     if (!std::isfinite(hi)) return StableRoot{0.0, RootStatus::kFailed, on};
     return StableRoot{BracketedNewton(residual, upper ? end : 0.0, hi, guess),
                       RootStatus::kOnBranch, on};

@@ -97,15 +97,16 @@ TEST(FamilyTerms, DerivativesAgreeWithCentralDifferences) {
   }
 }
 
-TEST(FamilyTerms, TurningPointsAreTheFirstAndLastSignChangesOfTheSlope) {
+TEST(FamilyTerms, TurningPointsAreTheFirstThreeSignChangesOfTheSlope) {
   const ResponseCoefficients<double> k = TwoFoldPairs();
   const std::vector<double> turning =
       GridRoots([&k](double a) { return k.dG(a); }, 1e-6, 3.0, 300000);
   ASSERT_EQ(turning.size(), 4u);
   const TurningPoints tp = FindTurningPoints(k);
   ASSERT_TRUE(tp.exist);
-  EXPECT_NEAR(tp.a_lower_end, turning.front(), 1e-12);
-  EXPECT_NEAR(tp.a_upper_end, turning.back(), 1e-12);
+  EXPECT_NEAR(tp.a_lower_end, turning[0], 1e-12);
+  EXPECT_NEAR(tp.a_upper_end, turning[1], 1e-12);
+  EXPECT_NEAR(tp.a_upper_limit, turning[2], 1e-12);
 }
 
 TEST(FamilyTerms, FindsAllFiveFixedPointsAndTheStableRootsOfTheNamedBranches) {
@@ -127,15 +128,22 @@ TEST(FamilyTerms, FindsAllFiveFixedPointsAndTheStableRootsOfTheNamedBranches) {
   ASSERT_EQ(found.size(), 5u);
   for (int i = 0; i < 5; ++i) EXPECT_NEAR(found[i], fixed[i], 1e-12 * fixed[i]) << i;
 
-  // The lower branch is the smallest root, the upper the largest, from any guess.
+  // The lower branch is the smallest root and the upper branch the root between
+  // the second and third turning points (the first fold pair's), from any
+  // guess; the largest root, beyond a second fold pair, has no name.
   for (double guess : {0.05, fixed[2], 2.5}) {
     const StableRoot lower = SolveStableRoot(k, a_base, Branch::kLower, guess);
     const StableRoot upper = SolveStableRootNear(k, a_base, Branch::kUpper, guess);
     EXPECT_EQ(lower.status, RootStatus::kOnBranch);
     EXPECT_EQ(upper.status, RootStatus::kOnBranch);
     EXPECT_NEAR(lower.a, fixed.front(), 1e-12 * fixed.front()) << guess;
-    EXPECT_NEAR(upper.a, fixed.back(), 1e-12 * fixed.back()) << guess;
+    EXPECT_NEAR(upper.a, fixed[2], 1e-12 * fixed[2]) << guess;
   }
+  // Above the upper branch's top it ends at the third turning point.
+  const double over = std::sqrt(1.01 * k.G(turning[2]));
+  const StableRoot top = SolveStableRoot(k, over, Branch::kUpper, 1.0);
+  EXPECT_EQ(top.status, RootStatus::kBranchEnd);
+  EXPECT_NEAR(top.a, turning[2], 1e-12);
   // Above the lower branch's maximum the lower branch ends at its turning point.
   const double above = std::sqrt(1.01 * k.G(turning[0]));
   const StableRoot end = SolveStableRoot(k, above, Branch::kLower, 0.1);
@@ -172,7 +180,7 @@ struct UpperRootOfFamily {
   template <typename T>
   bool operator()(const T* const k567, T* residual) const {
     const ResponseCoefficients<T> k = TwoFoldPairs<T>(k567[0], k567[1], k567[2]);
-    const StableRoot root = SolveStableRoot(ScalarCoefficients(k), a_base, Branch::kUpper, 2.0);
+    const StableRoot root = SolveStableRoot(ScalarCoefficients(k), a_base, Branch::kUpper, 1.0);
     if (root.status == RootStatus::kFailed) return false;
     residual[0] = LiftRoot(k, a_base, root);
     return true;
@@ -185,7 +193,8 @@ TEST(FamilyTerms, TheLiftedRootsDerivativeInTheNewTermsPassesTheGradientChecker)
   const std::vector<double> turning =
       GridRoots([&k](double a) { return k.dG(a); }, 1e-6, 3.0, 300000);
   ASSERT_EQ(turning.size(), 4u);
-  const double a_base = std::sqrt(2.0 * k.G(turning[3]));  // on the upper branch
+  // On the upper branch, between its bottom and top.
+  const double a_base = std::sqrt(0.5 * (k.G(turning[1]) + k.G(turning[2])));
   ceres::AutoDiffCostFunction<UpperRootOfFamily, 1, 3> cost(new UpperRootOfFamily(a_base));
   ceres::NumericDiffOptions numeric;
   numeric.ridders_relative_initial_step_size = 1e-4;
