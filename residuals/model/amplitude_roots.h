@@ -16,6 +16,7 @@
 #define DWELLFIT_RESIDUALS_MODEL_AMPLITUDE_ROOTS_H_
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
 #include <limits>
@@ -56,22 +57,13 @@ inline std::vector<std::complex<double>> ScaledPolynomialRoots(Eigen::VectorXd b
 inline std::vector<std::complex<double>> AmplitudeRoots(const ResponseCoefficients<double>& k,
                                                         double a_base, double a_scale) {
   const double target = a_base * a_base;
+  const std::array<double, 11> c = k.Coefficients();
   Eigen::VectorXd b = Eigen::VectorXd::Zero(k.higher_order ? 11 : 7);
   b[0] = -1.0;
-  b[2] = k.c2();
-  b[3] = k.c3();
-  b[4] = k.c4();
-  b[5] = k.c5();
-  b[6] = k.c6();
-  if (k.higher_order) {
-    b[7] = k.c7();
-    b[8] = k.c8();
-    b[10] = k.c10();
-  }
   double s = 1.0;
   for (int n = 2; n < b.size(); ++n) {
     s *= n == 2 ? a_scale * a_scale : a_scale;
-    b[n] *= s / target;
+    b[n] = c[n] * (s / target);
   }
   return ScaledPolynomialRoots(b, a_scale);
 }

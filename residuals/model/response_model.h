@@ -17,6 +17,8 @@
 #ifndef DWELLFIT_RESIDUALS_MODEL_RESPONSE_MODEL_H_
 #define DWELLFIT_RESIDUALS_MODEL_RESPONSE_MODEL_H_
 
+#include <array>
+
 #include "dwellfit/residuals/model/model_parameters.h"
 
 namespace dwellfit {
@@ -79,15 +81,24 @@ struct ResponseCoefficients {
   // The amplitude `a` is a T, or a double where it is a constant (a root
   // found in double and lifted to Jets): the same values, with no
   // derivative part carried for it.
+  // P(a) / a and Q(a) / a: the polynomials P and Q share with h.
+  template <typename A>
+  T PPerA(const A& a) const {
+    if (higher_order) return k1 + (k2 + (k5 + k7 * a) * a) * a;
+    return k1 + k2 * a;
+  }
+  template <typename A>
+  T QPerA(const A& a) const {
+    if (higher_order) return k3 + (k4 + k6 * a * a) * a * a;
+    return k3 + k4 * a * a;
+  }
   template <typename A>
   T P(const A& a) const {
-    if (higher_order) return (k1 + (k2 + (k5 + k7 * a) * a) * a) * a;
-    return (k1 + k2 * a) * a;
+    return PPerA(a) * a;
   }
   template <typename A>
   T Q(const A& a) const {
-    if (higher_order) return (k3 + (k4 + k6 * a * a) * a * a) * a;
-    return (k3 + k4 * a * a) * a;
+    return QPerA(a) * a;
   }
   template <typename A>
   T dP(const A& a) const {
@@ -139,14 +150,7 @@ struct ResponseCoefficients {
   // h(a) = (dG/da) / a = 2 c2 + 3 c3 a + 4 c4 a^2 + 5 c5 a^3 + 6 c6 a^4
   // + 7 c7 a^5 + 8 c8 a^6 + 10 c10 a^8, written through P and Q for conditioning; its
   // positive roots are the turning points of G.
-  T h(const T& a) const {
-    if (higher_order) {
-      return 2.0 * ((k1 + (k2 + (k5 + k7 * a) * a) * a) * dP(a) +
-                    (k3 + (k4 + k6 * a * a) * a * a) * dQ(a));
-    }
-    return 2.0 *
-           ((k1 + k2 * a) * (k1 + 2.0 * k2 * a) + (k3 + k4 * a * a) * (k3 + 3.0 * k4 * a * a));
-  }
+  T h(const T& a) const { return 2.0 * (PPerA(a) * dP(a) + QPerA(a) * dQ(a)); }
   T dh(const T& a) const {
     if (higher_order) {
       const T a2 = a * a;
@@ -181,6 +185,10 @@ struct ResponseCoefficients {
   T c7() const { return higher_order ? T(2.0 * k5 * k7) : T(0.0); }
   T c8() const { return higher_order ? T(k7 * k7 + 2.0 * k4 * k6) : T(0.0); }
   T c10() const { return higher_order ? T(k6 * k6) : T(0.0); }
+  // c_n at index n, n = 0..10 (c0 = c1 = c9 = 0).
+  std::array<T, 11> Coefficients() const {
+    return {T(0.0), T(0.0), c2(), c3(), c4(), c5(), c6(), c7(), c8(), T(0.0), c10()};
+  }
 };
 
 }  // namespace dwellfit

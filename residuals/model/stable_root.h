@@ -15,6 +15,7 @@
 #define DWELLFIT_RESIDUALS_MODEL_STABLE_ROOT_H_
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
 #include <limits>
@@ -74,8 +75,7 @@ double ExpandUntil(double hi, const Predicate& positive) {
 // quintic k6 > 0 that the correction adds folds back at large amplitude).
 inline TurningPoints FindTurningPointsOfFamily(const ResponseCoefficients<double>& k) {
   TurningPoints tp;
-  const double c[11] = {0.0,    0.0,    k.c2(), k.c3(), k.c4(), k.c5(),
-                        k.c6(), k.c7(), k.c8(), 0.0,    k.c10()};
+  const std::array<double, 11> c = k.Coefficients();
   int top = 10;
   while (top > 2 && c[top] == 0.0) --top;
   if (top <= 3 || !(c[2] > 0.0)) return tp;  // G = c2 a^2 + c3 a^3 rises on a > 0
