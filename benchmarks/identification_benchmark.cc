@@ -197,6 +197,20 @@ BENCHMARK(BM_ClampedBeamFit)
     ->Iterations(5)
     ->UseRealTime();
 
+// The same fit with the second-order model (`model: {averaging: second_order}`,
+// model_form.h): what its degree-ten G costs a whole fit.
+void BM_ClampedBeamFitSecondOrder(benchmark::State& state) {
+  static ResolvedRun* beam = LoadCase("clamped-beam-27C");
+  beam->options.solve.residual.form = kSecondOrderForm;
+  RunConfiguredFit(state, *beam);
+}
+BENCHMARK(BM_ClampedBeamFitSecondOrder)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(2)
+    ->UseRealTime();
+
 // The same on a busy machine: `busy` other processes spin for the whole run,
 // each keeping one core occupied, as other jobs do on a shared machine. The
 // bar (docs/performance.md): idle, threads:0 at least 1.5x faster than
@@ -297,7 +311,7 @@ void TraceCurvesAtEstimate(benchmark::State& state, ResolvedRun& run) {
   std::vector<const Sweep*> sweeps = run.fitted;
   sweeps.insert(sweeps.end(), run.validation.begin(), run.validation.end());
   for (auto _ : state) {
-    const RunCurves traced = TraceRunCurves(estimate, sweeps);
+    const RunCurves traced = TraceRunCurves(kFirstOrderForm, estimate, sweeps);
     benchmark::DoNotOptimize(traced.csv.data());
     state.counters["curves"] = static_cast<double>(traced.curves.size());
     state.counters["csv_bytes"] = static_cast<double>(traced.csv.size());

@@ -26,12 +26,14 @@ const ResolvedRun& Thesis() {
   return *thesis;
 }
 
-// state.range(0): 0 vertical, 1 all roots; state.range(1): 1 with Jacobian.
-void BM_DwellResidual(benchmark::State& state) {
+// state.range(0): 0 vertical, 1 all roots; state.range(1): 1 with Jacobian;
+// `form`: the response model (model_form.h).
+void DwellResidual(benchmark::State& state, ModelForm form) {
   const ResolvedRun& thesis = Thesis();
   ProblemBuilderOptions options;
   options.residual = state.range(0) == 0 ? ResidualKind::kVertical : ResidualKind::kAllRoots;
   options.residual_options = thesis.options.solve.residual;
+  options.residual_options.form = form;
   const ProblemBuilder builder(options);
   std::vector<std::unique_ptr<ceres::CostFunction>> costs;
   for (const Sweep* sweep : thesis.fitted) {
@@ -55,17 +57,31 @@ void BM_DwellResidual(benchmark::State& state) {
       benchmark::DoNotOptimize(residual);
     }
   }
-  state.SetLabel(std::string(ResidualKindName(options.residual)) +
+  state.SetLabel(std::string(form.second_order() ? "second_order " : "") +
+                 ResidualKindName(options.residual) +
                  (with_jacobian ? " value+Jacobian" : " value"));
   state.counters["dwells"] = static_cast<double>(costs.size());
   state.counters["ns_per_dwell"] =
       benchmark::Counter(static_cast<double>(state.iterations() * costs.size()),
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
+void BM_DwellResidual(benchmark::State& state) { DwellResidual(state, kFirstOrderForm); }
 BENCHMARK(BM_DwellResidual)
     ->ArgNames({"all_roots", "jacobian"})
     ->Args({0, 0})
     ->Args({1, 0})
+    ->Args({0, 1})
+    ->Args({1, 1})
+    ->Unit(benchmark::kMicrosecond);
+
+// The same with the second-order model (G of degree ten: the roots take the
+// companion matrix's path), what `model: {averaging: second_order}` costs.
+void BM_SecondOrderDwellResidual(benchmark::State& state) {
+  DwellResidual(state, kSecondOrderForm);
+}
+BENCHMARK(BM_SecondOrderDwellResidual)
+    ->ArgNames({"all_roots", "jacobian"})
+    ->Args({0, 0})
     ->Args({0, 1})
     ->Args({1, 1})
     ->Unit(benchmark::kMicrosecond);

@@ -48,6 +48,7 @@ set(DWELLFIT_PUBLIC_HEADERS
     residuals/functors/error_measure.h
     residuals/model/amplitude_roots.h
     residuals/model/bracketed_newton.h
+    residuals/model/model_form.h
     residuals/model/model_parameters.h
     residuals/model/response_model.h
     residuals/model/stable_root.h

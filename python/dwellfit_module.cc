@@ -192,7 +192,13 @@ py::dict PyLoadSweeps(const std::string& path) {
 // sweep at base level `held` over [low_hz, high_hz], or an amplitude sweep at
 // `held` Hz over base levels [low, high].
 py::dict PyCurve(const std::map<std::string, double>& parameters, const std::string& kind,
-                 double held, double low, double high, int points_per_side) {
+                 double held, double low, double high, int points_per_side,
+                 const std::string& averaging) {
+  ModelForm form;
+  if (!AveragingFromName(averaging, &form.averaging)) {
+    throw InputError("averaging", 0, "averaging",
+                     "give 'first_order' or 'second_order', not '" + averaging + "'");
+  }
   ParameterVector p{};
   for (int i = 0; i < kNumParameters; ++i) {
     const auto it = parameters.find(ParameterName(i));
@@ -216,7 +222,7 @@ py::dict PyCurve(const std::map<std::string, double>& parameters, const std::str
   ResponseCurve curve;
   {
     py::gil_scoped_release release;
-    curve = TraceResponseCurve(p, spec);
+    curve = TraceResponseCurve(form, p, spec);
   }
   const std::vector<CurvePoint>& points = curve.points;
   py::dict out;
@@ -301,7 +307,7 @@ PYBIND11_MODULE(_dwellfit, m) {
         py::arg("overrides"), py::arg("write"), py::arg("figures"));
   m.def("load_sweeps", &dwellfit::PyLoadSweeps, py::arg("path"));
   m.def("curve", &dwellfit::PyCurve, py::arg("parameters"), py::arg("kind"), py::arg("held"),
-        py::arg("low"), py::arg("high"), py::arg("points_per_side"));
+        py::arg("low"), py::arg("high"), py::arg("points_per_side"), py::arg("averaging"));
   m.def("next_dwell", &dwellfit::PyNextDwell, py::arg("path"), py::arg("text"), py::arg("base_dir"),
         py::arg("overrides"), py::arg("state"), py::arg("limits"), py::arg("target"),
         py::arg("noise_sigma"), py::arg("segment_dwells"), py::arg("settle_time_constants"),

@@ -39,6 +39,9 @@ DEFINE_double(to, NAN, "end of the swept range.");
 DEFINE_int32(points, 400, "samples per side of each curve (folds are added exactly).");
 DEFINE_string(id, "curve", "the sweep column's value for a curve given by flags.");
 DEFINE_string(output, "", "CSV file to write (default: standard output).");
+DEFINE_string(averaging, "",
+              "the response model: first_order or second_order (default: the plan's model, "
+              "else first_order).");
 
 namespace {
 
@@ -121,8 +124,15 @@ int main(int argc, char** argv) {
     std::optional<dwellfit::DwellPlan> plan;
     if (!FLAGS_plan.empty()) plan = dwellfit::ReadDwellPlan(FLAGS_plan);
     const dwellfit::DwellPlan* plan_ptr = plan ? &*plan : nullptr;
+    dwellfit::ModelForm form = plan ? plan->form : dwellfit::ModelForm();
+    if (!FLAGS_averaging.empty() &&
+        !dwellfit::AveragingFromName(FLAGS_averaging, &form.averaging)) {
+      throw dwellfit::InputError(
+          "--averaging", 0, "",
+          "unknown averaging '" + FLAGS_averaging + "'; allowed: first_order, second_order");
+    }
     const std::vector<dwellfit::ResponseCurve> curves =
-        dwellfit::TraceCurves(Parameters(plan_ptr), Specs(plan_ptr));
+        dwellfit::TraceCurves(form, Parameters(plan_ptr), Specs(plan_ptr));
     for (const dwellfit::ResponseCurve& curve : curves) {
       // Parameters or a range far outside a structure's (1e300, 1e-300)
       // leave no finite response to trace: an error, not an empty file.

@@ -33,18 +33,36 @@ void Band(const ParameterVector& p, const ParameterMatrix& covariance, Quantity 
 
 }  // namespace
 
-double ModalFrequency(const ParameterVector& p, double a) {
+double ModalFrequency(ModelForm form, const ParameterVector& p, double a) {
   const double w = p[kNaturalFrequency];
-  const double squared = (4.0 * w * w + 3.0 * p[kAlpha] * a * a) / (4.0 + 2.0 * p[kDelta] * a * a);
+  const double mass = 4.0 + 2.0 * p[kDelta] * a * a;
+  const double stiffness = 4.0 * w * w + 3.0 * p[kAlpha] * a * a;
+  double squared = stiffness / mass;
+  // The second order's fixed point: its correction is of order a^4, small
+  // beside the first order's, so a few steps settle it.
+  for (int i = 0; form.second_order() && i < 50 && squared > 0.0; ++i) {
+    const double g = p[kAlpha] - 2.0 * p[kDelta] * squared;
+    const double d = 9.0 * squared - w * w;
+    const double next = (stiffness + 0.75 * g * g * a * a * a * a / d) / mass;
+    const bool settled = std::abs(next - squared) <= 1e-15 * std::abs(squared);
+    squared = next;
+    if (settled) break;
+  }
   return squared > 0.0 ? std::sqrt(squared) : std::numeric_limits<double>::quiet_NaN();
 }
 
-double ModalDampingRatio(const ParameterVector& p, double a) {
-  const double damping = p[kMu1] + 4.0 * p[kMu2] * a / (3.0 * kPi);
-  return damping / ((1.0 + 0.5 * p[kDelta] * a * a) * ModalFrequency(p, a));
+double ModalDampingRatio(ModelForm form, const ParameterVector& p, double a) {
+  double damping = p[kMu1] + 4.0 * p[kMu2] * a / (3.0 * kPi);
+  const double omega = ModalFrequency(form, p, a);
+  if (form.second_order()) {
+    const double w = p[kNaturalFrequency];
+    const double g = p[kAlpha] - 2.0 * p[kDelta] * omega * omega;
+    damping -= 3.0 * p[kMu2] * g * a * a * a / (5.0 * kPi * (9.0 * omega * omega - w * w));
+  }
+  return damping / ((1.0 + 0.5 * p[kDelta] * a * a) * omega);
 }
 
-ModalProperties ComputeModalProperties(const ParameterVector& parameters,
+ModalProperties ComputeModalProperties(ModelForm form, const ParameterVector& parameters,
                                        const ParameterMatrix* covariance, double a_min,
                                        double a_max, int points) {
   ModalProperties modal;
@@ -56,10 +74,12 @@ ModalProperties ComputeModalProperties(const ParameterVector& parameters,
   for (int i = 0; i < points; ++i) {
     ModalPoint point;
     point.a = a_min + (a_max - a_min) * i / (points - 1);
-    const auto omega_hz = [&point](const ParameterVector& p) {
-      return RadPerSecondToHz(ModalFrequency(p, point.a));
+    const auto omega_hz = [&point, form](const ParameterVector& p) {
+      return RadPerSecondToHz(ModalFrequency(form, p, point.a));
     };
-    const auto zeta = [&point](const ParameterVector& p) { return ModalDampingRatio(p, point.a); };
+    const auto zeta = [&point, form](const ParameterVector& p) {
+      return ModalDampingRatio(form, p, point.a);
+    };
     point.omega_hz = point.omega_hz_low = point.omega_hz_high = omega_hz(parameters);
     point.zeta = point.zeta_low = point.zeta_high = zeta(parameters);
     if (covariance != nullptr) {

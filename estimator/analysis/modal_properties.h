@@ -7,6 +7,13 @@
 //   omega(a)^2 = k / m = (4 w^2 + 3 alpha a^2) / (4 + 2 delta a^2)   (the backbone)
 //   zeta(a)    = c / (2 sqrt(k m)) = (mu1 + 4 mu2 a / (3 pi)) / ((1 + delta a^2 / 2) omega(a))
 //
+// The second order (model_form.h) adds k6 a^5 to Q and k7 a^4 to P, which hold
+// 1/D(Omega), D = 9 Omega^2 - w^2, g = alpha - 2 delta Omega^2: omega(a) is
+// then the root of Q = 0,
+//   omega^2 = (4 w^2 + 3 alpha a^2 + (3/4) g^2 a^4 / D) / (4 + 2 delta a^2),
+// by fixed-point iteration from the first order's, and zeta(a) takes
+// mu1 + 4 mu2 a / (3 pi) - 3 mu2 g a^3 / (5 pi D) at Omega = omega(a).
+//
 // The 95 % bands are linearised: q +/- 1.95996 sqrt(g^T C g), g = dq/dp by
 // central differences (relative step 1e-6), C the fit's covariance.
 #ifndef DWELLFIT_ESTIMATOR_ANALYSIS_MODAL_PROPERTIES_H_
@@ -34,12 +41,13 @@ struct ModalProperties {
 
 // omega(a) [rad/s] and zeta(a) at `parameters` (omega in rad/s); NaN where
 // the backbone has no real frequency.
-double ModalFrequency(const ParameterVector& parameters, double a);
-double ModalDampingRatio(const ParameterVector& parameters, double a);
+// `form`: the response model's.
+double ModalFrequency(ModelForm form, const ParameterVector& parameters, double a);
+double ModalDampingRatio(ModelForm form, const ParameterVector& parameters, double a);
 
 // `points` amplitudes evenly over [a_min, a_max], with bands from
 // `covariance` (physical units, omega in rad/s) when given.
-ModalProperties ComputeModalProperties(const ParameterVector& parameters,
+ModalProperties ComputeModalProperties(ModelForm form, const ParameterVector& parameters,
                                        const ParameterMatrix* covariance, double a_min,
                                        double a_max, int points = 25);
 

@@ -92,13 +92,13 @@ std::string DescribeNullSpace(const Eigen::MatrixXd& null_space, const Eigen::Ve
 // Counts the fitted dwells past the end of their branch at `estimate`
 // (RootStatus::kBranchEnd: the cost has a kink where the fold passes a
 // dwell) and warns, naming up to three.
-void WarnAboutDwellsPastTheirBranchEnd(const std::vector<const Sweep*>& fitted,
+void WarnAboutDwellsPastTheirBranchEnd(const std::vector<const Sweep*>& fitted, ModelForm form,
                                        const ParameterVector& estimate, ParameterUncertainty* u) {
   int count = 0;
   std::string examples;
   for (const Sweep* sweep : fitted) {
     for (const DwellPoint& point : sweep->points) {
-      const auto k = ResponseCoefficients<double>::FromParameters(estimate.data(),
+      const auto k = ResponseCoefficients<double>::FromParameters(form, estimate.data(),
                                                                   point.drive_frequency_rad_s);
       if (SolveStableRoot(k, point.a_base, point.branch, point.amplitude).status !=
           RootStatus::kBranchEnd) {
@@ -129,6 +129,7 @@ void WarnAboutDwellsPastTheirBranchEnd(const std::vector<const Sweep*>& fitted,
 struct PenaltyCurvature {
   const Sweep* sweep;
   const JumpBracket* jump;
+  ModelForm form;          // the fit's response model
   double distance = 0.0;   // u
   double curvature = 0.0;  // kappa
 };
@@ -152,12 +153,12 @@ ceres::CostFunction* DistanceRow(const PenaltyCurvature& term, double weight) {
   BifurcationRangeOptions reading;
   reading.exponent = 2;
   reading.weight = weight;
-  return MakeBifurcationRangePenalty(*term.sweep, *term.jump, reading);
+  return MakeBifurcationRangePenalty(term.form, *term.sweep, *term.jump, reading);
 }
 
 // Every enforced jump's distance and curvature at `estimate`, with warnings
 // for folds missing or outside their bracket.
-std::vector<PenaltyCurvature> EnforcedJumps(const std::vector<const Sweep*>& fitted,
+std::vector<PenaltyCurvature> EnforcedJumps(const std::vector<const Sweep*>& fitted, ModelForm form,
                                             const PenaltyOptions& penalties, double weight,
                                             int exponent, const ParameterVector& estimate,
                                             ParameterUncertainty* u) {
@@ -165,7 +166,7 @@ std::vector<PenaltyCurvature> EnforcedJumps(const std::vector<const Sweep*>& fit
   for (const Sweep* sweep : fitted) {
     for (const JumpBracket& jump : sweep->jumps) {
       if (!IsEnforced(penalties.bifurcation_range, *sweep, jump)) continue;
-      PenaltyCurvature term{sweep, &jump};
+      PenaltyCurvature term{sweep, &jump, form};
       const std::unique_ptr<ceres::CostFunction> row(DistanceRow(term, 1.0));
       const double* blocks[] = {estimate.data()};
       const std::string name = sweep->Name() + " " + JumpKindName(jump.kind);
@@ -345,8 +346,8 @@ BlockCovariance PenaltyCovariance(const std::vector<const Sweep*>& fitted,
   }
   const double noise_variance = data_only.noise_sigma * data_only.noise_sigma;
   if (!penalty || !(noise_variance > 0.0)) return data_only;
-  const std::vector<PenaltyCurvature> terms =
-      EnforcedJumps(fitted, options.solve.penalties, weight, exponent, estimate, u);
+  const std::vector<PenaltyCurvature> terms = EnforcedJumps(
+      fitted, options.solve.residual.form, options.solve.penalties, weight, exponent, estimate, u);
   if (terms.empty()) return data_only;
   BlockCovariance c = PenalisedCovariance(fitted, options, estimate, noise_variance, terms);
   if (!c.available) {
@@ -498,7 +499,8 @@ ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted
   const LevelNoise level =
       c.available ? AddLevelNoise(fitted, options, estimate, &c, &u) : LevelNoise();
   CopyCounts(c, &u);
-  if (c.evaluated) WarnAboutDwellsPastTheirBranchEnd(fitted, estimate, &u);
+  if (c.evaluated)
+    WarnAboutDwellsPastTheirBranchEnd(fitted, options.solve.residual.form, estimate, &u);
   if (!c.available) {
     // Entries the data cannot tell apart are named in the model's terms.
     u.message = c.null_space.cols() == 0

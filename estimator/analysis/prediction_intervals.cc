@@ -28,11 +28,11 @@ constexpr double kRelativeStep = 1e-5;
 // The values `PredictHeldOut` predicts under `p`, in its order: each
 // measured jump of a frequency sweep (Hz; NaN when the model lacks the
 // fold), then the upper-branch amplitude when `dwells` is not empty.
-std::vector<double> Quantities(const ParameterVector& p, const Sweep& sweep,
+std::vector<double> Quantities(ModelForm form, const ParameterVector& p, const Sweep& sweep,
                                const std::vector<int>& dwells) {
   std::vector<double> values;
   if (sweep.kind == SweepKind::kFrequency) {
-    for (const PredictedJump& jump : PredictJumps(p, sweep)) {
+    for (const PredictedJump& jump : PredictJumps(form, p, sweep)) {
       if (!jump.measured) continue;
       values.push_back(jump.exists ? RadPerSecondToHz(jump.control) : kNaN);
     }
@@ -41,7 +41,7 @@ std::vector<double> Quantities(const ParameterVector& p, const Sweep& sweep,
     double sum = 0.0;
     for (int i : dwells) {
       const DwellPoint& point = sweep.points[i];
-      sum += ModelAmplitudeNear(p, point.drive_frequency_rad_s, point.a_base, point.branch,
+      sum += ModelAmplitudeNear(form, p, point.drive_frequency_rad_s, point.a_base, point.branch,
                                 point.amplitude)
                  .a;
     }
@@ -53,14 +53,14 @@ std::vector<double> Quantities(const ParameterVector& p, const Sweep& sweep,
 // `scale` d Quantities / d p_j by central differences: step kRelativeStep of p_j's
 // magnitude, or 1e-6 for a parameter at 0 (delta, mu2: their effect is
 // linear near 0, so the step's size hardly matters).
-std::vector<double> Derivatives(const ParameterVector& p, int j, const Sweep& sweep,
+std::vector<double> Derivatives(ModelForm form, const ParameterVector& p, int j, const Sweep& sweep,
                                 const std::vector<int>& dwells, double scale = 1.0) {
   const double h = std::abs(p[j]) > 0.0 ? kRelativeStep * std::abs(p[j]) : 1e-6;
   ParameterVector plus = p, minus = p;
   plus[j] += h;
   minus[j] -= h;
-  std::vector<double> up = Quantities(plus, sweep, dwells);
-  const std::vector<double> down = Quantities(minus, sweep, dwells);
+  std::vector<double> up = Quantities(form, plus, sweep, dwells);
+  const std::vector<double> down = Quantities(form, minus, sweep, dwells);
   for (std::size_t q = 0; q < up.size(); ++q) up[q] = scale * (up[q] - down[q]) / (2.0 * h);
   return up;
 }
@@ -103,7 +103,7 @@ ParameterMatrix PredictionCovariance(const ParameterMatrix& data_only,
       bool finite = h_k > 0.0;
       for (int a = 0; a < k && finite; ++a) {
         // d f_k / d q_a = d_a d f_k / d p_j.
-        g[a] = Derivatives(parameters, free[a], *sweep, {}, d[a])[q];
+        g[a] = Derivatives(options.solve.residual.form, parameters, free[a], *sweep, {}, d[a])[q];
         finite = std::isfinite(g[a]);
       }
       if (!finite) continue;
@@ -172,8 +172,9 @@ std::vector<int> UpperBranchDwells(const Sweep& sweep) {
   return dwells;
 }
 
-std::vector<HeldOutPrediction> PredictHeldOut(const Sweep& sweep, const ParameterVector& parameters,
-                                              bool usable, const ParameterMatrix* covariance,
+std::vector<HeldOutPrediction> PredictHeldOut(ModelForm form, const Sweep& sweep,
+                                              const ParameterVector& parameters, bool usable,
+                                              const ParameterMatrix* covariance,
                                               const std::array<bool, kNumParameters>& fixed) {
   std::vector<HeldOutPrediction> predictions;
   const std::vector<int> dwells = UpperBranchDwells(sweep);
@@ -195,7 +196,7 @@ std::vector<HeldOutPrediction> PredictHeldOut(const Sweep& sweep, const Paramete
     for (HeldOutPrediction& p : predictions) p.predicted = p.half_width = kNaN;
     return predictions;
   }
-  const std::vector<double> values = Quantities(parameters, sweep, dwells);
+  const std::vector<double> values = Quantities(form, parameters, sweep, dwells);
   std::vector<double> variance(values.size(), 0.0);
   if (covariance != nullptr) {
     // g_q = d q / d p_j over the free parameters (column q); s_p^2 = g^T C g.
@@ -203,7 +204,7 @@ std::vector<HeldOutPrediction> PredictHeldOut(const Sweep& sweep, const Paramete
         Eigen::MatrixXd::Zero(kNumParameters, values.size());
     for (int j = 0; j < kNumParameters; ++j) {
       if (fixed[j] || (*covariance)(j, j) <= 0.0) continue;
-      const std::vector<double> derivatives = Derivatives(parameters, j, sweep, dwells);
+      const std::vector<double> derivatives = Derivatives(form, parameters, j, sweep, dwells);
       for (std::size_t q = 0; q < values.size(); ++q) {
         gradient(j, q) = std::isfinite(derivatives[q]) ? derivatives[q] : 0.0;
       }
@@ -296,8 +297,9 @@ ValidationIntervals PredictValidationIntervals(const std::vector<const Sweep*>& 
   for (const Sweep* sweep : validation) {
     const auto [it, added] = index.emplace(sweep->id, intervals.levels.size());
     if (added) intervals.levels.push_back({sweep->id, {}});
-    const std::vector<HeldOutPrediction> predicted = PredictHeldOut(
-        *sweep, parameters, usable, covariance ? &*covariance : nullptr, options.fixed);
+    const std::vector<HeldOutPrediction> predicted =
+        PredictHeldOut(options.solve.residual.form, *sweep, parameters, usable,
+                       covariance ? &*covariance : nullptr, options.fixed);
     std::vector<HeldOutPrediction>& level = intervals.levels[it->second].predictions;
     level.insert(level.end(), predicted.begin(), predicted.end());
   }

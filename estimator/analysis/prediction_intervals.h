@@ -79,9 +79,11 @@ std::vector<int> UpperBranchDwells(const Sweep& sweep);
 
 // The predictions of `sweep` under `parameters` (not `usable`: NaN), with
 // parameter_sd from `covariance` over the parameters `fixed` leaves free (0
-// without it); the rest is left for AddPredictionIntervals.
-std::vector<HeldOutPrediction> PredictHeldOut(const Sweep& sweep, const ParameterVector& parameters,
-                                              bool usable, const ParameterMatrix* covariance,
+// without it); the rest is left for AddPredictionIntervals. `form`: the
+// response model's (model_form.h).
+std::vector<HeldOutPrediction> PredictHeldOut(ModelForm form, const Sweep& sweep,
+                                              const ParameterVector& parameters, bool usable,
+                                              const ParameterMatrix* covariance,
                                               const std::array<bool, kNumParameters>& fixed);
 
 // The covariance of a fit's predictions: its dwells-alone covariance C_d

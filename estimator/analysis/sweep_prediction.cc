@@ -8,15 +8,16 @@
 namespace dwellfit {
 namespace {
 
-PredictedJump PredictJump(const ParameterVector& p, const Sweep& sweep, JumpKind kind,
-                          double guess_control) {
+PredictedJump PredictJump(ModelForm form, const ParameterVector& p, const Sweep& sweep,
+                          JumpKind kind, double guess_control) {
   PredictedJump predicted;
   predicted.kind = kind;
   const DwellPoint& first = sweep.points.front();
   const FoldPoint fold =
       sweep.kind == SweepKind::kFrequency
-          ? SolveFrequencyFold(p.data(), first.a_base, kind, guess_control, 1e-3 * guess_control)
-          : SolveAmplitudeFold(p.data(), first.drive_frequency_rad_s, kind);
+          ? SolveFrequencyFold(form, p.data(), first.a_base, kind, guess_control,
+                               1e-3 * guess_control)
+          : SolveAmplitudeFold(form, p.data(), first.drive_frequency_rad_s, kind);
   predicted.exists = fold.exists;
   predicted.control = fold.control;
   return predicted;
@@ -24,11 +25,12 @@ PredictedJump PredictJump(const ParameterVector& p, const Sweep& sweep, JumpKind
 
 }  // namespace
 
-std::vector<PredictedJump> PredictJumps(const ParameterVector& parameters, const Sweep& sweep) {
+std::vector<PredictedJump> PredictJumps(ModelForm form, const ParameterVector& parameters,
+                                        const Sweep& sweep) {
   std::vector<PredictedJump> predicted;
   if (sweep.points.empty()) return predicted;
   for (const JumpBracket& jump : sweep.jumps) {
-    PredictedJump p = PredictJump(parameters, sweep, jump.kind, jump.centre());
+    PredictedJump p = PredictJump(form, parameters, sweep, jump.kind, jump.centre());
     p.measured = true;
     p.bracket = jump;
     p.inside = p.exists && std::abs(p.control - jump.centre()) <= jump.half_width();
@@ -39,25 +41,26 @@ std::vector<PredictedJump> PredictJumps(const ParameterVector& parameters, const
         sweep.points.begin(), sweep.points.end(),
         [](const DwellPoint& a, const DwellPoint& b) { return a.amplitude < b.amplitude; });
     for (JumpKind kind : {JumpKind::kJumpUp, JumpKind::kJumpDown}) {
-      predicted.push_back(PredictJump(parameters, sweep, kind, peak->drive_frequency_rad_s));
+      predicted.push_back(PredictJump(form, parameters, sweep, kind, peak->drive_frequency_rad_s));
     }
   }
   return predicted;
 }
 
-SweepPrediction PredictSweep(const ParameterVector& parameters, const Sweep& sweep, bool fitted) {
+SweepPrediction PredictSweep(ModelForm form, const ParameterVector& parameters, const Sweep& sweep,
+                             bool fitted) {
   SweepPrediction prediction;
   prediction.sweep = &sweep;
   prediction.fitted = fitted;
   for (const DwellPoint& point : sweep.points) {
     // From the measured amplitude, as the vertical error's root solve (most
     // dwells lie near their branch: no turning points to find).
-    const StableRoot root = ModelAmplitudeNear(parameters, point.drive_frequency_rad_s,
+    const StableRoot root = ModelAmplitudeNear(form, parameters, point.drive_frequency_rad_s,
                                                point.a_base, point.branch, point.amplitude);
     prediction.model.push_back(root);
     if (root.status == RootStatus::kBranchEnd) ++prediction.points_off_branch;
   }
-  prediction.jumps = PredictJumps(parameters, sweep);
+  prediction.jumps = PredictJumps(form, parameters, sweep);
   ScoreSweepPrediction(&prediction);
   return prediction;
 }
@@ -78,15 +81,15 @@ void ScoreSweepPrediction(SweepPrediction* prediction) {
   }
 }
 
-std::vector<SweepPrediction> PredictSweeps(const ParameterVector& parameters,
+std::vector<SweepPrediction> PredictSweeps(ModelForm form, const ParameterVector& parameters,
                                            const std::vector<const Sweep*>& fitted,
                                            const std::vector<const Sweep*>& validation) {
   std::vector<SweepPrediction> predictions;
   for (const Sweep* sweep : fitted) {
-    predictions.push_back(PredictSweep(parameters, *sweep, /*fitted=*/true));
+    predictions.push_back(PredictSweep(form, parameters, *sweep, /*fitted=*/true));
   }
   for (const Sweep* sweep : validation) {
-    predictions.push_back(PredictSweep(parameters, *sweep, /*fitted=*/false));
+    predictions.push_back(PredictSweep(form, parameters, *sweep, /*fitted=*/false));
   }
   return predictions;
 }

@@ -33,7 +33,9 @@ struct PredictedJump {
 
 // For every measured jump, the model's fold nearest the bracket; without
 // one, the model's jump-up and jump-down (searched from the amplitude peak).
-std::vector<PredictedJump> PredictJumps(const ParameterVector& parameters, const Sweep& sweep);
+// `form`: the response model's (model_form.h), here and below.
+std::vector<PredictedJump> PredictJumps(ModelForm form, const ParameterVector& parameters,
+                                        const Sweep& sweep);
 
 struct SweepPrediction {
   const Sweep* sweep = nullptr;
@@ -45,13 +47,14 @@ struct SweepPrediction {
   std::vector<PredictedJump> jumps;  // the model beside each measured jump
 };
 
-SweepPrediction PredictSweep(const ParameterVector& parameters, const Sweep& sweep, bool fitted);
+SweepPrediction PredictSweep(ModelForm form, const ParameterVector& parameters, const Sweep& sweep,
+                             bool fitted);
 
 // Sets rms_error and relative_rms_error from `model` and the sweep's points
 // (after both were mapped into the measured quantity, measured_outputs.h).
 void ScoreSweepPrediction(SweepPrediction* prediction);
 
-std::vector<SweepPrediction> PredictSweeps(const ParameterVector& parameters,
+std::vector<SweepPrediction> PredictSweeps(ModelForm form, const ParameterVector& parameters,
                                            const std::vector<const Sweep*>& fitted,
                                            const std::vector<const Sweep*>& validation);
 

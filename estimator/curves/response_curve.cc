@@ -5,9 +5,11 @@
 #include <cstdint>
 #include <limits>
 
+#include "boost/math/tools/minima.hpp"
 #include "boost/math/tools/toms748_solve.hpp"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/string_printf.h"
+#include "dwellfit/residuals/model/fold_point.h"
 #include "dwellfit/residuals/model/response_model.h"
 
 namespace dwellfit {
@@ -51,8 +53,8 @@ double SideFrequency(const ParameterVector& p, double a_base, double a, int side
   return x > 0.0 ? std::sqrt(x) : kNaN;
 }
 
-double DgDa(const ParameterVector& p, double omega, double a) {
-  return ResponseCoefficients<double>::FromParameters(p.data(), omega).dG(a);
+double DgDa(ModelForm form, const ParameterVector& p, double omega, double a) {
+  return ResponseCoefficients<double>::FromParameters(form, p.data(), omega).dG(a);
 }
 
 // Solves f on [lo, hi] (a sign change) to full double precision.
@@ -69,6 +71,58 @@ double Toms748(const F& f, double lo, double hi) {
   return 0.5 * (bracket.first + bracket.second);
 }
 
+// The second order (model_form.h): 1/D depends on Omega, so G = A^2 is no
+// quadratic in Omega^2. At amplitude a, G(a; Omega) has its minimum near the
+// backbone (Brent's minimisation, Boost, over a bracket about the first
+// order's backbone, clear of the superharmonic resonance Omega = w/3); the
+// left and right roots of G(a; Omega) = A^2 lie on either side of it, each
+// solved by TOMS 748 in Omega on a bracket grown outward from the minimum.
+struct SecondOrderSlice {
+  double omega_min = kNaN;  // [rad/s] where G(a; Omega) is least
+  double excess = kNaN;     // A^2 - G(a; omega_min): >= 0 where the roots are real
+};
+
+double SliceG(const ParameterVector& p, double omega, double a) {
+  return ResponseCoefficients<double>::FromParameters(kSecondOrderForm, p.data(), omega).G(a);
+}
+
+SecondOrderSlice MakeSecondOrderSlice(const ParameterVector& p, double a_base, double a) {
+  SecondOrderSlice slice;
+  const double x = MakeQuadratic(p, a_base, a).backbone_x;
+  const double w = p[kNaturalFrequency];
+  const double centre = x > 0.0 ? std::sqrt(x) : w;
+  const double lo = std::max(0.6 * centre, 0.45 * w);
+  const double hi = std::max(1.6 * centre, 1.1 * lo);
+  std::uintmax_t iterations = 200;
+  const auto minimum = boost::math::tools::brent_find_minima(
+      [&](double omega) { return SliceG(p, omega, a); }, lo, hi, 52, iterations);
+  slice.omega_min = minimum.first;
+  slice.excess = a_base * a_base - minimum.second;
+  return slice;
+}
+
+// Omega [rad/s] on `side` (0: left, 1: right) of the second-order curve at
+// amplitude a; NaN where G(a; Omega) = A^2 has no root on that side.
+double SecondOrderSideFrequency(const ParameterVector& p, double a_base, double a, int side) {
+  const SecondOrderSlice slice = MakeSecondOrderSlice(p, a_base, a);
+  const double target = a_base * a_base;
+  // An excess rounded just below 0 at a piece's end counts as 0.
+  if (!(slice.excess >= -1e-12 * target)) return kNaN;
+  if (slice.excess <= 0.0) return slice.omega_min;
+  auto f = [&](double omega) { return SliceG(p, omega, a) - target; };
+  const double w = p[kNaturalFrequency];
+  const double direction = side == 0 ? -1.0 : 1.0;
+  double step = 1e-3 * slice.omega_min;
+  double far = slice.omega_min;
+  for (int i = 0; i < 60; ++i, step *= 2.0) {
+    far = slice.omega_min + direction * step;
+    if (side == 0 && far < 0.4 * w) return kNaN;  // towards the superharmonic resonance
+    if (f(far) > 0.0) break;
+  }
+  if (!(f(far) > 0.0)) return kNaN;
+  return Toms748(f, std::min(far, slice.omega_min), std::max(far, slice.omega_min));
+}
+
 // A point of the trace before folds and segments are assigned.
 struct RawPoint {
   double a = 0.0;
@@ -78,8 +132,9 @@ struct RawPoint {
   bool breaks = false;  // does not continue from the previous point
 };
 
-CurvePoint MakePoint(const ParameterVector& p, double omega, double a_base, double a) {
-  const auto k = ResponseCoefficients<double>::FromParameters(p.data(), omega);
+CurvePoint MakePoint(ModelForm form, const ParameterVector& p, double omega, double a_base,
+                     double a) {
+  const auto k = ResponseCoefficients<double>::FromParameters(form, p.data(), omega);
   CurvePoint point;
   point.omega_rad_s = omega;
   point.a_base = a_base;
@@ -117,10 +172,13 @@ std::vector<double> PieceSamples(double lo, double hi, int n) {
 
 // The intervals of a where the frequency quadratic has real roots, each end
 // refined on the discriminant; `lo` and `hi` bound the search.
-std::vector<std::pair<double, double>> RealPieces(const ParameterVector& p, double a_base,
-                                                  double lo, double hi) {
+std::vector<std::pair<double, double>> RealPieces(ModelForm form, const ParameterVector& p,
+                                                  double a_base, double lo, double hi) {
   constexpr int kScan = 4000;
-  auto disc = [&](double a) { return MakeQuadratic(p, a_base, a).disc; };
+  auto disc = [&](double a) {
+    return form.second_order() ? MakeSecondOrderSlice(p, a_base, a).excess
+                               : MakeQuadratic(p, a_base, a).disc;
+  };
   std::vector<std::pair<double, double>> pieces;
   double previous = lo;
   bool inside = disc(lo) >= 0.0;
@@ -146,9 +204,13 @@ bool InRange(const CurveSpec& spec, double control) {
 }
 
 // The swept control on `side` at amplitude a: Omega [rad/s] or a_base.
-double SideControl(const ParameterVector& p, const CurveSpec& spec, double a, int side) {
-  if (spec.kind == SweepKind::kFrequency) return SideFrequency(p, spec.a_base, a, side % 2);
-  const auto k = ResponseCoefficients<double>::FromParameters(p.data(), spec.omega_rad_s);
+double SideControl(ModelForm form, const ParameterVector& p, const CurveSpec& spec, double a,
+                   int side) {
+  if (spec.kind == SweepKind::kFrequency) {
+    return form.second_order() ? SecondOrderSideFrequency(p, spec.a_base, a, side % 2)
+                               : SideFrequency(p, spec.a_base, a, side % 2);
+  }
+  const auto k = ResponseCoefficients<double>::FromParameters(form, p.data(), spec.omega_rad_s);
   return std::sqrt(k.G(a));
 }
 
@@ -157,9 +219,9 @@ double SideControl(const ParameterVector& p, const CurveSpec& spec, double a, in
 // range between two samples (so the curve spans the whole range).
 class RangeWalker {
  public:
-  RangeWalker(const ParameterVector& p, const CurveSpec& spec, int side,
+  RangeWalker(ModelForm form, const ParameterVector& p, const CurveSpec& spec, int side,
               std::vector<RawPoint>* trace)
-      : p_(p), spec_(spec), side_(side), trace_(trace) {}
+      : form_(form), p_(p), spec_(spec), side_(side), trace_(trace) {}
 
   void Add(double a) {
     const double c = Control(a);
@@ -193,8 +255,9 @@ class RangeWalker {
                        frequency ? spec_.a_base : control, side_, breaks});
   }
 
-  double Control(double a) const { return SideControl(p_, spec_, a, side_); }
+  double Control(double a) const { return SideControl(form_, p_, spec_, a, side_); }
 
+  const ModelForm form_;
   const ParameterVector& p_;
   const CurveSpec& spec_;
   int side_;
@@ -203,19 +266,22 @@ class RangeWalker {
   double previous_a_ = 0.0, previous_c_ = 0.0;
 };
 
-std::vector<RawPoint> FrequencyTrace(const ParameterVector& p, const CurveSpec& spec) {
-  const auto k_lo = ResponseCoefficients<double>::FromParameters(p.data(), spec.control_low);
-  const auto k_hi = ResponseCoefficients<double>::FromParameters(p.data(), spec.control_high);
+std::vector<RawPoint> FrequencyTrace(ModelForm form, const ParameterVector& p,
+                                     const CurveSpec& spec) {
+  const auto k_lo = ResponseCoefficients<double>::FromParameters(form, p.data(), spec.control_low);
+  const auto k_hi = ResponseCoefficients<double>::FromParameters(form, p.data(), spec.control_high);
   const double a_start = 0.25 * spec.a_base / std::sqrt(std::max(k_lo.c2(), k_hi.c2()));
-  const double a_bound = FrequencyAmplitudeBound(p, spec);
+  // The bound is the first order's; P's k7 a^4 may lower P, so the second
+  // order searches further.
+  const double a_bound = (form.second_order() ? 1.5 : 1.0) * FrequencyAmplitudeBound(p, spec);
   std::vector<RawPoint> trace;
   if (!(a_start > 0.0) || !(a_bound > a_start)) return trace;
-  const auto pieces = RealPieces(p, spec.a_base, a_start, a_bound);
+  const auto pieces = RealPieces(form, p, spec.a_base, a_start, a_bound);
   for (size_t piece = 0; piece < pieces.size(); ++piece) {
     const std::vector<double> samples =
         PieceSamples(pieces[piece].first, pieces[piece].second, spec.points_per_side);
     for (int side = 0; side < 2; ++side) {
-      RangeWalker walker(p, spec, static_cast<int>(2 * piece + side), &trace);
+      RangeWalker walker(form, p, spec, static_cast<int>(2 * piece + side), &trace);
       for (size_t i = 0; i < samples.size(); ++i)
         walker.Add(side == 0 ? samples[i] : samples[samples.size() - 1 - i]);
     }
@@ -231,8 +297,9 @@ std::vector<RawPoint> FrequencyTrace(const ParameterVector& p, const CurveSpec& 
   return trace;
 }
 
-std::vector<RawPoint> AmplitudeTrace(const ParameterVector& p, const CurveSpec& spec) {
-  const auto k = ResponseCoefficients<double>::FromParameters(p.data(), spec.omega_rad_s);
+std::vector<RawPoint> AmplitudeTrace(ModelForm form, const ParameterVector& p,
+                                     const CurveSpec& spec) {
+  const auto k = ResponseCoefficients<double>::FromParameters(form, p.data(), spec.omega_rad_s);
   const TurningPoints tp = FindTurningPoints(k);
   const double target = spec.control_high * spec.control_high;
   const double seed =
@@ -241,37 +308,64 @@ std::vector<RawPoint> AmplitudeTrace(const ParameterVector& p, const CurveSpec& 
   std::vector<RawPoint> trace;
   if (!std::isfinite(a_hi)) return trace;
   const int n = 2 * spec.points_per_side;
-  RangeWalker walker(p, spec, 0, &trace);
+  RangeWalker walker(form, p, spec, 0, &trace);
   for (int i = 0; i <= n; ++i) walker.Add(a_hi * i / n);
   return trace;
 }
 
-CurvePoint PointAt(const ParameterVector& p, const CurveSpec& spec, double a, int side) {
-  const double control = SideControl(p, spec, a, side);
+CurvePoint PointAt(ModelForm form, const ParameterVector& p, const CurveSpec& spec, double a,
+                   int side) {
+  const double control = SideControl(form, p, spec, a, side);
   const bool frequency = spec.kind == SweepKind::kFrequency;
-  return MakePoint(p, frequency ? control : spec.omega_rad_s, frequency ? spec.a_base : control, a);
+  return MakePoint(form, p, frequency ? control : spec.omega_rad_s,
+                   frequency ? spec.a_base : control, a);
 }
 
 // The fold between two points of one side whose stability differs: the root
 // of dG/da(a, Omega(a)) on [a0, a1]; false when it cannot be bracketed.
-bool FindFold(const ParameterVector& p, const CurveSpec& spec, double a0, double a1, int side,
-              CurvePoint* fold) {
-  auto dg = [&](double a) { return PointAt(p, spec, a, side).dG_da; };
+bool FindFold(ModelForm form, const ParameterVector& p, const CurveSpec& spec, double a0, double a1,
+              int side, CurvePoint* fold) {
+  auto dg = [&](double a) { return PointAt(form, p, spec, a, side).dG_da; };
   const double a = Toms748(dg, std::min(a0, a1), std::max(a0, a1));
   if (!std::isfinite(a)) return false;
-  *fold = PointAt(p, spec, a, side);
-  const auto k = ResponseCoefficients<double>::FromParameters(p.data(), fold->omega_rad_s);
+  *fold = PointAt(form, p, spec, a, side);
+  const auto k = ResponseCoefficients<double>::FromParameters(form, p.data(), fold->omega_rad_s);
   fold->fold = true;
   fold->fold_kind = k.d2G(a) < 0.0 ? JumpKind::kJumpUp : JumpKind::kJumpDown;
   return std::isfinite(fold->omega_rad_s) && std::isfinite(fold->a_base);
 }
 
-void AddBackbone(const ParameterVector& p, const std::vector<RawPoint>& trace,
+// The backbone's a^2 at a fixed Omega: Q / a = k3 + k4 a^2 (+ k6 a^4) = 0, the
+// second order's root the one nearest the first order's -k3 / k4.
+double BackboneAmplitudeSquared(const ResponseCoefficients<double>& k) {
+  const double first = k.k4 != 0.0 ? -k.k3 / k.k4 : kNaN;
+  if (!k.higher_order || k.k6 == 0.0) return first;
+  const double disc = k.k4 * k.k4 - 4.0 * k.k6 * k.k3;
+  if (!(disc >= 0.0)) return kNaN;
+  const double big = -0.5 * (k.k4 + std::copysign(std::sqrt(disc), k.k4));
+  const double y1 = big / k.k6;
+  const double y2 = big != 0.0 ? k.k3 / big : y1;
+  return std::abs(y1 - first) < std::abs(y2 - first) ? y1 : y2;
+}
+
+// The backbone's Omega [rad/s] at amplitude a: the first order's sqrt(B / C),
+// the second order's the root of Q(a; Omega) = 0 within 20 % of it.
+double BackboneFrequency(ModelForm form, const ParameterVector& p, double a_base, double a) {
+  const double x = MakeQuadratic(p, a_base, a).backbone_x;
+  if (!(x > 0.0)) return kNaN;
+  if (!form.second_order()) return std::sqrt(x);
+  auto q = [&](double omega) {
+    return ResponseCoefficients<double>::FromParameters(form, p.data(), omega).Q(a);
+  };
+  return Toms748(q, 0.8 * std::sqrt(x), 1.2 * std::sqrt(x));
+}
+
+void AddBackbone(ModelForm form, const ParameterVector& p, const std::vector<RawPoint>& trace,
                  ResponseCurve* curve) {
   const CurveSpec& spec = curve->spec;
   if (spec.kind == SweepKind::kAmplitude) {
-    const auto k = ResponseCoefficients<double>::FromParameters(p.data(), spec.omega_rad_s);
-    const double a2 = k.k4 != 0.0 ? -k.k3 / k.k4 : kNaN;
+    const auto k = ResponseCoefficients<double>::FromParameters(form, p.data(), spec.omega_rad_s);
+    const double a2 = BackboneAmplitudeSquared(k);
     if (a2 > 0.0) {
       const double a = std::sqrt(a2);
       curve->backbone.push_back({spec.omega_rad_s, a, std::abs(k.P(a))});
@@ -280,10 +374,10 @@ void AddBackbone(const ParameterVector& p, const std::vector<RawPoint>& trace,
   }
   for (const RawPoint& raw : trace) {
     if (raw.side % 2 != 0) continue;
-    const double x = MakeQuadratic(p, spec.a_base, raw.a).backbone_x;
-    if (!(x > 0.0) || !InRange(spec, std::sqrt(x))) continue;
-    const auto k = ResponseCoefficients<double>::FromParameters(p.data(), std::sqrt(x));
-    curve->backbone.push_back({std::sqrt(x), raw.a, std::abs(k.P(raw.a))});
+    const double omega = BackboneFrequency(form, p, spec.a_base, raw.a);
+    if (!(omega > 0.0) || !InRange(spec, omega)) continue;
+    const auto k = ResponseCoefficients<double>::FromParameters(form, p.data(), omega);
+    curve->backbone.push_back({omega, raw.a, std::abs(k.P(raw.a))});
   }
 }
 
@@ -307,7 +401,7 @@ bool CurveSpec::IsValid(std::string* why) const {
   return true;
 }
 
-ResponseCurve TraceResponseCurve(const ParameterVector& p, const CurveSpec& spec) {
+ResponseCurve TraceResponseCurve(ModelForm form, const ParameterVector& p, const CurveSpec& spec) {
   std::string why;
   if (!spec.IsValid(&why)) throw InputError(spec.name, 0, "curve", why);
   if (!(p[kEtaE] > 0.0) || !(p[kMu1] >= 0.0) || !(p[kMu2] >= 0.0) || !(p[kMu1] + p[kMu2] > 0.0)) {
@@ -315,13 +409,14 @@ ResponseCurve TraceResponseCurve(const ParameterVector& p, const CurveSpec& spec
                      "the parameters make no response curve: it needs eta_e > 0, mu1 >= 0, "
                      "mu2 >= 0 and some damping (mu1 + mu2 > 0); give physical parameters");
   }
-  const std::vector<RawPoint> trace =
-      spec.kind == SweepKind::kFrequency ? FrequencyTrace(p, spec) : AmplitudeTrace(p, spec);
+  const std::vector<RawPoint> trace = spec.kind == SweepKind::kFrequency
+                                          ? FrequencyTrace(form, p, spec)
+                                          : AmplitudeTrace(form, p, spec);
   ResponseCurve curve;
   curve.spec = spec;
   int segment = 0;
   for (size_t i = 0; i < trace.size(); ++i) {
-    CurvePoint point = MakePoint(p, trace[i].omega, trace[i].a_base, trace[i].a);
+    CurvePoint point = MakePoint(form, p, trace[i].omega, trace[i].a_base, trace[i].a);
     point.side = trace[i].side;
     point.continues = i > 0 && !trace[i].breaks;
     if (i > 0 && !point.continues) ++segment;
@@ -329,7 +424,7 @@ ResponseCurve TraceResponseCurve(const ParameterVector& p, const CurveSpec& spec
     if (point.continues && previous->stable != point.stable) {
       CurvePoint fold;
       if (previous->side == point.side &&
-          FindFold(p, spec, previous->a, point.a, point.side, &fold)) {
+          FindFold(form, p, spec, previous->a, point.a, point.side, &fold)) {
         fold.side = point.side;
         fold.continues = true;
         fold.stable = previous->stable;
@@ -346,12 +441,12 @@ ResponseCurve TraceResponseCurve(const ParameterVector& p, const CurveSpec& spec
     point.segment = segment;
     curve.points.push_back(point);
   }
-  AddBackbone(p, trace, &curve);
+  AddBackbone(form, p, trace, &curve);
   return curve;
 }
 
-std::vector<CurveRoot> CurveAmplitudesAt(const ParameterVector& p, const ResponseCurve& curve,
-                                         double control) {
+std::vector<CurveRoot> CurveAmplitudesAt(ModelForm form, const ParameterVector& p,
+                                         const ResponseCurve& curve, double control) {
   const CurveSpec& spec = curve.spec;
   std::vector<CurveRoot> roots;
   for (size_t i = 1; i < curve.points.size(); ++i) {
@@ -366,16 +461,16 @@ std::vector<CurveRoot> CurveAmplitudesAt(const ParameterVector& p, const Respons
     bool at_point = false;
     for (const CurvePoint* point : {&a0, &a1}) {
       if (std::abs(curve.Control(*point) - control) <= 1e-13 * std::abs(control)) {
-        roots.push_back({point->a, DgDa(p, omega, point->a) > 0.0});
+        roots.push_back({point->a, DgDa(form, p, omega, point->a) > 0.0});
         at_point = true;
       }
     }
     if (at_point || c0 * c1 > 0.0) continue;
     const int side = a1.side;
-    auto f = [&](double a) { return SideControl(p, spec, a, side) - control; };
+    auto f = [&](double a) { return SideControl(form, p, spec, a, side) - control; };
     const double a = Toms748(f, std::min(a0.a, a1.a), std::max(a0.a, a1.a));
     if (!std::isfinite(a)) continue;
-    roots.push_back({a, DgDa(p, omega, a) > 0.0});
+    roots.push_back({a, DgDa(form, p, omega, a) > 0.0});
   }
   std::sort(roots.begin(), roots.end(),
             [](const CurveRoot& x, const CurveRoot& y) { return x.a < y.a; });

@@ -10,7 +10,8 @@
 // give P = Omega D(a) and Q = B(a) - C(a) x, where
 //   D = (mu1 + 4 mu2 a / (3 pi)) a / eta_e,
 //   B = a (4 w^2 + 3 alpha a^2) / (8 eta_e),   C = a (4 + 2 delta a^2) / (8 eta_e),
-// so G(a; Omega) = A^2 is the quadratic in x
+// so G(a; Omega) = A^2 is the quadratic in x (the first order; ModelForm,
+// model_form.h)
 //   C^2 x^2 + (D^2 - 2 B C) x + (B^2 - A^2) = 0,
 // with discriminant D^2 (D^2 - 4 B C) + 4 C^2 A^2 (written so, it does not
 // cancel). Each amplitude has zero, one or two drive frequencies: the left
@@ -20,6 +21,13 @@
 // changes sign along the curve (a local extremum of Omega(a)), refined by
 // Boost's TOMS 748 on dG/da(a, Omega(a)). The backbone is Q = 0:
 // Omega_bb^2 = B / C = (4 w^2 + 3 alpha a^2) / (4 + 2 delta a^2).
+//
+// The second order's k6 and k7 hold 1/D, D = 9 Omega^2 - w^2, so G = A^2 is no
+// quadratic in Omega^2: at each amplitude the minimum of G(a; Omega) over
+// Omega (Brent) parts the left root from the right one, each solved on
+// G(a; Omega) = A^2 by TOMS 748; the pieces are where that minimum is below
+// A^2. Stability, folds (dG/da = 0) and the backbone (Q = 0) are the full
+// model's. Amplitude curves are explicit in either form.
 #ifndef DWELLFIT_ESTIMATOR_CURVES_RESPONSE_CURVE_H_
 #define DWELLFIT_ESTIMATOR_CURVES_RESPONSE_CURVE_H_
 
@@ -91,12 +99,14 @@ struct CurveRoot {
 // Traces the curve of `spec` at `parameters` (omega in rad/s). Throws
 // InputError (field `curve`) for an invalid spec, or when the parameters
 // make no curve (eta_e = 0, no damping so the frequency response has no peak).
-ResponseCurve TraceResponseCurve(const ParameterVector& parameters, const CurveSpec& spec);
+// `form`: the response model's (model_form.h).
+ResponseCurve TraceResponseCurve(ModelForm form, const ParameterVector& parameters,
+                                 const CurveSpec& spec);
 
 // Every amplitude of the traced curve at one control value (Omega [rad/s] or
 // a_base) inside the curve's range, ascending: each bracketed between two
 // consecutive points of the trace and solved on the exact curve (TOMS 748 in a).
-std::vector<CurveRoot> CurveAmplitudesAt(const ParameterVector& parameters,
+std::vector<CurveRoot> CurveAmplitudesAt(ModelForm form, const ParameterVector& parameters,
                                          const ResponseCurve& curve, double control);
 
 // The curve's amplitude on `branch` at `control`: the smallest stable root

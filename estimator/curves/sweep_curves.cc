@@ -72,10 +72,10 @@ std::vector<CurveSpec> CurveSpecsForSweeps(const std::vector<const Sweep*>& swee
   return specs;
 }
 
-std::vector<ResponseCurve> TraceCurves(const ParameterVector& parameters,
+std::vector<ResponseCurve> TraceCurves(ModelForm form, const ParameterVector& parameters,
                                        const std::vector<CurveSpec>& specs) {
   std::vector<ResponseCurve> curves;
-  for (const CurveSpec& spec : specs) curves.push_back(TraceResponseCurve(parameters, spec));
+  for (const CurveSpec& spec : specs) curves.push_back(TraceResponseCurve(form, parameters, spec));
   return curves;
 }
 

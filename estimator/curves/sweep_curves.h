@@ -18,7 +18,7 @@ namespace dwellfit {
 std::vector<CurveSpec> CurveSpecsForSweeps(const std::vector<const Sweep*>& sweeps);
 
 // The traced curves of `specs` at `parameters`.
-std::vector<ResponseCurve> TraceCurves(const ParameterVector& parameters,
+std::vector<ResponseCurve> TraceCurves(ModelForm form, const ParameterVector& parameters,
                                        const std::vector<CurveSpec>& specs);
 
 // curves.csv: one row per point, in tracing order; numbers round-trip.

@@ -344,10 +344,11 @@ double LastAmplitude(const DesignStudyCase& study, const Measured& measured,
 
 // The branch the rig is on after a dwell of measured amplitude `a`: where
 // the estimate has two stable roots, the one nearer a (in ln a).
-Branch BranchOf(const ParameterVector& estimate, double f_hz, double level, double a) {
+Branch BranchOf(ModelForm form, const ParameterVector& estimate, double f_hz, double level,
+                double a) {
   const double omega = HzToRadPerSecond(f_hz);
-  const StableRoot upper = ModelAmplitude(estimate, omega, level, Branch::kUpper, 0.0);
-  const StableRoot lower = ModelAmplitude(estimate, omega, level, Branch::kLower, 0.0);
+  const StableRoot upper = ModelAmplitude(form, estimate, omega, level, Branch::kUpper, 0.0);
+  const StableRoot lower = ModelAmplitude(form, estimate, omega, level, Branch::kLower, 0.0);
   if (upper.status != RootStatus::kOnBranch || lower.status != RootStatus::kOnBranch ||
       upper.branch == Branch::kOnly || !(upper.a > lower.a * (1.0 + 1e-9)) || !(a > 0.0)) {
     return Branch::kOnly;
@@ -410,7 +411,8 @@ ArmRun RunClosedLoop(const DesignStudyCase& study, const DesignStudyOptions& opt
   design.recording_seconds = study.rig.record_periods / limits.frequency_min_hz;
   const StudyDwell& last = arm.dwells.back();
   RigState state{last.frequency_hz, last.level, Branch::kOnly};
-  state.branch = BranchOf(estimate, state.frequency_hz, state.level,
+  const ModelForm form = study.config.identification.solve.residual.form;
+  state.branch = BranchOf(form, estimate, state.frequency_hz, state.level,
                           LastAmplitude(study, measured, last.sweep));
   arm.end = "time budget spent";
   for (int n = 1; !arm.reached; ++n) {
@@ -439,7 +441,8 @@ ArmRun RunClosedLoop(const DesignStudyCase& study, const DesignStudyOptions& opt
               &measured, &arm);
     Record(FitDwells(study, measured, estimate, options.target, &estimate, &basis), &arm);
     state = {next.frequency_hz, next.level,
-             BranchOf(estimate, next.frequency_hz, next.level, LastAmplitude(study, measured, id))};
+             BranchOf(form, estimate, next.frequency_hz, next.level,
+                      LastAmplitude(study, measured, id))};
     arm.dwells.back().expected_branch = BranchName(next.branch);
     arm.dwells.back().landed_branch = BranchName(state.branch);
   }

@@ -32,7 +32,8 @@ std::vector<double> AxisGrid(double present, double step, double reach, double l
 }
 
 // The value of the target's quantity at p (kDOptimal: 0); NaN where undefined.
-double QuantityValue(const ParameterVector& p, const DesignTarget& target, double omega_ref_rad_s) {
+double QuantityValue(ModelForm form, const ParameterVector& p, const DesignTarget& target,
+                     double omega_ref_rad_s) {
   switch (target.kind) {
     case TargetKind::kDOptimal:
       return 0.0;
@@ -41,10 +42,11 @@ double QuantityValue(const ParameterVector& p, const DesignTarget& target, doubl
     case TargetKind::kEffectiveNonlinearity:
       return EffectiveNonlinearity(p, omega_ref_rad_s);
     case TargetKind::kModalFrequency:
-      return RadPerSecondToHz(ModalFrequency(p, target.amplitude));
+      return RadPerSecondToHz(ModalFrequency(form, p, target.amplitude));
     case TargetKind::kJumpFrequency: {
       const double w = p[kNaturalFrequency];
-      const FoldPoint fold = SolveFrequencyFold(p.data(), target.level, target.jump, w, 1e-3 * w);
+      const FoldPoint fold =
+          SolveFrequencyFold(form, p.data(), target.level, target.jump, w, 1e-3 * w);
       return fold.exists ? RadPerSecondToHz(fold.control) : std::nan("");
     }
   }
@@ -233,10 +235,11 @@ bool DesignOptions::IsValid(std::string* error) const {
   return false;
 }
 
-bool LandingPoint(const ParameterVector& p, Branch from, double a_now, double frequency_hz,
-                  double level, Branch* branch, double* amplitude, bool* jumps) {
+bool LandingPoint(ModelForm form, const ParameterVector& p, Branch from, double a_now,
+                  double frequency_hz, double level, Branch* branch, double* amplitude,
+                  bool* jumps) {
   const double omega = HzToRadPerSecond(frequency_hz);
-  const auto k = ResponseCoefficients<double>::FromParameters(p.data(), omega);
+  const auto k = ResponseCoefficients<double>::FromParameters(form, p.data(), omega);
   const TurningPoints tp = FindTurningPoints(k);
   const double target = level * level;
   const bool lower_reaches = tp.exist && k.G(tp.a_lower_end) > target;
@@ -251,7 +254,7 @@ bool LandingPoint(const ParameterVector& p, Branch from, double a_now, double fr
   } else if (two) {
     on = SolveStableRoot(k, level, Branch::kOnly, a_now).branch;
   }
-  const StableRoot root = ModelAmplitude(p, omega, level, on, a_now);
+  const StableRoot root = ModelAmplitude(form, p, omega, level, on, a_now);
   if (root.status != RootStatus::kOnBranch || !(root.a > 0.0)) return false;
   *branch = on;
   *amplitude = root.a;
@@ -260,9 +263,9 @@ bool LandingPoint(const ParameterVector& p, Branch from, double a_now, double fr
 
 bool ResidualGradient(const DesignBasis& basis, double frequency_hz, double level, Branch branch,
                       double amplitude, ParameterGradient* g, double* level_slope) {
-  const std::unique_ptr<ceres::CostFunction> cost(
-      VerticalErrorResidual::Create(HzToRadPerSecond(frequency_hz), level, amplitude, branch,
-                                    basis.residual.error, 1.0, basis.residual.amplitude_floor));
+  const std::unique_ptr<ceres::CostFunction> cost(VerticalErrorResidual::Create(
+      basis.residual.form, HzToRadPerSecond(frequency_hz), level, amplitude, branch,
+      basis.residual.error, 1.0, basis.residual.amplitude_floor));
   const double* parameters[] = {basis.estimate.data()};
   double residual = 0.0;
   double row[kNumParameters];
@@ -279,7 +282,7 @@ bool ResidualGradient(const DesignBasis& basis, double frequency_hz, double leve
 bool QuantityGradient(const DesignBasis& basis, const DesignTarget& target, double* value,
                       ParameterGradient* c) {
   c->setZero();
-  *value = QuantityValue(basis.estimate, target, basis.omega_ref_rad_s);
+  *value = QuantityValue(basis.residual.form, basis.estimate, target, basis.omega_ref_rad_s);
   if (!Finite(*value)) return false;
   if (target.kind == TargetKind::kDOptimal) return true;
   for (int j = 0; j < kNumParameters; ++j) {
@@ -292,8 +295,8 @@ bool QuantityGradient(const DesignBasis& basis, const DesignTarget& target, doub
     ParameterVector plus = basis.estimate, minus = basis.estimate;
     plus[j] += h;
     minus[j] -= h;
-    (*c)(j) = (QuantityValue(plus, target, basis.omega_ref_rad_s) -
-               QuantityValue(minus, target, basis.omega_ref_rad_s)) /
+    (*c)(j) = (QuantityValue(basis.residual.form, plus, target, basis.omega_ref_rad_s) -
+               QuantityValue(basis.residual.form, minus, target, basis.omega_ref_rad_s)) /
               (2.0 * h);
   }
   return c->allFinite();
@@ -312,7 +315,8 @@ bool WalkCandidate(const DesignBasis& basis, Branch from, double a_now,
     double a;
     bool jumps;
     ParameterGradient g;
-    if (!LandingPoint(basis.estimate, from, a_now, f, level, &branch, &a, &jumps) ||
+    if (!LandingPoint(basis.residual.form, basis.estimate, from, a_now, f, level, &branch, &a,
+                      &jumps) ||
         !ResidualGradient(basis, f, level, branch, a, &g, &h[k])) {
       return false;
     }
@@ -362,8 +366,9 @@ Recommendation RecommendNextDwell(const DesignBasis& given, const RigState& stat
                      "there); choose another target");
   }
   out.quantity_variance = c.dot(basis.covariance * c);
-  const StableRoot now = ModelAmplitude(basis.estimate, HzToRadPerSecond(state.frequency_hz),
-                                        state.level, state.branch, 0.0);
+  const StableRoot now =
+      ModelAmplitude(basis.residual.form, basis.estimate, HzToRadPerSecond(state.frequency_hz),
+                     state.level, state.branch, 0.0);
   out.state = state;
   out.present_amplitude = now.a;
   if (now.status == RootStatus::kFailed) {

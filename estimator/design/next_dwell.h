@@ -168,8 +168,10 @@ struct Recommendation {
 // The model's amplitude and branch after a step from the branch `from` at
 // amplitude `a_now` to (f, level) (the landing rule above); false where no
 // stable root is found. `jumps`: the branch it came from ends before (f, level).
-bool LandingPoint(const ParameterVector& p, Branch from, double a_now, double frequency_hz,
-                  double level, Branch* branch, double* amplitude, bool* jumps);
+// `form`: the response model's (model_form.h).
+bool LandingPoint(ModelForm form, const ParameterVector& p, Branch from, double a_now,
+                  double frequency_hz, double level, Branch* branch, double* amplitude,
+                  bool* jumps);
 
 // g = dr/dtheta of one dwell whose model amplitude is `amplitude` on `branch`,
 // at the estimate; zero on the fixed parameters. False where undefined.

@@ -42,11 +42,14 @@ class BatchedCostFunction : public ceres::CostFunction {
 // AutoDiffCostFunction<Functor, 1, kNumParameters> each, held side by side.
 // The parameters' terms (ParameterTerms) are formed once per batch, on Jets
 // seeded as AutoDifferentiate seeds them, so each member's residual and
-// Jacobian row are the numbers AutoDiffCostFunction gives.
+// Jacobian row are the numbers AutoDiffCostFunction gives. The terms are
+// formed in the batch's model form, which must be its members' form.
 template <typename Functor>
 class FunctorBatch : public ceres::CostFunction {
  public:
-  FunctorBatch() { mutable_parameter_block_sizes()->push_back(kNumParameters); }
+  explicit FunctorBatch(ModelForm form) : form_(form) {
+    mutable_parameter_block_sizes()->push_back(kNumParameters);
+  }
 
   // Appends a member made from `args` (Functor's constructor arguments) and
   // returns it; it lives as long as the batch, at this address.
@@ -60,7 +63,7 @@ class FunctorBatch : public ceres::CostFunction {
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
     if (jacobians == nullptr) {
-      const ParameterTerms<double> terms(parameters[0]);
+      const ParameterTerms<double> terms(form_, parameters[0]);
       for (size_t m = 0; m < functors_.size(); ++m) {
         if (!functors_[m].Evaluate(terms, residuals + m)) return false;
       }
@@ -70,7 +73,7 @@ class FunctorBatch : public ceres::CostFunction {
     using JetT = ceres::Jet<double, kNumParameters>;
     std::array<JetT, kNumParameters> point;
     ceres::internal::Make1stOrderPerturbations<Dims::Parameters>::Apply(parameters, point.data());
-    const ParameterTerms<JetT> terms(point.data());
+    const ParameterTerms<JetT> terms(form_, point.data());
     for (size_t m = 0; m < functors_.size(); ++m) {
       JetT residual;
       residual.a = ceres::kImpossibleValue;
@@ -86,6 +89,7 @@ class FunctorBatch : public ceres::CostFunction {
   }
 
  private:
+  const ModelForm form_;
   // A deque: members keep their address as more are added, and need not be
   // movable.
   std::deque<Functor> functors_;

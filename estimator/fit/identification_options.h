@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "dwellfit/residuals/functors/error_measure.h"
+#include "dwellfit/residuals/model/model_form.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 
 namespace dwellfit {
@@ -37,6 +38,9 @@ struct ResidualOptions {
   // a used sigma is weighted by Omega^p, so that it stays the error of the
   // measured quantity: Omega^p (a_i - a_model) = y_i - y_model.
   int response_power = 0;
+  // The response model every residual, penalty and prediction evaluates
+  // (config `model: {averaging: ...}`; model_form.h).
+  ModelForm form;
   bool IsValid(std::string* error) const;
 };
 

@@ -39,20 +39,21 @@ ceres::CostFunction* ProblemBuilder::MakeBatch(
     const std::vector<DwellPoint>& points, size_t first, size_t end,
     std::vector<VerticalErrorResidual*>* warm_started) const {
   if (options_.residual == ResidualKind::kAlgebraic) {
-    auto* batch = new FunctorBatch<AlgebraicResidual>();
+    auto* batch = new FunctorBatch<AlgebraicResidual>(form());
     for (size_t i = first; i < end; ++i) {
       const DwellPoint& point = points[i];
-      batch->Add(point.drive_frequency_rad_s, point.a_base, point.amplitude, options_.dwell_weight);
+      batch->Add(form(), point.drive_frequency_rad_s, point.a_base, point.amplitude,
+                 options_.dwell_weight);
     }
     return batch;
   }
   if (options_.residual == ResidualKind::kVertical) {
-    auto* batch = new FunctorBatch<VerticalErrorResidual>();
+    auto* batch = new FunctorBatch<VerticalErrorResidual>(form());
     for (size_t i = first; i < end; ++i) {
       const DwellPoint& point = points[i];
       VerticalErrorResidual* functor =
-          batch->Add(point.drive_frequency_rad_s, point.a_base, point.amplitude, point.branch,
-                     options_.residual_options.error, AmplitudeWeight(point),
+          batch->Add(form(), point.drive_frequency_rad_s, point.a_base, point.amplitude,
+                     point.branch, options_.residual_options.error, AmplitudeWeight(point),
                      options_.residual_options.amplitude_floor);
       if (warm_started != nullptr) warm_started->push_back(functor);
     }
@@ -65,23 +66,24 @@ ceres::CostFunction* ProblemBuilder::MakeBatch(
 
 ceres::CostFunction* ProblemBuilder::MakeResidual(const DwellPoint& point) const {
   if (options_.residual == ResidualKind::kAlgebraic) {
-    return AlgebraicResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
-                                     options_.dwell_weight);
+    return AlgebraicResidual::Create(form(), point.drive_frequency_rad_s, point.a_base,
+                                     point.amplitude, options_.dwell_weight);
   }
   if (options_.residual == ResidualKind::kPhaseLag) {
     // AddSweep has checked that every dwell carries its phase.
-    return PhaseLagResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
-                                    point.phase_rad.value_or(0.0), options_.dwell_weight);
+    return PhaseLagResidual::Create(form(), point.drive_frequency_rad_s, point.a_base,
+                                    point.amplitude, point.phase_rad.value_or(0.0),
+                                    options_.dwell_weight);
   }
   const double weight = AmplitudeWeight(point);
   if (options_.residual == ResidualKind::kAllRoots) {
-    return AllRootsResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
-                                    options_.residual_options.error, weight,
+    return AllRootsResidual::Create(form(), point.drive_frequency_rad_s, point.a_base,
+                                    point.amplitude, options_.residual_options.error, weight,
                                     options_.residual_options.amplitude_floor);
   }
-  return VerticalErrorResidual::Create(point.drive_frequency_rad_s, point.a_base, point.amplitude,
-                                       point.branch, options_.residual_options.error, weight,
-                                       options_.residual_options.amplitude_floor);
+  return VerticalErrorResidual::Create(
+      form(), point.drive_frequency_rad_s, point.a_base, point.amplitude, point.branch,
+      options_.residual_options.error, weight, options_.residual_options.amplitude_floor);
 }
 
 void ProblemBuilder::Add(ceres::CostFunction* cost, const ParameterLayout& layout,
@@ -140,34 +142,37 @@ double HeldControl(const Sweep& sweep, const JumpBracket& jump) {
 }
 
 // The algebraic fold condition of one measured jump (FoldConditionResidual).
-ceres::CostFunction* MakeFoldCondition(const Sweep& sweep, const JumpBracket& jump) {
+ceres::CostFunction* MakeFoldCondition(ModelForm form, const Sweep& sweep,
+                                       const JumpBracket& jump) {
   const DwellPoint& before = sweep.points[jump.index_before];
   const bool frequency = sweep.kind == SweepKind::kFrequency;
   // One jump weighs as much as its sweep's dwells together.
   const double weight = std::sqrt(static_cast<double>(sweep.points.size()));
-  return FoldConditionResidual::Create(frequency ? jump.centre() : before.drive_frequency_rad_s,
-                                       frequency ? before.a_base : jump.centre(),
-                                       jump.amplitude_before, weight);
+  return FoldConditionResidual::Create(
+      form, frequency ? jump.centre() : before.drive_frequency_rad_s,
+      frequency ? before.a_base : jump.centre(), jump.amplitude_before, weight);
 }
 
 }  // namespace
 
-ceres::CostFunction* MakeBifurcationRangePenalty(const Sweep& sweep, const JumpBracket& jump,
+ceres::CostFunction* MakeBifurcationRangePenalty(ModelForm form, const Sweep& sweep,
+                                                 const JumpBracket& jump,
                                                  const BifurcationRangeOptions& options,
                                                  ResidualKind residual) {
   if (residual == ResidualKind::kAllRoots) {
     // The all-roots method enforces the range through the roots (section 3.2.3).
-    return new RootTransitionPenalty(sweep.kind, jump.kind, HeldControl(sweep, jump),
+    return new RootTransitionPenalty(form, sweep.kind, jump.kind, HeldControl(sweep, jump),
                                      jump.control_before, jump.control_after, jump.amplitude_before,
                                      options.weight);
   }
-  return BifurcationRangePenalty::Create(sweep.kind, jump.kind, HeldControl(sweep, jump),
+  return BifurcationRangePenalty::Create(form, sweep.kind, jump.kind, HeldControl(sweep, jump),
                                          jump.control_before, jump.control_after,
                                          jump.amplitude_before, options.exponent, options.weight);
 }
 
-bool FoldExists(const Sweep& sweep, const JumpBracket& jump, const ParameterVector& p) {
-  const BifurcationRangePenalty penalty(sweep.kind, jump.kind, HeldControl(sweep, jump),
+bool FoldExists(ModelForm form, const Sweep& sweep, const JumpBracket& jump,
+                const ParameterVector& p) {
+  const BifurcationRangePenalty penalty(form, sweep.kind, jump.kind, HeldControl(sweep, jump),
                                         jump.control_before, jump.control_after,
                                         jump.amplitude_before, 2, 1.0);
   return penalty.SolveFold(p).exists;
@@ -180,8 +185,8 @@ void ProblemBuilder::AddPenalties(const Sweep& sweep, const ParameterLayout& lay
   const BifurcationRangeOptions& range = options_.penalties.bifurcation_range;
   for (const JumpBracket& jump : sweep.jumps) {
     if (!IsEnforced(range, sweep, jump)) continue;
-    Add(algebraic ? MakeFoldCondition(sweep, jump)
-                  : MakeBifurcationRangePenalty(sweep, jump, range, options_.residual),
+    Add(algebraic ? MakeFoldCondition(form(), sweep, jump)
+                  : MakeBifurcationRangePenalty(form(), sweep, jump, range, options_.residual),
         layout, problem, evaluator);
   }
   const BranchStabilityOptions& stability = options_.penalties.branch_stability;
@@ -191,8 +196,8 @@ void ProblemBuilder::AddPenalties(const Sweep& sweep, const ParameterLayout& lay
     const double lambda = stability.lambda / largest;  // [1/amplitude]
     for (const DwellPoint& point : sweep.points) {
       if (point.branch == Branch::kOnly) continue;
-      Add(BranchStabilityPenalty::Create(point.drive_frequency_rad_s, point.amplitude, point.branch,
-                                         lambda, stability.weight),
+      Add(BranchStabilityPenalty::Create(form(), point.drive_frequency_rad_s, point.amplitude,
+                                         point.branch, lambda, stability.weight),
           layout, problem, evaluator);
     }
   }

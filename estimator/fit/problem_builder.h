@@ -80,6 +80,7 @@ class ProblemBuilder {
                                  std::vector<VerticalErrorResidual*>* warm_started) const;
   void Add(ceres::CostFunction* cost, const ParameterLayout& layout, ceres::Problem* problem,
            ParallelResidualEvaluator* evaluator) const;
+  ModelForm form() const { return options_.residual_options.form; }
 
   ProblemBuilderOptions options_;
 };
@@ -91,14 +92,16 @@ JumpTarget TargetOf(const Sweep& sweep, const JumpBracket& jump);
 bool IsEnforced(const BifurcationRangeOptions& range, const Sweep& sweep, const JumpBracket& jump);
 
 // The bifurcation-range penalty of one measured jump (eq. 3.17; for the
-// all-roots residual a RootTransitionPenalty), owned by the caller.
-ceres::CostFunction* MakeBifurcationRangePenalty(const Sweep& sweep, const JumpBracket& jump,
+// all-roots residual a RootTransitionPenalty) in `form`, owned by the caller.
+ceres::CostFunction* MakeBifurcationRangePenalty(ModelForm form, const Sweep& sweep,
+                                                 const JumpBracket& jump,
                                                  const BifurcationRangeOptions& options,
                                                  ResidualKind residual = ResidualKind::kVertical);
 
 // Whether the model at `p` has the fold the jump's bifurcation-range
 // penalty measures (within a factor 2 of the bracket).
-bool FoldExists(const Sweep& sweep, const JumpBracket& jump, const ParameterVector& p);
+bool FoldExists(ModelForm form, const Sweep& sweep, const JumpBracket& jump,
+                const ParameterVector& p);
 
 }  // namespace dwellfit
 

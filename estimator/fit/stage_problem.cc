@@ -115,7 +115,9 @@ std::vector<std::string> StageProblem::MissingFolds(const BifurcationRangeOption
     const ParameterVector p = layouts_[d].Values();
     for (const Sweep* sweep : fit_.datasets[d].sweeps) {
       for (const JumpBracket& jump : sweep->jumps) {
-        if (!IsEnforced(range, *sweep, jump) || FoldExists(*sweep, jump, p)) continue;
+        if (!IsEnforced(range, *sweep, jump) ||
+            FoldExists(setup_.residuals.residual_options.form, *sweep, jump, p))
+          continue;
         const bool frequency = sweep->kind == SweepKind::kFrequency;
         const double scale = frequency ? 1.0 / kTwoPi : 1.0;
         missing.push_back(StringPrintf("%s: no %s fold near its measured bracket %.6g..%.6g %s",

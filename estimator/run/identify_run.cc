@@ -86,9 +86,10 @@ void ComputeAfterFit(const ResolvedRun& run, const IdentificationResult& result,
   sweeps.insert(sweeps.end(), run.validation.begin(), run.validation.end());
   std::size_t dwells = 0;
   for (const Sweep* sweep : sweeps) dwells += sweep->points.size();
-  const auto trace_curves = [&] { *curves = TraceRunCurves(result.parameters, sweeps); };
+  const ModelForm form = run.options.solve.residual.form;
+  const auto trace_curves = [&] { *curves = TraceRunCurves(form, result.parameters, sweeps); };
   const auto predict = [&] {
-    report->predictions = PredictSweeps(result.parameters, run.fitted, run.validation);
+    report->predictions = PredictSweeps(form, result.parameters, run.fitted, run.validation);
     *predictions_csv = ReportToPredictionsCsv(*report);
   };
   const int threads = std::min(ResolveThreadCount(run.options.solve.solver.num_threads), 2);
@@ -110,7 +111,7 @@ void ComputeAfterFit(const ResolvedRun& run, const IdentificationResult& result,
 
 // omega(a) and zeta(a) over the fitted dwells' amplitudes, with bands from
 // the fit's covariance when it has one.
-ModalProperties FitModalProperties(const std::vector<const Sweep*>& fitted,
+ModalProperties FitModalProperties(ModelForm form, const std::vector<const Sweep*>& fitted,
                                    const IdentificationReport& report) {
   double a_min = std::numeric_limits<double>::infinity(), a_max = 0.0;
   for (const Sweep* sweep : fitted) {
@@ -120,8 +121,8 @@ ModalProperties FitModalProperties(const std::vector<const Sweep*>& fitted,
     }
   }
   const ParameterUncertainty& u = report.uncertainty;
-  return ComputeModalProperties(report.result.parameters, u.available ? &u.covariance : nullptr,
-                                a_min, a_max);
+  return ComputeModalProperties(form, report.result.parameters,
+                                u.available ? &u.covariance : nullptr, a_min, a_max);
 }
 
 // result.mat from result.yaml and the CSVs among `files` (docs/matlab.md).
@@ -210,7 +211,7 @@ std::unique_ptr<IdentifyOutcome> ComputeIdentify(const IdentifyConfig& config, s
                 ResolveThreadCount(run.options.solve.solver.num_threads), &report);
   report.config_in_effect = ConfigToYaml(config, ConfigKeys::kAffectingTheResult);
   MarkUnidentifiable(&report);
-  report.modal = FitModalProperties(run.fitted, report);
+  report.modal = FitModalProperties(run.options.solve.residual.form, run.fitted, report);
   if (!config.test.IsModelForm()) {
     MapOutputsToMeasured(config.test, run.phase_offset_rad, &outcome->run.sweeps, &report,
                          &curves.curves);

@@ -193,11 +193,11 @@ std::string JumpNote(const Sweep& sweep, const PredictedJump& jump) {
                              jump.inside ? ", inside" : "");
 }
 
-RunCurves TraceRunCurves(const ParameterVector& parameters,
+RunCurves TraceRunCurves(ModelForm form, const ParameterVector& parameters,
                          const std::vector<const Sweep*>& sweeps) {
   RunCurves traced;
   try {
-    traced.curves = TraceCurves(parameters, CurveSpecsForSweeps(sweeps));
+    traced.curves = TraceCurves(form, parameters, CurveSpecsForSweeps(sweeps));
   } catch (const InputError& error) {
     // The run's status says what happened; the files it can write are
     // still written.

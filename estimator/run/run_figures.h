@@ -23,7 +23,7 @@ struct RunCurves {
   std::string csv;
   std::string warning;
 };
-RunCurves TraceRunCurves(const ParameterVector& parameters,
+RunCurves TraceRunCurves(ModelForm form, const ParameterVector& parameters,
                          const std::vector<const Sweep*>& sweeps);
 
 // Appends curves.csv and figures.gp (`curves`: TraceRunCurves of the

@@ -168,11 +168,12 @@ std::vector<double> ControlGrid(const SweepPlan& sweep, SweepDirection direction
   return grid;
 }
 
-SettledDwell SettleDwell(const ParameterVector& truth, double omega_drive_rad_s, double a_base,
-                         Branch side_before, double a_before) {
+SettledDwell SettleDwell(ModelForm form, const ParameterVector& truth, double omega_drive_rad_s,
+                         double a_base, Branch side_before, double a_before) {
   const bool from_rest = !(a_before > 0.0);
   const double guess = from_rest ? 0.0 : a_before;
-  const StableRoot lower = ModelAmplitude(truth, omega_drive_rad_s, a_base, Branch::kLower, guess);
+  const StableRoot lower =
+      ModelAmplitude(form, truth, omega_drive_rad_s, a_base, Branch::kLower, guess);
   if (lower.status == RootStatus::kFailed) {
     throw InputError("the model has no stable root at " + G12(RadPerSecondToHz(omega_drive_rad_s)) +
                      " Hz, a_base " + G12(a_base) +
@@ -183,7 +184,8 @@ SettledDwell SettleDwell(const ParameterVector& truth, double omega_drive_rad_s,
     dwell.amplitude = lower.a;
     return dwell;
   }
-  const StableRoot upper = ModelAmplitude(truth, omega_drive_rad_s, a_base, Branch::kUpper, guess);
+  const StableRoot upper =
+      ModelAmplitude(form, truth, omega_drive_rad_s, a_base, Branch::kUpper, guess);
   CHECK(upper.status != RootStatus::kFailed);
   const bool lower_exists = lower.status == RootStatus::kOnBranch;
   const bool upper_exists = upper.status == RootStatus::kOnBranch;
@@ -194,7 +196,8 @@ SettledDwell SettleDwell(const ParameterVector& truth, double omega_drive_rad_s,
     // Coming from a monotone G: stay on the side of the saddle the previous
     // amplitude was on.
     if (lower_exists && upper_exists) {
-      const auto k = ResponseCoefficients<double>::FromParameters(truth.data(), omega_drive_rad_s);
+      const auto k =
+          ResponseCoefficients<double>::FromParameters(form, truth.data(), omega_drive_rad_s);
       const double saddle = MiddleRoot(k, FindTurningPoints(k), a_base);
       side = !from_rest && a_before > saddle ? Branch::kUpper : Branch::kLower;
     } else {
@@ -211,8 +214,10 @@ SettledDwell SettleDwell(const ParameterVector& truth, double omega_drive_rad_s,
   return dwell;
 }
 
-double ResponseLag(const ParameterVector& truth, double omega_drive_rad_s, double amplitude) {
-  const auto k = ResponseCoefficients<double>::FromParameters(truth.data(), omega_drive_rad_s);
+double ResponseLag(ModelForm form, const ParameterVector& truth, double omega_drive_rad_s,
+                   double amplitude) {
+  const auto k =
+      ResponseCoefficients<double>::FromParameters(form, truth.data(), omega_drive_rad_s);
   return std::atan2(k.P(amplitude), k.Q(amplitude));
 }
 
@@ -232,7 +237,7 @@ std::vector<Sweep> SimulateDwells(const DwellPlan& plan) {
             HzToRadPerSecond(frequency ? control : sweep_plan.held_frequency_hz);
         point.a_base = frequency ? sweep_plan.held_a_base : control;
         const SettledDwell dwell =
-            SettleDwell(plan.truth, point.drive_frequency_rad_s, point.a_base, side, a);
+            SettleDwell(plan.form, plan.truth, point.drive_frequency_rad_s, point.a_base, side, a);
         if (dwell.jumped && !sweep.points.empty()) {
           JumpBracket jump;  // its controls and amplitudes once the noise is on
           jump.kind = side == Branch::kLower ? JumpKind::kJumpUp : JumpKind::kJumpDown;
@@ -243,7 +248,8 @@ std::vector<Sweep> SimulateDwells(const DwellPlan& plan) {
         a = dwell.amplitude;
         point.amplitude = dwell.amplitude;
         point.branch = dwell.branch;
-        point.phase_rad = ResponseLag(plan.truth, point.drive_frequency_rad_s, dwell.amplitude);
+        point.phase_rad =
+            ResponseLag(plan.form, plan.truth, point.drive_frequency_rad_s, dwell.amplitude);
         sweep.points.push_back(point);
       }
       sweeps.push_back(std::move(sweep));

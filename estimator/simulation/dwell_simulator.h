@@ -69,6 +69,7 @@ struct DwellNoise {
 
 struct DwellPlan {
   ParameterVector truth{};  // ParameterIndex layout; omega in rad/s
+  ModelForm form;           // the response model the dwells follow (model_form.h)
   std::vector<SweepPlan> sweeps;
   DwellNoise noise;
 
@@ -97,13 +98,14 @@ struct SettledDwell {
 // previous dwell: the branch it was on and its amplitude (a_before <= 0: no
 // previous dwell, start from rest). Throws InputError when the model has no
 // root there (parameters not finite or eta_e = 0).
-SettledDwell SettleDwell(const ParameterVector& truth, double omega_drive_rad_s, double a_base,
-                         Branch side_before, double a_before);
+SettledDwell SettleDwell(ModelForm form, const ParameterVector& truth, double omega_drive_rad_s,
+                         double a_base, Branch side_before, double a_before);
 
 // The lag gamma [rad] of the response behind the base excitation at a fixed
 // point of amplitude `amplitude` (docs/model.md, "Phase convention"):
 // gamma = atan2(P(a), Q(a)) of eqs. (3.1)-(3.2), in (0, pi) for positive damping.
-double ResponseLag(const ParameterVector& truth, double omega_drive_rad_s, double amplitude);
+double ResponseLag(ModelForm form, const ParameterVector& truth, double omega_drive_rad_s,
+                   double amplitude);
 
 // Simulates every sweep of `plan`: one Sweep per (sweep, direction), in plan
 // order, with kind, direction, id, points (drive_frequency_rad_s, a_base,

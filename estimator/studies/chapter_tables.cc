@@ -98,9 +98,11 @@ void JumpTable(const PairedFit& fit, std::ostream& out) {
         return frequency ? StringPrintf("%.3f Hz", RadPerSecondToHz(control))
                          : StringPrintf("%.4g", control);
       };
-      const std::vector<PredictedJump> with = PredictJumps(fit.with_penalty.parameters, *sweep);
+      const ModelForm form = fit.data.options.solve.residual.form;
+      const std::vector<PredictedJump> with =
+          PredictJumps(form, fit.with_penalty.parameters, *sweep);
       const std::vector<PredictedJump> without =
-          PredictJumps(fit.without_penalty.parameters, *sweep);
+          PredictJumps(form, fit.without_penalty.parameters, *sweep);
       for (size_t j = 0; j < with.size(); ++j) {
         if (!with[j].measured) continue;
         const bool counted = !fitted && frequency && with[j].kind == JumpKind::kJumpDown;

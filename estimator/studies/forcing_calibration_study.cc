@@ -20,11 +20,12 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kMissingPercent = 100.0;
 
 // The errors of `sweep`'s jump-down and upper-branch amplitude at `p`.
-HeldOutSweepErrors ErrorsOf(const Sweep& sweep, const ParameterVector& p, double scale,
-                            const std::array<bool, kNumParameters>& fixed) {
+HeldOutSweepErrors ErrorsOf(ModelForm form, const Sweep& sweep, const ParameterVector& p,
+                            double scale, const std::array<bool, kNumParameters>& fixed) {
   HeldOutSweepErrors errors{sweep.Name(), scale, kNaN, kNaN};
   const bool usable = std::isfinite(scale);
-  for (const HeldOutPrediction& prediction : PredictHeldOut(sweep, p, usable, nullptr, fixed)) {
+  for (const HeldOutPrediction& prediction :
+       PredictHeldOut(form, sweep, p, usable, nullptr, fixed)) {
     // Measured but not predicted (no fold, no usable fit): 100 %, as in method_comparison.
     const double error =
         std::isfinite(prediction.predicted) ? prediction.ErrorPercent() : kMissingPercent;
@@ -91,7 +92,8 @@ ForcingCalibrationComparison CompareForcingCalibration(
   c.with = IdentifyWithForcingCalibration(run.fitted, options, calibration, data_sigma);
   for (const Sweep* sweep : run.fitted) c.fitted.push_back(sweep->Name());
   for (const Sweep* sweep : run.validation) {
-    c.errors_without.push_back(ErrorsOf(*sweep, c.without.parameters, 1.0, options.fixed));
+    c.errors_without.push_back(
+        ErrorsOf(options.solve.residual.form, *sweep, c.without.parameters, 1.0, options.fixed));
     std::string why;
     const double scale = c.with.fit.IsSolutionUsable()
                              ? CalibrateHeldOutScale(*sweep, c.with.fit.parameters, options,
@@ -100,7 +102,7 @@ ForcingCalibrationComparison CompareForcingCalibration(
     if (!std::isfinite(scale)) c.notes.push_back(why.empty() ? c.with.fit.message : why);
     ParameterVector p = c.with.fit.parameters;
     p[CalibratedIndex(calibration.parameter)] *= std::isfinite(scale) ? scale : 1.0;
-    c.errors_with.push_back(ErrorsOf(*sweep, p, scale, options.fixed));
+    c.errors_with.push_back(ErrorsOf(options.solve.residual.form, *sweep, p, scale, options.fixed));
   }
   return c;
 }

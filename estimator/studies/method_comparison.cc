@@ -64,14 +64,14 @@ struct MethodFit {
 
 // The jump-down errors of `sweeps` at `parameters`, against the folds of
 // `truth` when given, else against the measured brackets' centres.
-std::vector<double> JumpDownErrors(const std::vector<const Sweep*>& sweeps,
+std::vector<double> JumpDownErrors(ModelForm form, const std::vector<const Sweep*>& sweeps,
                                    const ParameterVector& parameters,
                                    const std::optional<ParameterVector>& truth) {
   std::vector<double> errors;
   for (const Sweep* sweep : sweeps) {
-    const std::vector<PredictedJump> model = PredictJumps(parameters, *sweep);
+    const std::vector<PredictedJump> model = PredictJumps(form, parameters, *sweep);
     std::vector<PredictedJump> reference;
-    if (truth) reference = PredictJumps(*truth, *sweep);
+    if (truth) reference = PredictJumps(form, *truth, *sweep);
     for (size_t j = 0; j < model.size(); ++j) {
       if (!model[j].measured || model[j].kind != JumpKind::kJumpDown) continue;
       const double target = truth && j < reference.size() && reference[j].exists
@@ -103,8 +103,10 @@ MethodFit FitMethod(const IdentifyConfig& config, const std::optional<std::vecto
   const auto start = std::chrono::steady_clock::now();
   fit.result = FitRun(run).best;
   fit.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  fit.fitted_jump_down_errors = JumpDownErrors(run.fitted, fit.result.parameters, truth);
-  fit.held_out_jump_down_errors = JumpDownErrors(run.validation, fit.result.parameters, truth);
+  const ModelForm form = run.options.solve.residual.form;
+  fit.fitted_jump_down_errors = JumpDownErrors(form, run.fitted, fit.result.parameters, truth);
+  fit.held_out_jump_down_errors =
+      JumpDownErrors(form, run.validation, fit.result.parameters, truth);
   return fit;
 }
 
@@ -400,9 +402,11 @@ Comparison CompareOnTraces(const TraceCase& traces, double phase_bias_rad) {
   fit.harmonic_balance = FittedHarmonicBalance(traces);
   fit.result.parameters = fit.harmonic_balance->estimate;
   fit.result.converged = true;
-  fit.fitted_jump_down_errors = JumpDownErrors(run.fitted, fit.result.parameters, traces.truth);
+  const ModelForm form = run.options.solve.residual.form;
+  fit.fitted_jump_down_errors =
+      JumpDownErrors(form, run.fitted, fit.result.parameters, traces.truth);
   fit.held_out_jump_down_errors =
-      JumpDownErrors(run.validation, fit.result.parameters, traces.truth);
+      JumpDownErrors(form, run.validation, fit.result.parameters, traces.truth);
   c.methods.push_back({"harmonic balance (traces)", {}});
   c.fits.push_back({fit});
   // Every parameter's row: harmonic balance estimates w too.

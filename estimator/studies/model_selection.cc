@@ -61,11 +61,12 @@ struct SweepResult {
   std::vector<HeldOutPrediction> predictions;
 };
 
-SweepResult PredictHeldOutSweep(const Sweep& sweep, const ParameterVector& parameters, bool usable,
+SweepResult PredictHeldOutSweep(ModelForm form, const Sweep& sweep,
+                                const ParameterVector& parameters, bool usable,
                                 const ParameterMatrix* covariance,
                                 const std::array<bool, kNumParameters>& fixed) {
   SweepResult result;
-  result.predictions = PredictHeldOut(sweep, parameters, usable, covariance, fixed);
+  result.predictions = PredictHeldOut(form, sweep, parameters, usable, covariance, fixed);
   PredictionErrors& errors = result.errors;
   for (const HeldOutPrediction& p : result.predictions) {
     const bool known = std::isfinite(p.predicted);
@@ -80,7 +81,7 @@ SweepResult PredictHeldOutSweep(const Sweep& sweep, const ParameterVector& param
     }
   }
   const double relative_rms =
-      usable ? PredictSweep(parameters, sweep, /*fitted=*/false).relative_rms_error : kNaN;
+      usable ? PredictSweep(form, parameters, sweep, /*fitted=*/false).relative_rms_error : kNaN;
   if (std::isfinite(relative_rms)) errors.relative_rms.push_back(relative_rms);
   return result;
 }
@@ -208,6 +209,7 @@ TaskResult RunTask(const IdentifyConfig& config, const ModelVariant& variant,
   for (const SweepSelection& s : plan.training[set]) task.fit.fitted_sweeps.push_back(s.Name());
   const IdentifyConfig variant_config = VariantConfig(config, variant, plan.training[set]);
   const std::array<bool, kNumParameters>& fixed = variant_config.identification.fixed;
+  const ModelForm form = variant_config.identification.solve.residual.form;
   ResolvedRun run;
   try {
     run = ResolveRun(variant_config, sweeps);
@@ -217,7 +219,7 @@ TaskResult RunTask(const IdentifyConfig& config, const ModelVariant& variant,
     task.fit.message = std::string("could not start: ") + error.what();
     for (const Sweep& sweep : sweeps) {
       if (!Predicts(plan, set, sweep)) continue;
-      task.predicted[sweep.Name()] = PredictHeldOutSweep(sweep, {}, false, nullptr, fixed);
+      task.predicted[sweep.Name()] = PredictHeldOutSweep(form, sweep, {}, false, nullptr, fixed);
     }
     return task;
   }
@@ -239,7 +241,7 @@ TaskResult RunTask(const IdentifyConfig& config, const ModelVariant& variant,
   for (const Sweep& sweep : run.sweeps) {
     if (!Predicts(plan, set, sweep)) continue;
     task.predicted[sweep.Name()] =
-        PredictHeldOutSweep(sweep, result.parameters, result.IsSolutionUsable(),
+        PredictHeldOutSweep(form, sweep, result.parameters, result.IsSolutionUsable(),
                             covariance ? &*covariance : nullptr, fixed);
   }
   return task;

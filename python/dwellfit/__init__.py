@@ -89,14 +89,15 @@ def next_dwell(config, state, *, limits=None, target="d_optimal", noise_sigma=0.
     return _dwellfit.next_dwell(os.fspath(config), "", "", pairs, *args)
 
 
-def curve(parameters, kind, held, low, high, points_per_side=400):
+def curve(parameters, kind, held, low, high, points_per_side=400, averaging="first_order"):
     """The model's response curve at `parameters` (a dict of eta_e, mu1, mu2,
     delta, alpha, omega; omega in rad/s): kind="frequency" at base level
     `held` from `low` to `high` Hz, or kind="amplitude" at `held` Hz from
-    base level `low` to `high`. Columns: freq_hz, a_base, a, phase_rad,
-    stable, fold (NumPy arrays), in tracing order."""
+    base level `low` to `high`. `averaging`: "first_order" (the chapter's
+    model) or "second_order" (docs/model.md). Columns: freq_hz, a_base, a,
+    phase_rad, stable, fold (NumPy arrays), in tracing order."""
     return _dwellfit.curve(dict(parameters), kind, float(held), float(low), float(high),
-                           int(points_per_side))
+                           int(points_per_side), str(averaging))
 
 
 def simulate(plan):

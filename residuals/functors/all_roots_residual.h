@@ -24,18 +24,20 @@
 
 #include "ceres/autodiff_cost_function.h"
 #include "dwellfit/residuals/functors/vertical_error_residual.h"
+#include "dwellfit/residuals/model/amplitude_roots.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 #include "dwellfit/residuals/model/response_model.h"
-#include "dwellfit/residuals/model/amplitude_roots.h"
 #include "dwellfit/residuals/model/stable_root.h"
 
 namespace dwellfit {
 
 class AllRootsResidual {
  public:
-  AllRootsResidual(double drive_frequency_rad_s, double a_base, double a_measured,
+  // `form`: the response model's (model_form.h).
+  AllRootsResidual(ModelForm form, double drive_frequency_rad_s, double a_base, double a_measured,
                    ErrorMeasure error, double weight, double amplitude_floor = 0.0)
-      : drive_frequency_rad_s_(drive_frequency_rad_s),
+      : form_(form),
+        drive_frequency_rad_s_(drive_frequency_rad_s),
         a_base_(a_base),
         a_measured_(a_measured),
         error_(error),
@@ -44,7 +46,8 @@ class AllRootsResidual {
 
   template <typename T>
   bool operator()(const T* const parameters, T* residual) const {
-    const auto k = ResponseCoefficients<T>::FromParameters(parameters, drive_frequency_rad_s_);
+    const auto k =
+        ResponseCoefficients<T>::FromParameters(form_, parameters, drive_frequency_rad_s_);
     StableRoot root;
     if (!NearestStableRoot(ScalarCoefficients(k), a_base_, a_measured_, &root.a)) return false;
     root.status = RootStatus::kOnBranch;
@@ -53,15 +56,16 @@ class AllRootsResidual {
                           weight_, amplitude_floor_, residual);
   }
 
-  static ceres::CostFunction* Create(double drive_frequency_rad_s, double a_base, double a_measured,
-                                     ErrorMeasure error, double weight,
+  static ceres::CostFunction* Create(ModelForm form, double drive_frequency_rad_s, double a_base,
+                                     double a_measured, ErrorMeasure error, double weight,
                                      double amplitude_floor = 0.0) {
     return new ceres::AutoDiffCostFunction<AllRootsResidual, 1, kNumParameters>(
-        new AllRootsResidual(drive_frequency_rad_s, a_base, a_measured, error, weight,
+        new AllRootsResidual(form, drive_frequency_rad_s, a_base, a_measured, error, weight,
                              amplitude_floor));
   }
 
  private:
+  const ModelForm form_;
   const double drive_frequency_rad_s_;
   const double a_base_;
   const double a_measured_;

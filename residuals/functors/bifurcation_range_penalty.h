@@ -33,10 +33,12 @@ class BifurcationRangePenalty {
   // `control_kind`: which control the jump's bracket is in. `held`: the other
   // control (a_base for a frequency sweep, Omega [rad/s] for an amplitude
   // sweep). `a_jump`: the measured amplitude on the branch that ends.
-  BifurcationRangePenalty(SweepKind control_kind, JumpKind fold_kind, double held,
+  // `form`: the response model's (model_form.h).
+  BifurcationRangePenalty(ModelForm form, SweepKind control_kind, JumpKind fold_kind, double held,
                           double control_before, double control_after, double a_jump, int exponent,
                           double weight)
-      : control_kind_(control_kind),
+      : form_(form),
+        control_kind_(control_kind),
         fold_kind_(fold_kind),
         held_(held),
         centre_(0.5 * (control_before + control_after)),
@@ -52,8 +54,9 @@ class BifurcationRangePenalty {
     T u;
     const FoldPoint fold = SolveFold(value);
     if (fold.exists) {
-      const T c_model = control_kind_ == SweepKind::kFrequency ? LiftFrequencyFold(p, held_, fold)
-                                                               : LiftAmplitudeFold(p, held_, fold);
+      const T c_model = control_kind_ == SweepKind::kFrequency
+                            ? LiftFrequencyFold(form_, p, held_, fold)
+                            : LiftAmplitudeFold(form_, p, held_, fold);
       u = (c_model - centre_) / half_width_;
     } else {
       u = kNoFoldDistance + FoldSlack(p);
@@ -67,30 +70,31 @@ class BifurcationRangePenalty {
   // The model's fold for this bracket, in double.
   FoldPoint SolveFold(const ParameterVector& p) const {
     if (control_kind_ == SweepKind::kFrequency) {
-      return SolveFrequencyFold(p.data(), held_, fold_kind_, centre_,
+      return SolveFrequencyFold(form_, p.data(), held_, fold_kind_, centre_,
                                 std::max(half_width_, 1e-4 * centre_));
     }
-    return SolveAmplitudeFold(p.data(), held_, fold_kind_);
+    return SolveAmplitudeFold(form_, p.data(), held_, fold_kind_);
   }
 
-  static ceres::CostFunction* Create(SweepKind control_kind, JumpKind fold_kind, double held,
-                                     double control_before, double control_after, double a_jump,
-                                     int exponent, double weight) {
+  static ceres::CostFunction* Create(ModelForm form, SweepKind control_kind, JumpKind fold_kind,
+                                     double held, double control_before, double control_after,
+                                     double a_jump, int exponent, double weight) {
     return new ceres::AutoDiffCostFunction<BifurcationRangePenalty, 1, kNumParameters>(
-        new BifurcationRangePenalty(control_kind, fold_kind, held, control_before, control_after,
-                                    a_jump, exponent, weight));
+        new BifurcationRangePenalty(form, control_kind, fold_kind, held, control_before,
+                                    control_after, a_jump, exponent, weight));
   }
 
  private:
   template <typename T>
   T FoldSlack(const T* p) const {
     const double omega = control_kind_ == SweepKind::kFrequency ? centre_ : held_;
-    const auto k = ResponseCoefficients<T>::FromParameters(p, omega);
+    const auto k = ResponseCoefficients<T>::FromParameters(form_, p, omega);
     const T a(a_jump_);
     const T slack = k.h(a) / (2.0 * k.c2());
     return slack > 0.0 ? slack : T(0.0);
   }
 
+  const ModelForm form_;
   const SweepKind control_kind_;
   const JumpKind fold_kind_;
   const double held_;

@@ -28,9 +28,11 @@ namespace dwellfit {
 class BranchStabilityPenalty {
  public:
   // `branch` must be kLower or kUpper; `lambda` is Lambda [1/amplitude].
-  BranchStabilityPenalty(double drive_frequency_rad_s, double a_measured, Branch branch,
-                         double lambda, double weight)
-      : drive_frequency_rad_s_(drive_frequency_rad_s),
+  // `form`: the response model's (model_form.h).
+  BranchStabilityPenalty(ModelForm form, double drive_frequency_rad_s, double a_measured,
+                         Branch branch, double lambda, double weight)
+      : form_(form),
+        drive_frequency_rad_s_(drive_frequency_rad_s),
         a_measured_(a_measured),
         upper_(branch == Branch::kUpper),
         lambda_(lambda),
@@ -38,7 +40,7 @@ class BranchStabilityPenalty {
 
   template <typename T>
   bool operator()(const T* const p, T* residual) const {
-    const auto k = ResponseCoefficients<T>::FromParameters(p, drive_frequency_rad_s_);
+    const auto k = ResponseCoefficients<T>::FromParameters(form_, p, drive_frequency_rad_s_);
     const TurningPoints tp = FindTurningPoints(ScalarCoefficients(k));
     if (!tp.exist) {
       residual[0] = T(0.0);
@@ -51,13 +53,16 @@ class BranchStabilityPenalty {
     return true;
   }
 
-  static ceres::CostFunction* Create(double drive_frequency_rad_s, double a_measured, Branch branch,
-                                     double lambda, double weight) {
+  static ceres::CostFunction* Create(ModelForm form, double drive_frequency_rad_s,
+                                     double a_measured, Branch branch, double lambda,
+                                     double weight) {
     return new ceres::AutoDiffCostFunction<BranchStabilityPenalty, 1, kNumParameters>(
-        new BranchStabilityPenalty(drive_frequency_rad_s, a_measured, branch, lambda, weight));
+        new BranchStabilityPenalty(form, drive_frequency_rad_s, a_measured, branch, lambda,
+                                   weight));
   }
 
  private:
+  const ModelForm form_;
   const double drive_frequency_rad_s_;
   const double a_measured_;
   const bool upper_;

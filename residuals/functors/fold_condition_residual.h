@@ -32,28 +32,32 @@ namespace dwellfit {
 
 class FoldConditionResidual {
  public:
-  FoldConditionResidual(double drive_frequency_rad_s, double a_base, double a_jump, double weight)
-      : drive_frequency_rad_s_(drive_frequency_rad_s),
+  // `form`: the response model's (model_form.h).
+  FoldConditionResidual(ModelForm form, double drive_frequency_rad_s, double a_base, double a_jump,
+                        double weight)
+      : form_(form),
+        drive_frequency_rad_s_(drive_frequency_rad_s),
         a_base_squared_(a_base * a_base),
         a_jump_(a_jump),
         weight_(weight) {}
 
   template <typename T>
   bool operator()(const T* const p, T* residual) const {
-    const auto k = ResponseCoefficients<T>::FromParameters(p, drive_frequency_rad_s_);
+    const auto k = ResponseCoefficients<T>::FromParameters(form_, p, drive_frequency_rad_s_);
     const double a = a_jump_;
     residual[0] = weight_ * (k.G(a) - a_base_squared_) / a_base_squared_;
     residual[1] = weight_ * a * k.dG(a) / a_base_squared_;
     return std::isfinite(ScalarPart(residual[0])) && std::isfinite(ScalarPart(residual[1]));
   }
 
-  static ceres::CostFunction* Create(double drive_frequency_rad_s, double a_base, double a_jump,
-                                     double weight) {
+  static ceres::CostFunction* Create(ModelForm form, double drive_frequency_rad_s, double a_base,
+                                     double a_jump, double weight) {
     return new ceres::AutoDiffCostFunction<FoldConditionResidual, 2, kNumParameters>(
-        new FoldConditionResidual(drive_frequency_rad_s, a_base, a_jump, weight));
+        new FoldConditionResidual(form, drive_frequency_rad_s, a_base, a_jump, weight));
   }
 
  private:
+  const ModelForm form_;
   const double drive_frequency_rad_s_;
   const double a_base_squared_;
   const double a_jump_;

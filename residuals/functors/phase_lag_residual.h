@@ -25,9 +25,12 @@ namespace dwellfit {
 
 class PhaseLagResidual {
  public:
-  PhaseLagResidual(double drive_frequency_rad_s, double a_base, double a_measured, double phase_rad,
-                   double weight)
-      : drive_frequency_rad_s_(drive_frequency_rad_s),
+  // `form`: the response model's (model_form.h); the second order's P and Q
+  // carry k7 a^4 and k6 a^5.
+  PhaseLagResidual(ModelForm form, double drive_frequency_rad_s, double a_base, double a_measured,
+                   double phase_rad, double weight)
+      : form_(form),
+        drive_frequency_rad_s_(drive_frequency_rad_s),
         a_measured_(a_measured),
         in_quadrature_(a_base * std::sin(phase_rad)),
         in_phase_(a_base * std::cos(phase_rad)),
@@ -35,7 +38,8 @@ class PhaseLagResidual {
 
   template <typename T>
   bool operator()(const T* const parameters, T* residual) const {
-    const auto k = ResponseCoefficients<T>::FromParameters(parameters, drive_frequency_rad_s_);
+    const auto k =
+        ResponseCoefficients<T>::FromParameters(form_, parameters, drive_frequency_rad_s_);
     const double a = a_measured_;
     residual[0] = weight_ * (in_quadrature_ - k.P(a));
     residual[1] = weight_ * (in_phase_ - k.Q(a));
@@ -43,13 +47,14 @@ class PhaseLagResidual {
     return std::isfinite(ScalarPart(residual[0])) && std::isfinite(ScalarPart(residual[1]));
   }
 
-  static ceres::CostFunction* Create(double drive_frequency_rad_s, double a_base, double a_measured,
-                                     double phase_rad, double weight) {
+  static ceres::CostFunction* Create(ModelForm form, double drive_frequency_rad_s, double a_base,
+                                     double a_measured, double phase_rad, double weight) {
     return new ceres::AutoDiffCostFunction<PhaseLagResidual, 2, kNumParameters>(
-        new PhaseLagResidual(drive_frequency_rad_s, a_base, a_measured, phase_rad, weight));
+        new PhaseLagResidual(form, drive_frequency_rad_s, a_base, a_measured, phase_rad, weight));
   }
 
  private:
+  const ModelForm form_;
   const double drive_frequency_rad_s_;
   const double a_measured_;
   const double in_quadrature_;  // a_base sin(gamma)

@@ -61,10 +61,12 @@ bool AmplitudeError(double measured_term, const T& a_model, ErrorMeasure error, 
 
 class VerticalErrorResidual {
  public:
-  VerticalErrorResidual(double drive_frequency_rad_s, double a_base, double a_measured,
-                        Branch branch, ErrorMeasure error, double weight,
+  // `form`: the response model's (model_form.h).
+  VerticalErrorResidual(ModelForm form, double drive_frequency_rad_s, double a_base,
+                        double a_measured, Branch branch, ErrorMeasure error, double weight,
                         double amplitude_floor = 0.0)
-      : drive_frequency_rad_s_(drive_frequency_rad_s),
+      : form_(form),
+        drive_frequency_rad_s_(drive_frequency_rad_s),
         a_base_(a_base),
         a_measured_(a_measured),
         branch_(branch),
@@ -75,10 +77,10 @@ class VerticalErrorResidual {
 
   template <typename T>
   bool operator()(const T* const parameters, T* residual) const {
-    return Evaluate(ParameterTerms<T>(parameters), residual);
+    return Evaluate(ParameterTerms<T>(form_, parameters), residual);
   }
   // The same residual from the parameters' terms, which a batch of dwells
-  // forms once for all of them.
+  // forms once for all of them (in this functor's form).
   template <typename T>
   bool Evaluate(const ParameterTerms<T>& terms, T* residual) const {
     const auto k = ResponseCoefficients<T>::FromTerms(terms, drive_frequency_rad_s_);
@@ -103,17 +105,18 @@ class VerticalErrorResidual {
 
   // The cost function of a functor made with these arguments; `*functor`,
   // when asked, is that functor (owned by the cost function).
-  static ceres::CostFunction* Create(double drive_frequency_rad_s, double a_base, double a_measured,
-                                     Branch branch, ErrorMeasure error, double weight,
-                                     double amplitude_floor = 0.0,
+  static ceres::CostFunction* Create(ModelForm form, double drive_frequency_rad_s, double a_base,
+                                     double a_measured, Branch branch, ErrorMeasure error,
+                                     double weight, double amplitude_floor = 0.0,
                                      VerticalErrorResidual** functor = nullptr) {
-    auto* made = new VerticalErrorResidual(drive_frequency_rad_s, a_base, a_measured, branch, error,
-                                           weight, amplitude_floor);
+    auto* made = new VerticalErrorResidual(form, drive_frequency_rad_s, a_base, a_measured, branch,
+                                           error, weight, amplitude_floor);
     if (functor != nullptr) *functor = made;
     return new ceres::AutoDiffCostFunction<VerticalErrorResidual, 1, kNumParameters>(made);
   }
 
  private:
+  const ModelForm form_;
   const double drive_frequency_rad_s_;
   const double a_base_;
   const double a_measured_;

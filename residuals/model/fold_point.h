@@ -33,14 +33,28 @@
 namespace dwellfit {
 
 // dG/dOmega at fixed a, from dk1/dOmega = k1/Omega, dk2/dOmega = k2/Omega,
-// dk3/dOmega = -Omega/eta_e, dk4/dOmega = -delta Omega/(2 eta_e).
+// dk3/dOmega = -Omega/eta_e, dk4/dOmega = -delta Omega/(2 eta_e); with the
+// second order (model_form.h), g = alpha - 2 delta Omega^2, D = 9 Omega^2 - w^2,
+// dg/dOmega = -4 delta Omega, dD/dOmega = 18 Omega:
+//   dk6/dOmega = 3 (2 g g' D - g^2 D') / (32 eta_e D^2)
+//   dk7/dOmega = -(3 mu2 / (5 pi)) ((g + Omega g') D - Omega g D') / (eta_e D^2).
+// `k` are the coefficients at `omega_drive_rad_s` in the same `form`.
 template <typename T>
-T DerivativeOfGInDriveFrequency(const T* p, double omega_drive_rad_s,
+T DerivativeOfGInDriveFrequency(ModelForm form, const T* p, double omega_drive_rad_s,
                                 const ResponseCoefficients<T>& k, const T& a) {
   const double omega = omega_drive_rad_s;
   const T dp = (k.k1 + k.k2 * a) * a / omega;
   const T dq = (-omega / p[kEtaE] - p[kDelta] * omega / (2.0 * p[kEtaE]) * a * a) * a;
-  return 2.0 * (k.P(a) * dp + k.Q(a) * dq);
+  if (!form.second_order()) return 2.0 * (k.P(a) * dp + k.Q(a) * dq);
+  const T g = p[kAlpha] - 2.0 * p[kDelta] * omega * omega;
+  const T dg = -4.0 * p[kDelta] * omega;
+  const T d = 9.0 * omega * omega - p[kNaturalFrequency] * p[kNaturalFrequency];
+  const double dd = 18.0 * omega;
+  const T eta_d2 = p[kEtaE] * d * d;
+  const T dk6 = (3.0 / 32.0) * (2.0 * g * dg * d - g * g * dd) / eta_d2;
+  const T dk7 = -(3.0 / (5.0 * kPi)) * p[kMu2] * ((g + omega * dg) * d - omega * g * dd) / eta_d2;
+  const T a4 = a * a * a * a;
+  return 2.0 * (k.P(a) * (dp + dk7 * a4) + k.Q(a) * (dq + dk6 * a4 * a));
 }
 
 inline double TurningAmplitude(const TurningPoints& tp, JumpKind kind) {
@@ -54,9 +68,10 @@ struct FoldPoint {
 };
 
 // Amplitude sweep at `omega_drive_rad_s`: the a_base where `kind` ends.
-inline FoldPoint SolveAmplitudeFold(const double* p, double omega_drive_rad_s, JumpKind kind) {
+inline FoldPoint SolveAmplitudeFold(ModelForm form, const double* p, double omega_drive_rad_s,
+                                    JumpKind kind) {
   FoldPoint fold;
-  const auto k = ResponseCoefficients<double>::FromParameters(p, omega_drive_rad_s);
+  const auto k = ResponseCoefficients<double>::FromParameters(form, p, omega_drive_rad_s);
   const TurningPoints tp = FindTurningPoints(k);
   if (!tp.exist) return fold;
   fold.a = TurningAmplitude(tp, kind);
@@ -67,8 +82,8 @@ inline FoldPoint SolveAmplitudeFold(const double* p, double omega_drive_rad_s, J
 
 // Lifts an amplitude-sweep fold to scalar T.
 template <typename T>
-T LiftAmplitudeFold(const T* p, double omega_drive_rad_s, const FoldPoint& fold) {
-  const auto k = ResponseCoefficients<T>::FromParameters(p, omega_drive_rad_s);
+T LiftAmplitudeFold(ModelForm form, const T* p, double omega_drive_rad_s, const FoldPoint& fold) {
+  const auto k = ResponseCoefficients<T>::FromParameters(form, p, omega_drive_rad_s);
   const double a0 = fold.a;
   const T a = a0 - k.dG(a0) / k.d2G(a0);
   return sqrt(k.G(a));
@@ -77,18 +92,18 @@ T LiftAmplitudeFold(const T* p, double omega_drive_rad_s, const FoldPoint& fold)
 // Frequency sweep at `a_base`: the Omega [rad/s] where `kind` ends, searched
 // outward from `omega_guess` (the measured bracket's centre) in steps that
 // start at `first_step` and double, within a factor 2 of the guess.
-inline FoldPoint SolveFrequencyFold(const double* p, double a_base, JumpKind kind,
+inline FoldPoint SolveFrequencyFold(ModelForm form, const double* p, double a_base, JumpKind kind,
                                     double omega_guess, double first_step) {
   FoldPoint fold;
   const double target = a_base * a_base;
   // phi(Omega) and phi'(Omega); false where the branch has no end at Omega.
   auto phi = [&](double omega, double* value, double* slope, double* a) {
-    const auto k = ResponseCoefficients<double>::FromParameters(p, omega);
+    const auto k = ResponseCoefficients<double>::FromParameters(form, p, omega);
     const TurningPoints tp = FindTurningPoints(k);
     if (!tp.exist) return false;
     *a = TurningAmplitude(tp, kind);
     *value = k.G(*a) - target;
-    *slope = DerivativeOfGInDriveFrequency(p, omega, k, *a);
+    *slope = DerivativeOfGInDriveFrequency(form, p, omega, k, *a);
     return std::isfinite(*value) && std::isfinite(*slope);
   };
   double value0, slope0, a0;
@@ -109,7 +124,7 @@ inline FoldPoint SolveFrequencyFold(const double* p, double a_base, JumpKind kin
       double omega = omega_guess + (side == 0 ? -step : step);
       double value, slope, a;
       if (phi(omega, &value, &slope, &a)) {
-        if (!at_guess) return SolveFrequencyFold(p, a_base, kind, omega, step / 4.0);
+        if (!at_guess) return SolveFrequencyFold(form, p, a_base, kind, omega, step / 4.0);
         if (differs(value)) {
           lo = std::min(omega, last_valid[side]);
           hi = std::max(omega, last_valid[side]);
@@ -152,11 +167,11 @@ inline FoldPoint SolveFrequencyFold(const double* p, double a_base, JumpKind kin
 
 // Lifts a frequency-sweep fold to scalar T.
 template <typename T>
-T LiftFrequencyFold(const T* p, double a_base, const FoldPoint& fold) {
-  const auto k = ResponseCoefficients<T>::FromParameters(p, fold.control);
+T LiftFrequencyFold(ModelForm form, const T* p, double a_base, const FoldPoint& fold) {
+  const auto k = ResponseCoefficients<T>::FromParameters(form, p, fold.control);
   const T a(fold.a);
   return fold.control -
-         (k.G(a) - a_base * a_base) / DerivativeOfGInDriveFrequency(p, fold.control, k, a);
+         (k.G(a) - a_base * a_base) / DerivativeOfGInDriveFrequency(form, p, fold.control, k, a);
 }
 
 }  // namespace dwellfit

@@ -14,11 +14,15 @@
 // Stability: a fixed point is stable iff dG/da > 0; folds (jumps) have dG/da = 0.
 // Models beyond the chapter's add k5 a^3 and k7 a^4 to P and k6 a^5 to Q
 // (ResponseCoefficients::higher_order; docs/model.md, "Terms beyond the chapter's").
+// The second-order form (ModelForm, model_form.h) sets, with
+//   g = alpha - 2 delta Omega^2,  D = 9 Omega^2 - w^2:
+//   k6 = 3 g^2 / (32 eta_e D),   k7 = -3 mu2 Omega g / (5 pi eta_e D),   k5 = 0.
 #ifndef DWELLFIT_RESIDUALS_MODEL_RESPONSE_MODEL_H_
 #define DWELLFIT_RESIDUALS_MODEL_RESPONSE_MODEL_H_
 
 #include <array>
 
+#include "dwellfit/residuals/model/model_form.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 
 namespace dwellfit {
@@ -32,22 +36,28 @@ inline constexpr double kPi = 3.14159265358979323846264338327950;
 // the same numbers either way.
 template <typename T>
 struct ParameterTerms {
-  // `p` is the parameter block (ParameterIndex layout).
-  explicit ParameterTerms(const T* p)
-      : eta_e(p[kEtaE]),
+  // `form` chooses the terms FromTerms adds; `p` is the parameter block
+  // (ParameterIndex layout).
+  ParameterTerms(ModelForm form, const T* p)
+      : second_order(form.second_order()),
+        eta_e(p[kEtaE]),
         two_eta_e(2.0 * p[kEtaE]),
         eight_eta_e(8.0 * p[kEtaE]),
         mu1(p[kMu1]),
         scaled_mu2((4.0 / (3.0 * kPi)) * p[kMu2]),
         w_squared(p[kNaturalFrequency] * p[kNaturalFrequency]),
         three_alpha(3.0 * p[kAlpha]),
-        two_delta(2.0 * p[kDelta]) {}
+        two_delta(2.0 * p[kDelta]) {
+    if (second_order) alpha = p[kAlpha];
+  }
 
+  bool second_order;
   T eta_e, two_eta_e, eight_eta_e;
   T mu1;
   T scaled_mu2;  // 4 mu2 / (3 pi)
   T w_squared;   // w^2 [rad^2/s^2]
   T three_alpha, two_delta;
+  T alpha = T(0.0);  // read by the second order only
 };
 
 template <typename T>
@@ -63,8 +73,8 @@ struct ResponseCoefficients {
 
   // `p` is the parameter block (ParameterIndex layout); `omega_drive` in rad/s.
   template <typename D>
-  static ResponseCoefficients FromParameters(const T* p, const D& omega_drive) {
-    return FromTerms(ParameterTerms<T>(p), omega_drive);
+  static ResponseCoefficients FromParameters(ModelForm form, const T* p, const D& omega_drive) {
+    return FromTerms(ParameterTerms<T>(form, p), omega_drive);
   }
   // The coefficients (3.3), at the top of this file, from the parameters'
   // terms.
@@ -75,7 +85,21 @@ struct ResponseCoefficients {
     k.k2 = t.scaled_mu2 * omega_drive / t.eta_e;
     k.k3 = -(omega_drive * omega_drive - t.w_squared) / t.two_eta_e;
     k.k4 = (t.three_alpha - t.two_delta * omega_drive * omega_drive) / t.eight_eta_e;
+    if (t.second_order) AddSecondOrderTerms(t, omega_drive, &k);
     return k;
+  }
+  // k6 = 3 g^2 / (32 eta_e D), k7 = -3 mu2 Omega g / (5 pi eta_e D), with
+  // g = alpha - 2 delta Omega^2, D = 9 Omega^2 - w^2 (harmonic balance on
+  // harmonics 1 and 3; -3 mu2 / (5 pi) = -(9/20) (4 mu2 / (3 pi))).
+  template <typename D>
+  static void AddSecondOrderTerms(const ParameterTerms<T>& t, const D& omega_drive,
+                                  ResponseCoefficients* k) {
+    const D omega_squared = omega_drive * omega_drive;
+    const T g = t.alpha - t.two_delta * omega_squared;
+    const T eta_d = t.eta_e * (9.0 * omega_squared - t.w_squared);
+    k->k6 = (3.0 / 32.0) * g * g / eta_d;
+    k->k7 = -0.45 * t.scaled_mu2 * omega_drive * g / eta_d;
+    k->higher_order = true;
   }
 
   // The amplitude `a` is a T, or a double where it is a constant (a root

@@ -315,9 +315,9 @@ ResponseCoefficients<double> ScalarCoefficients(const ResponseCoefficients<T>& k
 }
 
 // The model's amplitude at one dwell (double precision convenience).
-inline StableRoot ModelAmplitude(const ParameterVector& p, double omega_drive_rad_s, double a_base,
-                                 Branch branch, double a_guess) {
-  const auto k = ResponseCoefficients<double>::FromParameters(p.data(), omega_drive_rad_s);
+inline StableRoot ModelAmplitude(ModelForm form, const ParameterVector& p, double omega_drive_rad_s,
+                                 double a_base, Branch branch, double a_guess) {
+  const auto k = ResponseCoefficients<double>::FromParameters(form, p.data(), omega_drive_rad_s);
   StableRoot root = SolveStableRoot(k, a_base, branch, a_guess);
   if (root.status != RootStatus::kFailed) root.a = LiftRoot(k, a_base, root);
   return root;
@@ -326,9 +326,10 @@ inline StableRoot ModelAmplitude(const ParameterVector& p, double omega_drive_ra
 // ModelAmplitude through SolveStableRootNear: the same amplitude, faster
 // where `a_guess` (a measured amplitude) lies near its branch; the returned
 // `branch` is the requested one (see SolveStableRootNear).
-inline StableRoot ModelAmplitudeNear(const ParameterVector& p, double omega_drive_rad_s,
-                                     double a_base, Branch branch, double a_guess) {
-  const auto k = ResponseCoefficients<double>::FromParameters(p.data(), omega_drive_rad_s);
+inline StableRoot ModelAmplitudeNear(ModelForm form, const ParameterVector& p,
+                                     double omega_drive_rad_s, double a_base, Branch branch,
+                                     double a_guess) {
+  const auto k = ResponseCoefficients<double>::FromParameters(form, p.data(), omega_drive_rad_s);
   StableRoot root = SolveStableRootNear(k, a_base, branch, a_guess);
   if (root.status != RootStatus::kFailed) root.a = LiftRoot(k, a_base, root);
   return root;

@@ -332,7 +332,8 @@ Eigen::VectorXd DistanceGradient(const Sweep& sweep, const JumpBracket& jump,
   BifurcationRangeOptions reading;
   reading.exponent = 2;
   reading.weight = 1.0;
-  const std::unique_ptr<ceres::CostFunction> row(MakeBifurcationRangePenalty(sweep, jump, reading));
+  const std::unique_ptr<ceres::CostFunction> row(
+      MakeBifurcationRangePenalty(kFirstOrderForm, sweep, jump, reading));
   auto evaluate = [&row](const ParameterVector& at) {
     const double* blocks[] = {at.data()};
     double u = 0.0;

@@ -49,14 +49,14 @@ const Sweep& Find(const std::vector<Sweep>& sweeps, SweepDirection direction) {
 // jump's fold from PredictJumps, and the mean of PredictSweep's model
 // amplitudes over the upper-branch dwells.
 double JumpHz(const ParameterVector& p, const Sweep& sweep) {
-  for (const PredictedJump& jump : PredictJumps(p, sweep)) {
+  for (const PredictedJump& jump : PredictJumps(kFirstOrderForm, p, sweep)) {
     if (jump.measured) return jump.exists ? RadPerSecondToHz(jump.control) : kNaN;
   }
   return kNaN;
 }
 
 double UpperBranchAmplitude(const ParameterVector& p, const Sweep& sweep) {
-  const SweepPrediction prediction = PredictSweep(p, sweep, /*fitted=*/false);
+  const SweepPrediction prediction = PredictSweep(kFirstOrderForm, p, sweep, /*fitted=*/false);
   const std::vector<int> dwells = UpperBranchDwells(sweep);
   double sum = 0.0;
   for (int i : dwells) sum += prediction.model[i].a;
@@ -95,7 +95,8 @@ TEST(PredictionIntervals, DeltaMethodMatchesAnIndependentFiniteDifference) {
   c(kMu1, kAlpha) = c(kAlpha, kMu1) = 0.5 * sd[kMu1] * sd[kAlpha];
   const std::array<bool, kNumParameters> fixed{};
 
-  const std::vector<HeldOutPrediction> on_up = PredictHeldOut(up, p, true, &c, fixed);
+  const std::vector<HeldOutPrediction> on_up =
+      PredictHeldOut(kFirstOrderForm, up, p, true, &c, fixed);
   ASSERT_EQ(on_up.size(), 2u);
   EXPECT_EQ(on_up[0].quantity, HeldOutQuantity::kJumpDown);
   EXPECT_EQ(on_up[1].quantity, HeldOutQuantity::kUpperBranchAmplitude);
@@ -109,7 +110,8 @@ TEST(PredictionIntervals, DeltaMethodMatchesAnIndependentFiniteDifference) {
   EXPECT_NEAR(on_up[0].parameter_sd, jump_down_sd, 1e-3 * jump_down_sd);
   EXPECT_NEAR(on_up[1].parameter_sd, amplitude_sd, 1e-3 * amplitude_sd);
 
-  const std::vector<HeldOutPrediction> on_down = PredictHeldOut(down, p, true, &c, fixed);
+  const std::vector<HeldOutPrediction> on_down =
+      PredictHeldOut(kFirstOrderForm, down, p, true, &c, fixed);
   ASSERT_EQ(on_down.size(), 1u);
   EXPECT_EQ(on_down[0].quantity, HeldOutQuantity::kJumpUp);
   const double jump_up_sd =
@@ -122,7 +124,7 @@ TEST(PredictionIntervals, DeltaMethodMatchesAnIndependentFiniteDifference) {
   ParameterMatrix without_alpha = c;
   without_alpha.row(kAlpha).setZero();
   without_alpha.col(kAlpha).setZero();
-  EXPECT_NEAR(PredictHeldOut(up, p, true, &c, alpha_fixed)[0].parameter_sd,
+  EXPECT_NEAR(PredictHeldOut(kFirstOrderForm, up, p, true, &c, alpha_fixed)[0].parameter_sd,
               DeltaMethodSd(p, without_alpha, jump_down), 1e-3 * jump_down_sd);
 }
 

@@ -21,12 +21,13 @@ namespace {
 void ExpectTheFullSolversRoots(const ResolvedRun& run, const ParameterVector& parameters,
                                int* on_branch, int* branch_end) {
   for (const Sweep& sweep : run.sweeps) {
-    const SweepPrediction prediction = PredictSweep(parameters, sweep, false);
+    const SweepPrediction prediction = PredictSweep(kFirstOrderForm, parameters, sweep, false);
     ASSERT_EQ(prediction.model.size(), sweep.points.size());
     for (size_t i = 0; i < sweep.points.size(); ++i) {
       const DwellPoint& point = sweep.points[i];
-      const StableRoot full = ModelAmplitude(parameters, point.drive_frequency_rad_s, point.a_base,
-                                             point.branch, point.amplitude);
+      const StableRoot full =
+          ModelAmplitude(kFirstOrderForm, parameters, point.drive_frequency_rad_s, point.a_base,
+                         point.branch, point.amplitude);
       const StableRoot& near = prediction.model[i];
       ASSERT_EQ(near.status, full.status) << sweep.Name() << " dwell " << i;
       EXPECT_NEAR(near.a, full.a, 1e-14 * full.a) << sweep.Name() << " dwell " << i;
@@ -64,7 +65,7 @@ TEST(PredictSweep, IsTheFullRootSolveOnTheThesisSweepsAtTheTruth) {
   // at its measured amplitude.
   EXPECT_EQ(branch_end, 0);
   for (const Sweep& sweep : run.sweeps) {
-    const SweepPrediction prediction = PredictSweep(truth, sweep, true);
+    const SweepPrediction prediction = PredictSweep(kFirstOrderForm, truth, sweep, true);
     for (size_t i = 0; i < sweep.points.size(); ++i) {
       EXPECT_NEAR(prediction.model[i].a, sweep.points[i].amplitude,
                   1e-9 * sweep.points[i].amplitude);

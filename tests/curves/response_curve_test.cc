@@ -39,26 +39,27 @@ int CompareAtEveryDwell(const ParameterVector& p, const ResolvedRun& run, int* d
       ADD_FAILURE() << "no curve for " << sweep.Name();
       continue;
     }
-    const ResponseCurve curve = TraceResponseCurve(p, *spec);
+    const ResponseCurve curve = TraceResponseCurve(kFirstOrderForm, p, *spec);
     for (const DwellPoint& point : sweep.points) {
       ++*dwells;
       const double held =
           sweep.kind == SweepKind::kFrequency ? point.a_base : point.drive_frequency_rad_s;
       EXPECT_EQ(held, sweep.kind == SweepKind::kFrequency ? spec->a_base : spec->omega_rad_s);
-      StableRoot root = ModelAmplitude(p, point.drive_frequency_rad_s, point.a_base,
-                                       point.branch, point.amplitude);
+      StableRoot root = ModelAmplitude(kFirstOrderForm, p, point.drive_frequency_rad_s,
+                                       point.a_base, point.branch, point.amplitude);
       Branch branch = point.branch;
       if (root.status == RootStatus::kBranchEnd) {
         branch = Branch::kOnly;
-        root = ModelAmplitude(p, point.drive_frequency_rad_s, point.a_base, branch,
+        root = ModelAmplitude(kFirstOrderForm, p, point.drive_frequency_rad_s, point.a_base, branch,
                               point.amplitude);
         EXPECT_EQ(root.status, RootStatus::kOnBranch) << sweep.Name() << " " << point.source_line;
         if (past_end != nullptr) ++*past_end;
       }
-      const std::vector<CurveRoot> roots = CurveAmplitudesAt(p, curve, sweep.Control(point));
+      const std::vector<CurveRoot> roots =
+          CurveAmplitudesAt(kFirstOrderForm, p, curve, sweep.Control(point));
       const double a = CurveAmplitudeOnBranch(roots, branch, point.amplitude);
-      EXPECT_NEAR(a, root.a, 1e-9 * root.a) << sweep.Name() << " line " << point.source_line
-                                            << " branch " << BranchName(branch);
+      EXPECT_NEAR(a, root.a, 1e-9 * root.a)
+          << sweep.Name() << " line " << point.source_line << " branch " << BranchName(branch);
       if (branch == point.branch) ++compared;
     }
   }
@@ -90,12 +91,13 @@ TEST(ResponseCurve, AgreesWithTheRootSolverAtEveryClampedBeamDwell) {
 
 // The curve's folds of each kind are where the fold solver puts them.
 void ExpectFoldsAsFoldSolver(const ParameterVector& p, const CurveSpec& spec) {
-  const ResponseCurve curve = TraceResponseCurve(p, spec);
+  const ResponseCurve curve = TraceResponseCurve(kFirstOrderForm, p, spec);
   for (const CurveFold& fold : curve.folds) {
-    const FoldPoint solved = spec.kind == SweepKind::kFrequency
-                                 ? SolveFrequencyFold(p.data(), spec.a_base, fold.kind,
-                                                      fold.control, 1e-4 * fold.control)
-                                 : SolveAmplitudeFold(p.data(), spec.omega_rad_s, fold.kind);
+    const FoldPoint solved =
+        spec.kind == SweepKind::kFrequency
+            ? SolveFrequencyFold(kFirstOrderForm, p.data(), spec.a_base, fold.kind, fold.control,
+                                 1e-4 * fold.control)
+            : SolveAmplitudeFold(kFirstOrderForm, p.data(), spec.omega_rad_s, fold.kind);
     ASSERT_TRUE(solved.exists) << spec.name;
     EXPECT_NEAR(fold.control, solved.control, 1e-9 * solved.control) << spec.name;
     EXPECT_NEAR(fold.a, solved.a, 1e-6 * solved.a) << spec.name;
@@ -109,7 +111,7 @@ TEST(ResponseCurve, FoldsOfTheThesisSweepsAreTheFoldSolvers) {
   frequency.a_base = 0.01;
   frequency.control_low = HzToRadPerSecond(38.0);
   frequency.control_high = HzToRadPerSecond(46.0);
-  const ResponseCurve curve = TraceResponseCurve(p, frequency);
+  const ResponseCurve curve = TraceResponseCurve(kFirstOrderForm, p, frequency);
   ASSERT_EQ(curve.folds.size(), 2u);
   // Traced from low frequencies: up the left side over the peak, the
   // jump-down fold, then back along the unstable branch to the jump-up fold.
@@ -126,7 +128,7 @@ TEST(ResponseCurve, FoldsOfTheThesisSweepsAreTheFoldSolvers) {
   amplitude.omega_rad_s = HzToRadPerSecond(41.5);
   amplitude.control_low = 0.002;
   amplitude.control_high = 0.05;
-  const ResponseCurve a_curve = TraceResponseCurve(p, amplitude);
+  const ResponseCurve a_curve = TraceResponseCurve(kFirstOrderForm, p, amplitude);
   ASSERT_EQ(a_curve.folds.size(), 2u);
   EXPECT_EQ(a_curve.folds[0].kind, JumpKind::kJumpUp);
   EXPECT_NEAR(a_curve.folds[0].control, 0.035358, 1e-6);
@@ -143,7 +145,7 @@ TEST(ResponseCurve, FoldsOfTheClampedBeamSweepsAreTheFoldSolvers) {
   for (const Sweep& sweep : run.sweeps) sweeps.push_back(&sweep);
   int folds = 0;
   for (const CurveSpec& spec : CurveSpecsForSweeps(sweeps)) {
-    folds += static_cast<int>(TraceResponseCurve(p, spec).folds.size());
+    folds += static_cast<int>(TraceResponseCurve(kFirstOrderForm, p, spec).folds.size());
     ExpectFoldsAsFoldSolver(p, spec);
   }
   EXPECT_GT(folds, 0);
@@ -155,11 +157,12 @@ TEST(ResponseCurve, StabilityFollowsTheSignOfDgDaAndFoldsSplitSegments) {
   spec.a_base = 0.01;
   spec.control_low = HzToRadPerSecond(38.0);
   spec.control_high = HzToRadPerSecond(46.0);
-  const ResponseCurve curve = TraceResponseCurve(Thesis(), spec);
+  const ResponseCurve curve = TraceResponseCurve(kFirstOrderForm, Thesis(), spec);
   int unstable = 0;
   for (size_t i = 0; i < curve.points.size(); ++i) {
     const CurvePoint& point = curve.points[i];
-    const auto k = ResponseCoefficients<double>::FromParameters(Thesis().data(), point.omega_rad_s);
+    const auto k = ResponseCoefficients<double>::FromParameters(kFirstOrderForm, Thesis().data(),
+                                                                point.omega_rad_s);
     // Every point lies on G(a; Omega) = a_base^2.
     EXPECT_NEAR(k.G(point.a), 1e-4, 1e-12) << i;
     if (!point.fold) EXPECT_EQ(point.stable, k.dG(point.a) > 0.0) << i;
@@ -170,7 +173,8 @@ TEST(ResponseCurve, StabilityFollowsTheSignOfDgDaAndFoldsSplitSegments) {
   // The backbone lies where Q = 0.
   ASSERT_FALSE(curve.backbone.empty());
   for (const BackbonePoint& b : curve.backbone) {
-    const auto k = ResponseCoefficients<double>::FromParameters(Thesis().data(), b.omega_rad_s);
+    const auto k = ResponseCoefficients<double>::FromParameters(kFirstOrderForm, Thesis().data(),
+                                                                b.omega_rad_s);
     EXPECT_NEAR(k.Q(b.a), 0.0, 1e-12 * std::abs(k.k3 * b.a));
   }
 }
@@ -183,11 +187,11 @@ TEST(ResponseCurve, RejectsAnInvalidSpecAndParametersWithoutACurve) {
   spec.control_high = 1.0;
   std::string why;
   EXPECT_FALSE(spec.IsValid(&why));
-  EXPECT_THROW(TraceResponseCurve(Thesis(), spec), InputError);
+  EXPECT_THROW(TraceResponseCurve(kFirstOrderForm, Thesis(), spec), InputError);
   spec.control_high = 300.0;
   ParameterVector p = Thesis();
   p[kMu1] = p[kMu2] = 0.0;
-  EXPECT_THROW(TraceResponseCurve(p, spec), InputError);
+  EXPECT_THROW(TraceResponseCurve(kFirstOrderForm, p, spec), InputError);
 }
 
 }  // namespace

@@ -101,19 +101,23 @@ TEST(LandingPoint, StaysOnItsBranchInTheHysteresisRangeAndJumpsPastItsEnd) {
   Branch branch;
   double a_upper, a_lower, a_past;
   bool jumps;
-  ASSERT_TRUE(LandingPoint(p, Branch::kUpper, 0.0039, 42.0, 0.01, &branch, &a_upper, &jumps));
+  ASSERT_TRUE(LandingPoint(kFirstOrderForm, p, Branch::kUpper, 0.0039, 42.0, 0.01, &branch,
+                           &a_upper, &jumps));
   EXPECT_EQ(branch, Branch::kUpper);
   EXPECT_FALSE(jumps);
   EXPECT_NEAR(a_upper, 0.0045099, 1e-7);
-  ASSERT_TRUE(LandingPoint(p, Branch::kLower, 0.0005, 42.0, 0.01, &branch, &a_lower, &jumps));
+  ASSERT_TRUE(LandingPoint(kFirstOrderForm, p, Branch::kLower, 0.0005, 42.0, 0.01, &branch,
+                           &a_lower, &jumps));
   EXPECT_EQ(branch, Branch::kLower);
   EXPECT_NEAR(a_lower, 0.00031036, 1e-8);
-  ASSERT_TRUE(LandingPoint(p, Branch::kUpper, 0.0039, 43.0, 0.01, &branch, &a_past, &jumps));
+  ASSERT_TRUE(LandingPoint(kFirstOrderForm, p, Branch::kUpper, 0.0039, 43.0, 0.01, &branch, &a_past,
+                           &jumps));
   EXPECT_EQ(branch, Branch::kOnly);
   EXPECT_TRUE(jumps);
   EXPECT_NEAR(a_past, 0.00020371, 1e-8);
   // Coming from a single-valued state: the stable root nearer the present amplitude.
-  ASSERT_TRUE(LandingPoint(p, Branch::kOnly, 0.0002, 42.0, 0.01, &branch, &a_lower, &jumps));
+  ASSERT_TRUE(LandingPoint(kFirstOrderForm, p, Branch::kOnly, 0.0002, 42.0, 0.01, &branch, &a_lower,
+                           &jumps));
   EXPECT_EQ(branch, Branch::kLower);
 }
 
@@ -289,9 +293,9 @@ TEST(RecommendNextDwell, TheLevelsNoiseEntersEachCandidatesNoise) {
   for (const Candidate& c : noisy.ranked) {
     if (c.dwells != 1) continue;
     const auto residual = [&](double level) {
-      const std::unique_ptr<ceres::CostFunction> cost(
-          VerticalErrorResidual::Create(kTwoPi * c.frequency_hz, level, c.amplitude, c.branch,
-                                        basis.residual.error, 1.0, basis.residual.amplitude_floor));
+      const std::unique_ptr<ceres::CostFunction> cost(VerticalErrorResidual::Create(
+          kFirstOrderForm, kTwoPi * c.frequency_hz, level, c.amplitude, c.branch,
+          basis.residual.error, 1.0, basis.residual.amplitude_floor));
       const double* parameters[] = {basis.estimate.data()};
       double r = 0.0;
       EXPECT_TRUE(cost->Evaluate(parameters, &r, nullptr));

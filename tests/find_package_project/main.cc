@@ -20,9 +20,10 @@ int main() {
     dwellfit::DwellPoint d;
     d.drive_frequency_rad_s = dwellfit::HzToRadPerSecond(hz);
     d.a_base = 0.005;
-    d.amplitude = dwellfit::ModelAmplitude(truth, d.drive_frequency_rad_s, d.a_base,
-                                           dwellfit::Branch::kOnly, 1e-3)
-                      .a;
+    d.amplitude =
+        dwellfit::ModelAmplitude(dwellfit::kFirstOrderForm, truth, d.drive_frequency_rad_s,
+                                 d.a_base, dwellfit::Branch::kOnly, 1e-3)
+            .a;
     // 1 % off the model, alternating: the covariance has noise to measure.
     d.amplitude *= hz == 36.0 || hz == 38.0 ? 1.01 : 0.99;
     sweep.points.push_back(d);

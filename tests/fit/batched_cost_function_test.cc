@@ -140,14 +140,15 @@ void ExpectBatchGivesEachAlone(const ceres::CostFunction& batch,
 // stay those Add returned.
 TEST(FunctorBatch, GivesEachDwellsAutodiffCostFunctionsValuesBitForBit) {
   const std::vector<DwellArgs> dwells = FoldDwells();
-  FunctorBatch<VerticalErrorResidual> batch;
+  FunctorBatch<VerticalErrorResidual> batch(kFirstOrderForm);
   std::vector<std::unique_ptr<ceres::CostFunction>> alone;
   std::vector<const VerticalErrorResidual*> added;
   for (const DwellArgs& d : dwells) {
-    added.push_back(
-        batch.Add(d.omega_rad_s, d.a_base, d.a, d.branch, ErrorMeasure::kRelative, d.weight, 1e-6));
-    alone.emplace_back(VerticalErrorResidual::Create(d.omega_rad_s, d.a_base, d.a, d.branch,
-                                                     ErrorMeasure::kRelative, d.weight, 1e-6));
+    added.push_back(batch.Add(kFirstOrderForm, d.omega_rad_s, d.a_base, d.a, d.branch,
+                              ErrorMeasure::kRelative, d.weight, 1e-6));
+    alone.emplace_back(VerticalErrorResidual::Create(kFirstOrderForm, d.omega_rad_s, d.a_base, d.a,
+                                                     d.branch, ErrorMeasure::kRelative, d.weight,
+                                                     1e-6));
   }
   ASSERT_EQ(batch.num_residuals(), static_cast<int>(dwells.size()));
   ASSERT_EQ(batch.parameter_block_sizes(), std::vector<int32_t>{kNumParameters});
@@ -160,11 +161,12 @@ TEST(FunctorBatch, GivesEachDwellsAutodiffCostFunctionsValuesBitForBit) {
 // The same for the algebraic residuals of eq. (3.11).
 TEST(FunctorBatch, GivesEachAlgebraicResidualsAutodiffValuesBitForBit) {
   const std::vector<DwellArgs> dwells = FoldDwells();
-  FunctorBatch<AlgebraicResidual> batch;
+  FunctorBatch<AlgebraicResidual> batch(kFirstOrderForm);
   std::vector<std::unique_ptr<ceres::CostFunction>> alone;
   for (const DwellArgs& d : dwells) {
-    batch.Add(d.omega_rad_s, d.a_base, d.a, d.weight);
-    alone.emplace_back(AlgebraicResidual::Create(d.omega_rad_s, d.a_base, d.a, d.weight));
+    batch.Add(kFirstOrderForm, d.omega_rad_s, d.a_base, d.a, d.weight);
+    alone.emplace_back(
+        AlgebraicResidual::Create(kFirstOrderForm, d.omega_rad_s, d.a_base, d.a, d.weight));
   }
   ExpectBatchGivesEachAlone(batch, alone, {104.0, 0.19, 310.0, 1.1e4, 9.3e8, kTwoPi * 40.1});
 }
@@ -173,11 +175,13 @@ TEST(FunctorBatch, FailsWhenAnyMemberFails) {
   const ParameterVector p = {100.0, 0.2, 300.0, 1.0e4, 9.0e8, kTwoPi * 40.0};
   const double* blocks[] = {p.data()};
   double r[2];
-  FunctorBatch<VerticalErrorResidual> batch;
-  batch.Add(kTwoPi * 40.0, 0.01, 0.001, Branch::kOnly, ErrorMeasure::kRelative, 1.0, 0.0);
+  FunctorBatch<VerticalErrorResidual> batch(kFirstOrderForm);
+  batch.Add(kFirstOrderForm, kTwoPi * 40.0, 0.01, 0.001, Branch::kOnly, ErrorMeasure::kRelative,
+            1.0, 0.0);
   EXPECT_TRUE(batch.Evaluate(blocks, r, nullptr));
   // A drive level of 0 has no root to solve for: this member fails.
-  batch.Add(kTwoPi * 41.0, 0.0, 0.001, Branch::kOnly, ErrorMeasure::kRelative, 1.0, 0.0);
+  batch.Add(kFirstOrderForm, kTwoPi * 41.0, 0.0, 0.001, Branch::kOnly, ErrorMeasure::kRelative, 1.0,
+            0.0);
   EXPECT_FALSE(batch.Evaluate(blocks, r, nullptr));
 }
 

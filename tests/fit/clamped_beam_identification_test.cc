@@ -55,7 +55,7 @@ TEST_F(ClampedBeamIdentification, PenalisedFitMeetsTheJumpBars) {
 
   int fitted_jump_downs = 0;
   for (const Sweep* sweep : data_->fitted) {
-    for (const PredictedJump& jump : PredictJumps(fit.parameters, *sweep)) {
+    for (const PredictedJump& jump : PredictJumps(kFirstOrderForm, fit.parameters, *sweep)) {
       if (jump.kind != JumpKind::kJumpDown || !jump.measured) continue;
       ++fitted_jump_downs;
       EXPECT_TRUE(jump.inside) << sweep->Name();
@@ -65,7 +65,7 @@ TEST_F(ClampedBeamIdentification, PenalisedFitMeetsTheJumpBars) {
 
   std::vector<double> errors;  // percent; a missing fold counts 100 %
   for (const Sweep* sweep : data_->validation) {
-    for (const PredictedJump& jump : PredictJumps(fit.parameters, *sweep)) {
+    for (const PredictedJump& jump : PredictJumps(kFirstOrderForm, fit.parameters, *sweep)) {
       if (jump.kind != JumpKind::kJumpDown || !jump.measured) continue;
       const double measured = jump.bracket.centre();
       errors.push_back(jump.exists ? 100.0 * std::abs(jump.control - measured) / measured : 100.0);

@@ -81,16 +81,16 @@ TEST(FitStatus, AFitWithoutItsEnforcedFoldIsAFailureNamingIt) {
 TEST(FoldConditionResidual, VanishesAtTheModelsFold) {
   const ParameterVector truth = {100.0, 0.2, 300.0, 1e4, 9e8, 2.0 * kPi * 40.0};
   const double a_base = 0.01;
-  const FoldPoint fold =
-      SolveFrequencyFold(truth.data(), a_base, JumpKind::kJumpDown, 2.0 * kPi * 42.25, 0.1);
+  const FoldPoint fold = SolveFrequencyFold(kFirstOrderForm, truth.data(), a_base,
+                                            JumpKind::kJumpDown, 2.0 * kPi * 42.25, 0.1);
   ASSERT_TRUE(fold.exists);
-  const FoldConditionResidual at_fold(fold.control, a_base, fold.a, 1.0);
+  const FoldConditionResidual at_fold(kFirstOrderForm, fold.control, a_base, fold.a, 1.0);
   double residual[2];
   ASSERT_TRUE(at_fold(truth.data(), residual));
   EXPECT_NEAR(residual[0], 0.0, 1e-9);
   EXPECT_NEAR(residual[1], 0.0, 1e-9);
   // A tenth lower in amplitude the turning point is missed.
-  const FoldConditionResidual below(fold.control, a_base, 0.9 * fold.a, 1.0);
+  const FoldConditionResidual below(kFirstOrderForm, fold.control, a_base, 0.9 * fold.a, 1.0);
   ASSERT_TRUE(below(truth.data(), residual));
   EXPECT_GT(std::abs(residual[1]), 1e-3);
 }

@@ -298,7 +298,7 @@ TEST(InitialGuess, ClampedBeamGuessIsPlausibleAndTheFitConvergesFromIt) {
   for (const Sweep* sweep : fitted) {
     for (const auto& [name, p] :
          {std::pair<const char*, ParameterVector>{"guess", guess}, {"fit", result.parameters}}) {
-      const SweepPrediction prediction = PredictSweep(p, *sweep, true);
+      const SweepPrediction prediction = PredictSweep(kFirstOrderForm, p, *sweep, true);
       double peak = 0.0;
       for (const StableRoot& root : prediction.model) peak = std::max(peak, root.a);
       std::printf(

@@ -37,8 +37,9 @@ struct PermutedBlocks {
 // A dwell on the up-sweep's upper branch just below its jump-down (42.2 Hz).
 ceres::CostFunction* UpperBranchDwell() {
   const double omega = HzToRadPerSecond(42.2);
-  const double a = ModelAmplitude(kThesisTruth, omega, 0.01, Branch::kUpper, 4.7e-3).a;
-  return VerticalErrorResidual::Create(omega, 0.01, 1.003 * a, Branch::kUpper,
+  const double a =
+      ModelAmplitude(kFirstOrderForm, kThesisTruth, omega, 0.01, Branch::kUpper, 4.7e-3).a;
+  return VerticalErrorResidual::Create(kFirstOrderForm, omega, 0.01, 1.003 * a, Branch::kUpper,
                                        ErrorMeasure::kRelative, 1.0);
 }
 
@@ -113,7 +114,7 @@ TEST(MappedCostFunction, GradientCheckerPassesWhenTwoParametersShareAnEntry) {
       {{shared, 0}, {ratio, 0}, {ratio, 0}, {shared, 2}, {shared, 3}, {shared, 4}}};
   const ParameterLayout layout = LayoutOf(fit, map);
   const MappedCostFunction mapped(
-      AlgebraicResidual::Create(HzToRadPerSecond(41.0), 0.01, 2e-3, 1.0), layout);
+      AlgebraicResidual::Create(kFirstOrderForm, HzToRadPerSecond(41.0), 0.01, 2e-3, 1.0), layout);
   ExpectJacobianMatchesFiniteDifferences(mapped, {shared, ratio});
 }
 

@@ -28,8 +28,9 @@ std::vector<Sweep> TwoSweeps() {
     point.drive_frequency_rad_s = HzToRadPerSecond(41.5);
     point.a_base = a_base;
     point.branch = Branch::kLower;
-    point.amplitude =
-        ModelAmplitude(kTruth, point.drive_frequency_rad_s, a_base, Branch::kLower, 1e-4).a;
+    point.amplitude = ModelAmplitude(kFirstOrderForm, kTruth, point.drive_frequency_rad_s, a_base,
+                                     Branch::kLower, 1e-4)
+                          .a;
     amplitude.points.push_back(point);
   }
   Sweep frequency;
@@ -38,8 +39,9 @@ std::vector<Sweep> TwoSweeps() {
     DwellPoint point;
     point.drive_frequency_rad_s = HzToRadPerSecond(hz);
     point.a_base = 0.01;
-    point.amplitude =
-        ModelAmplitude(kTruth, point.drive_frequency_rad_s, 0.01, Branch::kOnly, 1e-3).a;
+    point.amplitude = ModelAmplitude(kFirstOrderForm, kTruth, point.drive_frequency_rad_s, 0.01,
+                                     Branch::kOnly, 1e-3)
+                          .a;
     frequency.points.push_back(point);
   }
   return {amplitude, frequency};

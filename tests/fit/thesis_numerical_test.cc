@@ -79,7 +79,8 @@ TEST_F(ThesisNumerical, BothStartsRecoverTheTruthAndPredictTheValidationSweeps) 
           << ParameterName(i) << " from start x" << factors[i];
     }
     for (const Sweep* sweep : validation_) {
-      const SweepPrediction prediction = PredictSweep(result.parameters, *sweep, false);
+      const SweepPrediction prediction =
+          PredictSweep(kFirstOrderForm, result.parameters, *sweep, false);
       EXPECT_LT(prediction.relative_rms_error, 1e-6) << sweep->Name();
       EXPECT_EQ(prediction.points_off_branch, 0) << sweep->Name();
     }
@@ -100,7 +101,7 @@ TEST_F(ThesisNumerical,
     }
     int jumps = 0;
     for (const Sweep* sweep : fitted_) {
-      for (const PredictedJump& jump : PredictJumps(result.parameters, *sweep)) {
+      for (const PredictedJump& jump : PredictJumps(kFirstOrderForm, result.parameters, *sweep)) {
         ASSERT_TRUE(jump.measured);
         EXPECT_TRUE(jump.inside) << sweep->Name() << " " << JumpKindName(jump.kind);
         ++jumps;

@@ -12,8 +12,8 @@
 #include "dwellfit/residuals/functors/phase_lag_residual.h"
 #include "dwellfit/residuals/functors/root_transition_penalty.h"
 #include "dwellfit/residuals/functors/vertical_error_residual.h"
-#include "dwellfit/residuals/model/fold_point.h"
 #include "dwellfit/residuals/model/amplitude_roots.h"
+#include "dwellfit/residuals/model/fold_point.h"
 #include "gtest/gtest.h"
 
 namespace dwellfit {
@@ -22,7 +22,8 @@ namespace {
 ParameterVector Truth() { return {100.0, 0.2, 300.0, 1e4, 9e8, HzToRadPerSecond(40.0)}; }
 
 ResponseCoefficients<double> At(const ParameterVector& p, double hz) {
-  return ResponseCoefficients<double>::FromParameters(p.data(), HzToRadPerSecond(hz));
+  return ResponseCoefficients<double>::FromParameters(kFirstOrderForm, p.data(),
+                                                      HzToRadPerSecond(hz));
 }
 
 std::vector<double> Evaluate(const ceres::CostFunction& cost, ParameterVector p) {
@@ -73,7 +74,8 @@ TEST(AmplitudeRoots, FindsTheThreeFixedPointsWhereTheResponseIsTripleValued) {
   EXPECT_LT(k.dG(real[1]), 0.0);  // the saddle
   // Past the fold only the lower root is left.
   EXPECT_EQ(
-      PositiveRealRoots(At(Truth(), 42.3), 0.01, AmplitudeRoots(At(Truth(), 42.3), 0.01, 1e-3)).size(),
+      PositiveRealRoots(At(Truth(), 42.3), 0.01, AmplitudeRoots(At(Truth(), 42.3), 0.01, 1e-3))
+          .size(),
       1u);
 }
 
@@ -81,10 +83,10 @@ TEST(AllRootsResidual, TakesTheStableRootNearestTheMeasurementAsTheVerticalError
   const double omega = HzToRadPerSecond(42.2);
   for (double a_measured : {1.2e-3, 4.9e-3}) {
     const Branch branch = a_measured > 3e-3 ? Branch::kUpper : Branch::kLower;
-    std::unique_ptr<ceres::CostFunction> all_roots(
-        AllRootsResidual::Create(omega, 0.01, a_measured, ErrorMeasure::kAbsolute, 1.0));
+    std::unique_ptr<ceres::CostFunction> all_roots(AllRootsResidual::Create(
+        kFirstOrderForm, omega, 0.01, a_measured, ErrorMeasure::kAbsolute, 1.0));
     std::unique_ptr<ceres::CostFunction> vertical(VerticalErrorResidual::Create(
-        omega, 0.01, a_measured, branch, ErrorMeasure::kAbsolute, 1.0));
+        kFirstOrderForm, omega, 0.01, a_measured, branch, ErrorMeasure::kAbsolute, 1.0));
     EXPECT_NEAR(Evaluate(*all_roots, Truth())[0], Evaluate(*vertical, Truth())[0], 1e-17);
     EXPECT_GT(std::abs(Evaluate(*all_roots, Truth())[0]), 1e-5);
   }
@@ -99,8 +101,8 @@ TEST(AllRootsResidual, GradientCheckerPassesOnEveryStableBranch) {
         Dwell{41.5, 0.02, 4.2e-3}, Dwell{41.5, 0.02, 1.1e-3}}) {
     for (ErrorMeasure error : {ErrorMeasure::kAbsolute, ErrorMeasure::kRelative}) {
       SCOPED_TRACE(testing::Message() << d.hz << " Hz, a_base " << d.a_base << ", a " << d.a);
-      std::unique_ptr<ceres::CostFunction> cost(
-          AllRootsResidual::Create(HzToRadPerSecond(d.hz), d.a_base, d.a, error, 1.0));
+      std::unique_ptr<ceres::CostFunction> cost(AllRootsResidual::Create(
+          kFirstOrderForm, HzToRadPerSecond(d.hz), d.a_base, d.a, error, 1.0));
       ExpectJacobianMatches(*cost, Truth(), 1e-6);
     }
   }
@@ -110,8 +112,8 @@ TEST(AllRootsResidual, GradientCheckerPassesOnEveryStableBranch) {
 // (fold 42.2150 Hz, docs/model.md).
 std::unique_ptr<ceres::CostFunction> FrequencyJumpDownPenalty(double before_hz, double after_hz) {
   return std::unique_ptr<ceres::CostFunction>(new RootTransitionPenalty(
-      SweepKind::kFrequency, JumpKind::kJumpDown, 0.01, HzToRadPerSecond(before_hz),
-      HzToRadPerSecond(after_hz), 4.7e-3, 1.0));
+      kFirstOrderForm, SweepKind::kFrequency, JumpKind::kJumpDown, 0.01,
+      HzToRadPerSecond(before_hz), HzToRadPerSecond(after_hz), 4.7e-3, 1.0));
 }
 
 TEST(RootTransitionPenalty, IsZeroWhenTheRootsTurnComplexInsideTheBracket) {
@@ -134,14 +136,15 @@ TEST(RootTransitionPenalty, PenalisesATransitionOnEitherSideOfTheBracket) {
 }
 
 TEST(RootTransitionPenalty, SeparationOfThePairChangesSignAtTheFold) {
-  const FoldPoint fold = SolveFrequencyFold(Truth().data(), 0.01, JumpKind::kJumpDown,
-                                            HzToRadPerSecond(42.25), HzToRadPerSecond(0.1));
+  const FoldPoint fold =
+      SolveFrequencyFold(kFirstOrderForm, Truth().data(), 0.01, JumpKind::kJumpDown,
+                         HzToRadPerSecond(42.25), HzToRadPerSecond(0.1));
   ASSERT_TRUE(fold.exists);
   FoldPairSeparation below, above;
-  ASSERT_TRUE(
-      SeparationOfFoldPair(Truth().data(), fold.control * (1 - 1e-6), 0.01, true, 4.7e-3, &below));
-  ASSERT_TRUE(
-      SeparationOfFoldPair(Truth().data(), fold.control * (1 + 1e-6), 0.01, true, 4.7e-3, &above));
+  ASSERT_TRUE(SeparationOfFoldPair(kFirstOrderForm, Truth().data(), fold.control * (1 - 1e-6), 0.01,
+                                   true, 4.7e-3, &below));
+  ASSERT_TRUE(SeparationOfFoldPair(kFirstOrderForm, Truth().data(), fold.control * (1 + 1e-6), 0.01,
+                                   true, 4.7e-3, &above));
   EXPECT_GT(below.d, 0.0);
   EXPECT_LT(above.d, 0.0);
   EXPECT_LT(std::abs(below.d), 1e-3 * 4.7e-3 * 4.7e-3);
@@ -151,8 +154,9 @@ TEST(RootTransitionPenalty, GradientCheckerPassesWhereThePenaltyIsActive) {
   // Real pair after the bracket (amplitude sweep's jump-up at 41.5 Hz, fold
   // a_base 0.035358, bracket placed below it), complex pair before it
   // (frequency jump-down, bracket above the fold).
-  std::unique_ptr<ceres::CostFunction> amplitude(new RootTransitionPenalty(
-      SweepKind::kAmplitude, JumpKind::kJumpUp, HzToRadPerSecond(41.5), 0.030, 0.031, 2.0e-3, 1.0));
+  std::unique_ptr<ceres::CostFunction> amplitude(
+      new RootTransitionPenalty(kFirstOrderForm, SweepKind::kAmplitude, JumpKind::kJumpUp,
+                                HzToRadPerSecond(41.5), 0.030, 0.031, 2.0e-3, 1.0));
   const std::vector<double> r = Evaluate(*amplitude, Truth());
   EXPECT_GT(r[1], 0.0);
   ExpectJacobianMatches(*amplitude, Truth(), 1e-6);
@@ -166,14 +170,15 @@ TEST(PhaseLagResidual, VanishesAtTheFixedPointsPhaseAndMeasuresEquations39And310
   const double gamma = std::atan2(k.P(a), k.Q(a));
   EXPECT_GT(gamma, 0.0);
   EXPECT_LT(gamma, kPi);
-  std::unique_ptr<ceres::CostFunction> exact(PhaseLagResidual::Create(omega, 0.02, a, gamma, 1.0));
+  std::unique_ptr<ceres::CostFunction> exact(
+      PhaseLagResidual::Create(kFirstOrderForm, omega, 0.02, a, gamma, 1.0));
   const std::vector<double> r = Evaluate(*exact, Truth());
   EXPECT_NEAR(r[0], 0.0, 1e-12);
   EXPECT_NEAR(r[1], 0.0, 1e-12);
   // A phase 2 degrees late moves both balances by a_base times the rotation.
   const double bias = 2.0 * kPi / 180.0;
   std::unique_ptr<ceres::CostFunction> late(
-      PhaseLagResidual::Create(omega, 0.02, a, gamma + bias, 1.0));
+      PhaseLagResidual::Create(kFirstOrderForm, omega, 0.02, a, gamma + bias, 1.0));
   const std::vector<double> b = Evaluate(*late, Truth());
   EXPECT_NEAR(b[0], std::sin(gamma + bias) - std::sin(gamma), 1e-12);
   EXPECT_NEAR(b[1], std::cos(gamma + bias) - std::cos(gamma), 1e-12);

@@ -3,9 +3,9 @@
 #include <vector>
 
 #include "ceres/gradient_checker.h"
-#include "gtest/gtest.h"
 #include "dwellfit/residuals/functors/bifurcation_range_penalty.h"
 #include "dwellfit/residuals/functors/branch_stability_penalty.h"
+#include "gtest/gtest.h"
 
 namespace dwellfit {
 namespace {
@@ -38,8 +38,8 @@ void ExpectGradientCheckerPasses(const ceres::CostFunction& cost, ParameterVecto
 std::unique_ptr<ceres::CostFunction> FrequencyJumpDown(double before_hz, double after_hz,
                                                        int exponent = 10) {
   return std::unique_ptr<ceres::CostFunction>(BifurcationRangePenalty::Create(
-      SweepKind::kFrequency, JumpKind::kJumpDown, 0.01, HzToRadPerSecond(before_hz),
-      HzToRadPerSecond(after_hz), 4.7e-3, exponent, 1.0));
+      kFirstOrderForm, SweepKind::kFrequency, JumpKind::kJumpDown, 0.01,
+      HzToRadPerSecond(before_hz), HzToRadPerSecond(after_hz), 4.7e-3, exponent, 1.0));
 }
 
 TEST(BifurcationRangePenalty, IsSmallInsideTheBracketAndGrowsFastOutside) {
@@ -58,11 +58,11 @@ TEST(BifurcationRangePenalty, IsSmallInsideTheBracketAndGrowsFastOutside) {
 TEST(BifurcationRangePenalty, GradientCheckerPassesForBothSweepKinds) {
   ExpectGradientCheckerPasses(*FrequencyJumpDown(42.2, 42.3), kTruth);
   std::unique_ptr<ceres::CostFunction> jump_up(BifurcationRangePenalty::Create(
-      SweepKind::kFrequency, JumpKind::kJumpUp, 0.01, HzToRadPerSecond(40.7),
+      kFirstOrderForm, SweepKind::kFrequency, JumpKind::kJumpUp, 0.01, HzToRadPerSecond(40.7),
       HzToRadPerSecond(40.6), 1.1e-3, 10, 1.0));
   ExpectGradientCheckerPasses(*jump_up, kTruth);
   std::unique_ptr<ceres::CostFunction> amplitude(
-      BifurcationRangePenalty::Create(SweepKind::kAmplitude, JumpKind::kJumpUp,
+      BifurcationRangePenalty::Create(kFirstOrderForm, SweepKind::kAmplitude, JumpKind::kJumpUp,
                                       HzToRadPerSecond(41.5), 0.035, 0.036, 2.0e-3, 10, 2.0));
   ExpectGradientCheckerPasses(*amplitude, kTruth);
 }
@@ -85,13 +85,14 @@ TEST(BifurcationRangePenalty, MissingFoldIsLargeFiniteAndHasAUsableGradient) {
 
 TEST(BranchStabilityPenalty, NegligibleOnTheBranchAndExponentialPastTheFold) {
   const double omega = HzToRadPerSecond(41.5);
-  const auto k = ResponseCoefficients<double>::FromParameters(kTruth.data(), omega);
+  const auto k =
+      ResponseCoefficients<double>::FromParameters(kFirstOrderForm, kTruth.data(), omega);
   const TurningPoints tp = FindTurningPoints(k);
   ASSERT_TRUE(tp.exist);
   const double lambda = 50.0 / 5e-3;
   auto cost = [&](double a, Branch branch) {
     std::unique_ptr<ceres::CostFunction> f(
-        BranchStabilityPenalty::Create(omega, a, branch, lambda, 1.0));
+        BranchStabilityPenalty::Create(kFirstOrderForm, omega, a, branch, lambda, 1.0));
     const double r = Evaluate(*f, kTruth);
     return r * r;
   };
@@ -102,8 +103,8 @@ TEST(BranchStabilityPenalty, NegligibleOnTheBranchAndExponentialPastTheFold) {
   // The mirror for the lower branch.
   EXPECT_NEAR(cost(tp.a_lower_end - 5e-4, Branch::kLower), std::exp(-lambda * 5e-4), 1e-12);
   // Single-valued response (no turning points at 38 Hz): no cost at all.
-  std::unique_ptr<ceres::CostFunction> single(
-      BranchStabilityPenalty::Create(HzToRadPerSecond(38.0), 3e-4, Branch::kUpper, lambda, 1.0));
+  std::unique_ptr<ceres::CostFunction> single(BranchStabilityPenalty::Create(
+      kFirstOrderForm, HzToRadPerSecond(38.0), 3e-4, Branch::kUpper, lambda, 1.0));
   EXPECT_EQ(Evaluate(*single, kTruth), 0.0);
 }
 
@@ -111,7 +112,7 @@ TEST(BranchStabilityPenalty, GradientCheckerPassesOnBothBranches) {
   const double omega = HzToRadPerSecond(41.5);
   for (Branch branch : {Branch::kUpper, Branch::kLower}) {
     std::unique_ptr<ceres::CostFunction> cost(
-        BranchStabilityPenalty::Create(omega, 3e-3, branch, 1e4, 1.0));
+        BranchStabilityPenalty::Create(kFirstOrderForm, omega, 3e-3, branch, 1e4, 1.0));
     ExpectGradientCheckerPasses(*cost, kTruth);
   }
 }

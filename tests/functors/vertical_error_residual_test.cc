@@ -4,8 +4,8 @@
 #include <vector>
 
 #include "ceres/gradient_checker.h"
-#include "gtest/gtest.h"
 #include "dwellfit/residuals/functors/algebraic_residual.h"
+#include "gtest/gtest.h"
 
 namespace dwellfit {
 namespace {
@@ -22,7 +22,7 @@ struct Dwell {
 
 Dwell OnBranch(double hz, double a_base, Branch branch, double relative_offset) {
   const double omega = HzToRadPerSecond(hz);
-  const StableRoot root = ModelAmplitude(Truth(), omega, a_base, branch, 1e-3);
+  const StableRoot root = ModelAmplitude(kFirstOrderForm, Truth(), omega, a_base, branch, 1e-3);
   EXPECT_EQ(root.status, RootStatus::kOnBranch);
   return {omega, a_base, root.a * (1.0 + relative_offset), branch};
 }
@@ -68,9 +68,9 @@ TEST(VerticalErrorResidual, VanishesOnTheModelCurveAndMeasuresTheVerticalDistanc
   for (const Dwell& d :
        {OnBranch(42.2, 0.01, Branch::kUpper, 0.0), OnBranch(42.2, 0.01, Branch::kLower, 0.0)}) {
     std::unique_ptr<ceres::CostFunction> absolute(VerticalErrorResidual::Create(
-        d.omega, d.a_base, d.a * 1.01, d.branch, ErrorMeasure::kAbsolute, 1.0));
+        kFirstOrderForm, d.omega, d.a_base, d.a * 1.01, d.branch, ErrorMeasure::kAbsolute, 1.0));
     std::unique_ptr<ceres::CostFunction> relative(VerticalErrorResidual::Create(
-        d.omega, d.a_base, d.a * 1.01, d.branch, ErrorMeasure::kRelative, 2.0));
+        kFirstOrderForm, d.omega, d.a_base, d.a * 1.01, d.branch, ErrorMeasure::kRelative, 2.0));
     EXPECT_NEAR(Evaluate(*absolute, Truth()), 0.01 * d.a, 1e-12 * d.a);
     EXPECT_NEAR(Evaluate(*relative, Truth()), 2.0 * std::log(1.01), 1e-10);
   }
@@ -80,8 +80,9 @@ TEST(VerticalErrorResidual, UsesTheBranchThePointWasMeasuredOn) {
   // Same controls and measured value, two branches: two different model amplitudes.
   const Dwell upper = OnBranch(41.5, 0.02, Branch::kUpper, 0.0);
   const Dwell lower = OnBranch(41.5, 0.02, Branch::kLower, 0.0);
-  std::unique_ptr<ceres::CostFunction> on_lower(VerticalErrorResidual::Create(
-      lower.omega, lower.a_base, upper.a, Branch::kLower, ErrorMeasure::kAbsolute, 1.0));
+  std::unique_ptr<ceres::CostFunction> on_lower(
+      VerticalErrorResidual::Create(kFirstOrderForm, lower.omega, lower.a_base, upper.a,
+                                    Branch::kLower, ErrorMeasure::kAbsolute, 1.0));
   EXPECT_NEAR(Evaluate(*on_lower, Truth()), upper.a - lower.a, 1e-15);
 }
 
@@ -106,8 +107,8 @@ TEST(VerticalErrorResidual, GradientCheckerPassesOnBothBranchesNearTheJumps) {
     for (ErrorMeasure error : {ErrorMeasure::kAbsolute, ErrorMeasure::kRelative}) {
       SCOPED_TRACE(testing::Message() << "Omega " << d.omega << " a_base " << d.a_base << " branch "
                                       << BranchName(d.branch));
-      std::unique_ptr<ceres::CostFunction> cost(
-          VerticalErrorResidual::Create(d.omega, d.a_base, d.a, d.branch, error, 1.0));
+      std::unique_ptr<ceres::CostFunction> cost(VerticalErrorResidual::Create(
+          kFirstOrderForm, d.omega, d.a_base, d.a, d.branch, error, 1.0));
       ExpectGradientMatchesFiniteDifferences(*cost, Truth());
     }
   }
@@ -117,21 +118,24 @@ TEST(VerticalErrorResidual, BranchEndExtensionIsContinuousAndDifferentiable) {
   // At 42.3 Hz the upper branch no longer reaches a_base = 0.01: the model
   // amplitude is the turning point where the branch ends.
   const double omega = HzToRadPerSecond(42.3);
-  const auto k = ResponseCoefficients<double>::FromParameters(Truth().data(), omega);
+  const auto k =
+      ResponseCoefficients<double>::FromParameters(kFirstOrderForm, Truth().data(), omega);
   const TurningPoints tp = FindTurningPoints(k);
   ASSERT_TRUE(tp.exist);
   std::unique_ptr<ceres::CostFunction> cost(VerticalErrorResidual::Create(
-      omega, 0.01, 4.8e-3, Branch::kUpper, ErrorMeasure::kAbsolute, 1.0));
+      kFirstOrderForm, omega, 0.01, 4.8e-3, Branch::kUpper, ErrorMeasure::kAbsolute, 1.0));
   EXPECT_NEAR(Evaluate(*cost, Truth()), 4.8e-3 - tp.a_upper_end, 1e-15);
   ExpectGradientMatchesFiniteDifferences(*cost, Truth());
 
   // Continuity: as a_base rises through the branch end's level the residual
   // moves continuously from the turning point onto the branch.
   const double level = std::sqrt(k.G(tp.a_upper_end));
-  std::unique_ptr<ceres::CostFunction> below(VerticalErrorResidual::Create(
-      omega, level * (1 - 1e-9), 4.8e-3, Branch::kUpper, ErrorMeasure::kAbsolute, 1.0));
-  std::unique_ptr<ceres::CostFunction> above(VerticalErrorResidual::Create(
-      omega, level * (1 + 1e-9), 4.8e-3, Branch::kUpper, ErrorMeasure::kAbsolute, 1.0));
+  std::unique_ptr<ceres::CostFunction> below(
+      VerticalErrorResidual::Create(kFirstOrderForm, omega, level * (1 - 1e-9), 4.8e-3,
+                                    Branch::kUpper, ErrorMeasure::kAbsolute, 1.0));
+  std::unique_ptr<ceres::CostFunction> above(
+      VerticalErrorResidual::Create(kFirstOrderForm, omega, level * (1 + 1e-9), 4.8e-3,
+                                    Branch::kUpper, ErrorMeasure::kAbsolute, 1.0));
   EXPECT_NEAR(Evaluate(*below, Truth()), Evaluate(*above, Truth()), 1e-7);
 }
 
@@ -154,13 +158,13 @@ TEST(VerticalErrorResidual, WarmStartGivesTheColdStartValueAlongAPathAcrossAFold
   for (const Dwell& d : dwells) {
     SCOPED_TRACE(BranchName(d.branch));
     std::unique_ptr<ceres::CostFunction> warm(VerticalErrorResidual::Create(
-        d.omega, d.a_base, d.a, d.branch, ErrorMeasure::kRelative, 1.0));
+        kFirstOrderForm, d.omega, d.a_base, d.a, d.branch, ErrorMeasure::kRelative, 1.0));
     int branch_ends = 0;
     for (double factor : alpha_factors) {
       ParameterVector p = Truth();
       p[kAlpha] *= factor;
       std::unique_ptr<ceres::CostFunction> cold(VerticalErrorResidual::Create(
-          d.omega, d.a_base, d.a, d.branch, ErrorMeasure::kRelative, 1.0));
+          kFirstOrderForm, d.omega, d.a_base, d.a, d.branch, ErrorMeasure::kRelative, 1.0));
       const double* blocks[] = {p.data()};
       double warm_residual, cold_residual;
       double warm_jacobian[kNumParameters], cold_jacobian[kNumParameters];
@@ -173,7 +177,7 @@ TEST(VerticalErrorResidual, WarmStartGivesTheColdStartValueAlongAPathAcrossAFold
         EXPECT_NEAR(warm_jacobian[j], cold_jacobian[j], 1e-9 * std::abs(cold_jacobian[j]) + 1e-300)
             << ParameterName(j) << ", alpha x " << factor;
       }
-      const StableRoot root = ModelAmplitude(p, d.omega, d.a_base, d.branch, d.a);
+      const StableRoot root = ModelAmplitude(kFirstOrderForm, p, d.omega, d.a_base, d.branch, d.a);
       branch_ends += root.status == RootStatus::kBranchEnd;
     }
     // The path does cross the fold for the upper branch.
@@ -184,10 +188,10 @@ TEST(VerticalErrorResidual, WarmStartGivesTheColdStartValueAlongAPathAcrossAFold
 TEST(AlgebraicResidual, VanishesAtTheTruthAndPassesTheGradientChecker) {
   const Dwell d = OnBranch(41.5, 0.02, Branch::kUpper, 0.0);
   std::unique_ptr<ceres::CostFunction> exact(
-      AlgebraicResidual::Create(d.omega, d.a_base, d.a, 1.0));
+      AlgebraicResidual::Create(kFirstOrderForm, d.omega, d.a_base, d.a, 1.0));
   EXPECT_NEAR(Evaluate(*exact, Truth()), 0.0, 1e-12);
   std::unique_ptr<ceres::CostFunction> off(
-      AlgebraicResidual::Create(d.omega, d.a_base, d.a * 1.02, 1.0));
+      AlgebraicResidual::Create(kFirstOrderForm, d.omega, d.a_base, d.a * 1.02, 1.0));
   EXPECT_GT(std::abs(Evaluate(*off, Truth())), 1e-3);
   ExpectGradientMatchesFiniteDifferences(*off, Truth());
 }
@@ -195,8 +199,9 @@ TEST(AlgebraicResidual, VanishesAtTheTruthAndPassesTheGradientChecker) {
 TEST(VerticalErrorResidual, RejectsAnUndefinedEvaluation) {
   ParameterVector p = Truth();
   p[kEtaE] = 0.0;
-  std::unique_ptr<ceres::CostFunction> cost(VerticalErrorResidual::Create(
-      HzToRadPerSecond(41.0), 0.01, 1e-3, Branch::kUpper, ErrorMeasure::kAbsolute, 1.0));
+  std::unique_ptr<ceres::CostFunction> cost(
+      VerticalErrorResidual::Create(kFirstOrderForm, HzToRadPerSecond(41.0), 0.01, 1e-3,
+                                    Branch::kUpper, ErrorMeasure::kAbsolute, 1.0));
   const double* blocks[] = {p.data()};
   double residual;
   EXPECT_FALSE(cost->Evaluate(blocks, &residual, nullptr));

@@ -156,7 +156,8 @@ TEST(FamilyTerms, WithoutTheFamilysTermsTheGeneralPathFindsTheSexticsAnswers) {
   // (higher_order false) is the independent answer.
   const ParameterVector p = {100.0, 0.2, 300.0, 1e4, 9e8, HzToRadPerSecond(40.0)};
   for (double hz : {41.2, 41.5, 42.3, 43.0}) {
-    const auto sextic = ResponseCoefficients<double>::FromParameters(p.data(), kTwoPi * hz);
+    const auto sextic =
+        ResponseCoefficients<double>::FromParameters(kFirstOrderForm, p.data(), kTwoPi * hz);
     ResponseCoefficients<double> general = sextic;
     general.higher_order = true;
     const TurningPoints a = FindTurningPoints(sextic);

@@ -14,8 +14,9 @@ const ParameterVector kTruth = {100.0, 0.2, 300.0, 1e4, 9e8, HzToRadPerSecond(40
 
 TEST(SolveAmplitudeFold, JumpLevelsAt41_5HzSolveTheFoldConditions) {
   const double omega = HzToRadPerSecond(41.5);
-  const FoldPoint up = SolveAmplitudeFold(kTruth.data(), omega, JumpKind::kJumpUp);
-  const FoldPoint down = SolveAmplitudeFold(kTruth.data(), omega, JumpKind::kJumpDown);
+  const FoldPoint up = SolveAmplitudeFold(kFirstOrderForm, kTruth.data(), omega, JumpKind::kJumpUp);
+  const FoldPoint down =
+      SolveAmplitudeFold(kFirstOrderForm, kTruth.data(), omega, JumpKind::kJumpDown);
   ASSERT_TRUE(up.exists);
   ASSERT_TRUE(down.exists);
   // The dataset's A41.5 sweep jumps up between a_base 0.035 and 0.036 and
@@ -24,16 +25,18 @@ TEST(SolveAmplitudeFold, JumpLevelsAt41_5HzSolveTheFoldConditions) {
   EXPECT_LT(up.control, 0.036);
   EXPECT_GT(down.control, 0.006);
   EXPECT_LT(down.control, 0.007);
-  const auto k = ResponseCoefficients<double>::FromParameters(kTruth.data(), omega);
+  const auto k =
+      ResponseCoefficients<double>::FromParameters(kFirstOrderForm, kTruth.data(), omega);
   EXPECT_NEAR(k.dG(up.a), 0.0, 1e-14);
   EXPECT_NEAR(k.G(down.a), down.control * down.control, 1e-18);
 }
 
 TEST(SolveFrequencyFold, JumpFrequenciesAtABase0_01SolveTheFoldConditions) {
   const double a_base = 0.01;
-  const FoldPoint down = SolveFrequencyFold(kTruth.data(), a_base, JumpKind::kJumpDown,
-                                            HzToRadPerSecond(42.25), HzToRadPerSecond(0.05));
-  const FoldPoint up = SolveFrequencyFold(kTruth.data(), a_base, JumpKind::kJumpUp,
+  const FoldPoint down =
+      SolveFrequencyFold(kFirstOrderForm, kTruth.data(), a_base, JumpKind::kJumpDown,
+                         HzToRadPerSecond(42.25), HzToRadPerSecond(0.05));
+  const FoldPoint up = SolveFrequencyFold(kFirstOrderForm, kTruth.data(), a_base, JumpKind::kJumpUp,
                                           HzToRadPerSecond(40.65), HzToRadPerSecond(0.05));
   ASSERT_TRUE(down.exists);
   ASSERT_TRUE(up.exists);
@@ -43,18 +46,19 @@ TEST(SolveFrequencyFold, JumpFrequenciesAtABase0_01SolveTheFoldConditions) {
   EXPECT_GT(RadPerSecondToHz(up.control), 40.6);
   EXPECT_LT(RadPerSecondToHz(up.control), 40.7);
   for (const FoldPoint& fold : {down, up}) {
-    const auto k = ResponseCoefficients<double>::FromParameters(kTruth.data(), fold.control);
+    const auto k =
+        ResponseCoefficients<double>::FromParameters(kFirstOrderForm, kTruth.data(), fold.control);
     EXPECT_NEAR(k.G(fold.a) / (a_base * a_base), 1.0, 1e-12);
     EXPECT_NEAR(k.dG(fold.a) / k.d2G(fold.a), 0.0, 1e-12 * fold.a);
   }
 }
 
 TEST(SolveFrequencyFold, FindsTheFoldFromAGuessFarFromItAndFromBeyondTheCusp) {
-  const FoldPoint reference = SolveFrequencyFold(kTruth.data(), 0.01, JumpKind::kJumpDown,
-                                                 HzToRadPerSecond(42.25), 0.1);
+  const FoldPoint reference = SolveFrequencyFold(kFirstOrderForm, kTruth.data(), 0.01,
+                                                 JumpKind::kJumpDown, HzToRadPerSecond(42.25), 0.1);
   for (double guess_hz : {41.0, 44.0, 39.0}) {  // 39 Hz: no turning points there
-    const FoldPoint fold = SolveFrequencyFold(kTruth.data(), 0.01, JumpKind::kJumpDown,
-                                              HzToRadPerSecond(guess_hz), 0.1);
+    const FoldPoint fold = SolveFrequencyFold(kFirstOrderForm, kTruth.data(), 0.01,
+                                              JumpKind::kJumpDown, HzToRadPerSecond(guess_hz), 0.1);
     ASSERT_TRUE(fold.exists) << guess_hz;
     EXPECT_NEAR(fold.control, reference.control, 1e-9 * reference.control) << guess_hz;
   }
@@ -63,11 +67,12 @@ TEST(SolveFrequencyFold, FindsTheFoldFromAGuessFarFromItAndFromBeyondTheCusp) {
 TEST(SolveFrequencyFold, ReportsNoFoldWhenTheDampingIsTooHighForAJump) {
   ParameterVector damped = kTruth;
   damped[kMu1] = 20.0;  // 100 x: no bistability at a_base = 0.01
-  EXPECT_FALSE(SolveFrequencyFold(damped.data(), 0.01, JumpKind::kJumpDown,
+  EXPECT_FALSE(SolveFrequencyFold(kFirstOrderForm, damped.data(), 0.01, JumpKind::kJumpDown,
                                   HzToRadPerSecond(42.25), 0.1)
                    .exists);
   EXPECT_FALSE(
-      SolveAmplitudeFold(damped.data(), HzToRadPerSecond(41.5), JumpKind::kJumpUp).exists);
+      SolveAmplitudeFold(kFirstOrderForm, damped.data(), HzToRadPerSecond(41.5), JumpKind::kJumpUp)
+          .exists);
 }
 
 // Functors exposing the lifted folds as residuals, to check their derivatives.
@@ -77,10 +82,10 @@ struct FrequencyFoldOf {
   bool operator()(const T* p, T* out) const {
     ParameterVector value;
     for (int i = 0; i < kNumParameters; ++i) value[i] = ScalarPart(p[i]);
-    const FoldPoint fold = SolveFrequencyFold(value.data(), 0.01, kind, HzToRadPerSecond(41.5),
-                                              HzToRadPerSecond(0.05));
+    const FoldPoint fold = SolveFrequencyFold(kFirstOrderForm, value.data(), 0.01, kind,
+                                              HzToRadPerSecond(41.5), HzToRadPerSecond(0.05));
     if (!fold.exists) return false;
-    out[0] = LiftFrequencyFold(p, 0.01, fold);
+    out[0] = LiftFrequencyFold(kFirstOrderForm, p, 0.01, fold);
     return true;
   }
 };
@@ -91,9 +96,10 @@ struct AmplitudeFoldOf {
   bool operator()(const T* p, T* out) const {
     ParameterVector value;
     for (int i = 0; i < kNumParameters; ++i) value[i] = ScalarPart(p[i]);
-    const FoldPoint fold = SolveAmplitudeFold(value.data(), HzToRadPerSecond(41.5), kind);
+    const FoldPoint fold =
+        SolveAmplitudeFold(kFirstOrderForm, value.data(), HzToRadPerSecond(41.5), kind);
     if (!fold.exists) return false;
-    out[0] = LiftAmplitudeFold(p, HzToRadPerSecond(41.5), fold);
+    out[0] = LiftAmplitudeFold(kFirstOrderForm, p, HzToRadPerSecond(41.5), fold);
     return true;
   }
 };

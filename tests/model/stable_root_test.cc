@@ -17,7 +17,8 @@ ParameterVector Truth() { return {100.0, 0.2, 300.0, 1e4, 9e8, HzToRadPerSecond(
 
 ResponseCoefficients<double> At(double hz) {
   const ParameterVector p = Truth();
-  return ResponseCoefficients<double>::FromParameters(p.data(), HzToRadPerSecond(hz));
+  return ResponseCoefficients<double>::FromParameters(kFirstOrderForm, p.data(),
+                                                      HzToRadPerSecond(hz));
 }
 
 // The coefficients (3.3) formed from the parameters' terms (as a batch of
@@ -25,9 +26,10 @@ ResponseCoefficients<double> At(double hz) {
 // double and with Jets carrying the derivatives.
 template <typename T>
 void ExpectCoefficientsOfEquations(const T* p, double omega) {
-  const ResponseCoefficients<T> k = ResponseCoefficients<T>::FromParameters(p, omega);
+  const ResponseCoefficients<T> k =
+      ResponseCoefficients<T>::FromParameters(kFirstOrderForm, p, omega);
   const ResponseCoefficients<T> shared =
-      ResponseCoefficients<T>::FromTerms(ParameterTerms<T>(p), omega);
+      ResponseCoefficients<T>::FromTerms(ParameterTerms<T>(kFirstOrderForm, p), omega);
   const T& eta_e = p[kEtaE];
   const T& w = p[kNaturalFrequency];
   const T written[] = {omega * p[kMu1] / eta_e, (4.0 / (3.0 * kPi)) * p[kMu2] * omega / eta_e,
@@ -117,7 +119,8 @@ TEST(SolveStableRoot, OnlyPicksTheStableRootNearestTheMeasurement) {
 TEST(SolveStableRoot, FailsCleanlyOnNonFiniteParameters) {
   ParameterVector p = Truth();
   p[kEtaE] = 0.0;
-  const auto k = ResponseCoefficients<double>::FromParameters(p.data(), HzToRadPerSecond(41.0));
+  const auto k = ResponseCoefficients<double>::FromParameters(kFirstOrderForm, p.data(),
+                                                              HzToRadPerSecond(41.0));
   EXPECT_EQ(SolveStableRoot(k, 0.01, Branch::kUpper, 1e-3).status, RootStatus::kFailed);
 }
 
@@ -176,7 +179,7 @@ TEST(SolveStableRootNear, AgreesWithTheSafeguardedSolverOnRandomModels) {
     p[kAlpha] = (unit(generator) < 0.2 ? -1.0 : 1.0) * log_uniform(1e6, 1e12);
     p[kNaturalFrequency] = log_uniform(100.0, 2000.0);
     const double omega = p[kNaturalFrequency] * (0.8 + 0.5 * unit(generator));
-    const auto k = ResponseCoefficients<double>::FromParameters(p.data(), omega);
+    const auto k = ResponseCoefficients<double>::FromParameters(kFirstOrderForm, p.data(), omega);
     const double a_base = log_uniform(1e-4, 1.0);
     for (Branch branch : {Branch::kLower, Branch::kUpper}) {
       const StableRoot reference = SolveStableRoot(k, a_base, branch, 1e-3);

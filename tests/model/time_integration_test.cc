@@ -23,8 +23,8 @@
 
 #include "boost/numeric/odeint.hpp"
 #include "dwellfit/estimator/simulation/dwell_simulator.h"
-#include "gtest/gtest.h"
 #include "dwellfit/residuals/model/stable_root.h"
+#include "gtest/gtest.h"
 
 namespace dwellfit {
 namespace {
@@ -82,7 +82,8 @@ double SteadyFirstHarmonic(const ParameterVector& p, double omega_drive_rad_s, d
 // u and u' at t = 0 on the model's fixed point with amplitude `a`:
 // u = a cos(Omega t - gamma), with a_base sin(gamma) = P(a), a_base cos(gamma) = Q(a).
 State OnFixedPoint(const ParameterVector& p, double omega_drive_rad_s, double a) {
-  const auto k = ResponseCoefficients<double>::FromParameters(p.data(), omega_drive_rad_s);
+  const auto k =
+      ResponseCoefficients<double>::FromParameters(kFirstOrderForm, p.data(), omega_drive_rad_s);
   const double gamma = std::atan2(k.P(a), k.Q(a));
   return {a * std::cos(gamma), a * omega_drive_rad_s * std::sin(gamma)};
 }
@@ -92,7 +93,7 @@ TEST(TimeIntegration, BothStableRootsAt41_5HzAreSteadyStatesOfTheEquationOfMotio
   const double omega = HzToRadPerSecond(41.5);
   const double a_base = 0.02;  // bistable: between 0.0068 and 0.0354
   for (Branch branch : {Branch::kLower, Branch::kUpper}) {
-    const StableRoot root = ModelAmplitude(p, omega, a_base, branch, 3e-3);
+    const StableRoot root = ModelAmplitude(kFirstOrderForm, p, omega, a_base, branch, 3e-3);
     ASSERT_EQ(root.status, RootStatus::kOnBranch);
     const double a = SteadyFirstHarmonic(p, omega, a_base, OnFixedPoint(p, omega, root.a),
                                          /*settle_periods=*/400, /*measure_periods=*/20);
@@ -105,9 +106,10 @@ TEST(TimeIntegration, SingleValuedResponseIsReachedFromRest) {
   const ParameterVector p = Truth();
   const double omega = HzToRadPerSecond(38.0);
   const double a_base = 0.01;
-  ASSERT_FALSE(
-      FindTurningPoints(ResponseCoefficients<double>::FromParameters(p.data(), omega)).exist);
-  const StableRoot root = ModelAmplitude(p, omega, a_base, Branch::kOnly, 0.0);
+  ASSERT_FALSE(FindTurningPoints(
+                   ResponseCoefficients<double>::FromParameters(kFirstOrderForm, p.data(), omega))
+                   .exist);
+  const StableRoot root = ModelAmplitude(kFirstOrderForm, p, omega, a_base, Branch::kOnly, 0.0);
   const double a = SteadyFirstHarmonic(p, omega, a_base, State{0.0, 0.0},
                                        /*settle_periods=*/1200, /*measure_periods=*/20);
   EXPECT_NEAR(a / root.a, 1.0, 0.01) << "model " << root.a << ", integrated " << a;
@@ -120,10 +122,11 @@ TEST(TimeIntegration, ResponseJumpsUpWhereTheLowerBranchHasEnded) {
   const ParameterVector p = Truth();
   const double omega = HzToRadPerSecond(41.5);
   const double a_base = 0.036;  // just above the jump-up level 0.0354
-  const TurningPoints tp =
-      FindTurningPoints(ResponseCoefficients<double>::FromParameters(p.data(), omega));
+  const TurningPoints tp = FindTurningPoints(
+      ResponseCoefficients<double>::FromParameters(kFirstOrderForm, p.data(), omega));
   ASSERT_TRUE(tp.exist);
-  const SettledDwell dwell = SettleDwell(p, omega, a_base, Branch::kLower, 0.9 * tp.a_lower_end);
+  const SettledDwell dwell =
+      SettleDwell(kFirstOrderForm, p, omega, a_base, Branch::kLower, 0.9 * tp.a_lower_end);
   ASSERT_TRUE(dwell.jumped);
   const double a = SteadyFirstHarmonic(p, omega, a_base, OnFixedPoint(p, omega, tp.a_lower_end),
                                        /*settle_periods=*/800, /*measure_periods=*/20);

@@ -99,10 +99,11 @@ TEST(RigSimulator, JumpsHappenWithinOneStepOfTheModelsFolds) {
     const double before = JumpControlBefore(sweep, &after);
     FoldPoint fold;
     if (sweep.kind == SweepKind::kFrequency) {
-      fold = SolveFrequencyFold(kTruth.data(), 0.01, expected[s].kind, 0.5 * (before + after),
-                                HzToRadPerSecond(0.01));
+      fold = SolveFrequencyFold(kFirstOrderForm, kTruth.data(), 0.01, expected[s].kind,
+                                0.5 * (before + after), HzToRadPerSecond(0.01));
     } else {
-      fold = SolveAmplitudeFold(kTruth.data(), HzToRadPerSecond(41.5), expected[s].kind);
+      fold = SolveAmplitudeFold(kFirstOrderForm, kTruth.data(), HzToRadPerSecond(41.5),
+                                expected[s].kind);
     }
     ASSERT_TRUE(fold.exists) << sweep.Name();
     // The first dwell after the jump lies within one control step of the fold.
@@ -114,8 +115,10 @@ TEST(RigSimulator, JumpsHappenWithinOneStepOfTheModelsFolds) {
 
 // The model's lag gamma = atan2(P(a), Q(a)) at the model's amplitude.
 double ModelLag(double omega, double a_base, double a_guess) {
-  const StableRoot root = ModelAmplitude(kTruth, omega, a_base, Branch::kOnly, a_guess);
-  const auto k = ResponseCoefficients<double>::FromParameters(kTruth.data(), omega);
+  const StableRoot root =
+      ModelAmplitude(kFirstOrderForm, kTruth, omega, a_base, Branch::kOnly, a_guess);
+  const auto k =
+      ResponseCoefficients<double>::FromParameters(kFirstOrderForm, kTruth.data(), omega);
   return std::atan2(k.P(root.a), k.Q(root.a));
 }
 

@@ -25,7 +25,7 @@ RigOptions ShortRig() {
 }
 
 double ModelRoot(double f_hz, double a_base, Branch branch) {
-  return ModelAmplitude(kTruth, HzToRadPerSecond(f_hz), a_base, branch, 0.0).a;
+  return ModelAmplitude(kFirstOrderForm, kTruth, HzToRadPerSecond(f_hz), a_base, branch, 0.0).a;
 }
 
 // Stepped up in frequency at level 0.01 the response climbs the upper branch

@@ -24,7 +24,7 @@ ParameterVector Truth() { return {100.0, 0.2, 300.0, 1e4, 9e8, HzToRadPerSecond(
 
 ResponseCoefficients<double> At(double omega_rad_s) {
   const ParameterVector p = Truth();
-  return ResponseCoefficients<double>::FromParameters(p.data(), omega_rad_s);
+  return ResponseCoefficients<double>::FromParameters(kFirstOrderForm, p.data(), omega_rad_s);
 }
 
 DwellPlan ThesisPlan() { return ReadDwellPlan(kDatasetDir + "plan.yaml"); }
@@ -215,13 +215,17 @@ TEST(DwellSimulator, StartBranchChoosesTheBranchInsideTheBistableRange) {
   for (const std::string direction : {"/up", "/down"}) {
     for (const DwellPoint& point : sweeps.at("rest" + direction).points) {
       EXPECT_EQ(point.branch, Branch::kLower);
-      EXPECT_NEAR(point.amplitude,
-                  ModelAmplitude(Truth(), omega, point.a_base, Branch::kLower, 1e-3).a, 1e-15);
+      EXPECT_NEAR(
+          point.amplitude,
+          ModelAmplitude(kFirstOrderForm, Truth(), omega, point.a_base, Branch::kLower, 1e-3).a,
+          1e-15);
     }
     for (const DwellPoint& point : sweeps.at("upper" + direction).points) {
       EXPECT_EQ(point.branch, Branch::kUpper);
-      EXPECT_NEAR(point.amplitude,
-                  ModelAmplitude(Truth(), omega, point.a_base, Branch::kUpper, 5e-3).a, 1e-15);
+      EXPECT_NEAR(
+          point.amplitude,
+          ModelAmplitude(kFirstOrderForm, Truth(), omega, point.a_base, Branch::kUpper, 5e-3).a,
+          1e-15);
     }
     EXPECT_TRUE(sweeps.at("rest" + direction).jumps.empty());
     EXPECT_TRUE(sweeps.at("upper" + direction).jumps.empty());
@@ -231,8 +235,9 @@ TEST(DwellSimulator, StartBranchChoosesTheBranchInsideTheBistableRange) {
 TEST(SettleDwell, FromAMonotoneResponseTakesTheSideOfTheSaddle) {
   const double omega = HzToRadPerSecond(41.5);
   const double a_base = 0.02;  // bistable at 41.5 Hz
-  const double lower = ModelAmplitude(Truth(), omega, a_base, Branch::kLower, 0).a;
-  const double upper = ModelAmplitude(Truth(), omega, a_base, Branch::kUpper, 5e-3).a;
+  const double lower = ModelAmplitude(kFirstOrderForm, Truth(), omega, a_base, Branch::kLower, 0).a;
+  const double upper =
+      ModelAmplitude(kFirstOrderForm, Truth(), omega, a_base, Branch::kUpper, 5e-3).a;
   // The unstable middle root, by bisection on G - a_base^2 (decreasing there).
   const auto k = At(omega);
   const TurningPoints tp = FindTurningPoints(k);
@@ -245,30 +250,34 @@ TEST(SettleDwell, FromAMonotoneResponseTakesTheSideOfTheSaddle) {
   ASSERT_LT(lower, saddle);
   ASSERT_LT(saddle, upper);
 
-  const SettledDwell below = SettleDwell(Truth(), omega, a_base, Branch::kOnly, 0.99 * saddle);
+  const SettledDwell below =
+      SettleDwell(kFirstOrderForm, Truth(), omega, a_base, Branch::kOnly, 0.99 * saddle);
   EXPECT_EQ(below.side, Branch::kLower);
   EXPECT_EQ(below.amplitude, lower);
   EXPECT_FALSE(below.jumped);
-  const SettledDwell above = SettleDwell(Truth(), omega, a_base, Branch::kOnly, 1.01 * saddle);
+  const SettledDwell above =
+      SettleDwell(kFirstOrderForm, Truth(), omega, a_base, Branch::kOnly, 1.01 * saddle);
   EXPECT_EQ(above.side, Branch::kUpper);
   EXPECT_EQ(above.branch, Branch::kUpper);
   EXPECT_NEAR(above.amplitude, upper, 1e-15);
-  const SettledDwell rest = SettleDwell(Truth(), omega, a_base, Branch::kOnly, 0.0);
+  const SettledDwell rest =
+      SettleDwell(kFirstOrderForm, Truth(), omega, a_base, Branch::kOnly, 0.0);
   EXPECT_EQ(rest.side, Branch::kLower);
 }
 
 TEST(SettleDwell, JumpsWhenTheBranchEnds) {
   const double omega = HzToRadPerSecond(41.5);
   // Above the jump-up level 0.0354 only the upper branch exists.
-  const SettledDwell jump = SettleDwell(Truth(), omega, 0.036, Branch::kLower, 2e-3);
+  const SettledDwell jump =
+      SettleDwell(kFirstOrderForm, Truth(), omega, 0.036, Branch::kLower, 2e-3);
   EXPECT_TRUE(jump.jumped);
   EXPECT_EQ(jump.side, Branch::kUpper);
   EXPECT_EQ(jump.branch, Branch::kOnly);
   // The first dwell (from rest) is not a jump even where lower does not exist.
-  EXPECT_FALSE(SettleDwell(Truth(), omega, 0.036, Branch::kLower, 0.0).jumped);
+  EXPECT_FALSE(SettleDwell(kFirstOrderForm, Truth(), omega, 0.036, Branch::kLower, 0.0).jumped);
   // Far below resonance G is monotone: one root, no branch.
   const SettledDwell single =
-      SettleDwell(Truth(), HzToRadPerSecond(38.0), 0.01, Branch::kUpper, 1e-3);
+      SettleDwell(kFirstOrderForm, Truth(), HzToRadPerSecond(38.0), 0.01, Branch::kUpper, 1e-3);
   EXPECT_EQ(single.side, Branch::kOnly);
   EXPECT_EQ(single.branch, Branch::kOnly);
   EXPECT_FALSE(single.jumped);
@@ -530,14 +539,14 @@ TEST(DwellPlanReader, AFileThatCannotBeReadIsNamedAsThePlanFile) {
     ReadDwellPlan(missing);
     ADD_FAILURE() << "no error for " << missing;
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()), missing + ": no such file; give the path of the YAML plan file");
+    EXPECT_EQ(std::string(e.what()),
+              missing + ": no such file; give the path of the YAML plan file");
   }
   try {
     ReadDwellPlan(::testing::TempDir());
     ADD_FAILURE() << "no error for a directory";
   } catch (const InputError& e) {
-    EXPECT_THAT(e.what(),
-                ::testing::EndsWith("is a folder; give the path of the YAML plan file"));
+    EXPECT_THAT(e.what(), ::testing::EndsWith("is a folder; give the path of the YAML plan file"));
   }
 }
 
