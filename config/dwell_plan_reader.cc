@@ -187,7 +187,7 @@ DwellNoise ReadNoise(const ConfigValue& value, const ConfigSource& source) {
 
 DwellPlan ReadPlan(const ConfigSource& source) {
   const ConfigValue document = DocumentValue(source);
-  const StrictMap block(document, source, {"truth", "sweeps", "noise"});
+  const StrictMap block(document, source, {"truth", "sweeps", "noise", "model"});
   DwellPlan plan;
   plan.truth = ReadTruth(
       block.Required("truth", "add truth: with eta_e, mu1, mu2, delta, alpha and omega_hz"),
@@ -195,12 +195,25 @@ DwellPlan ReadPlan(const ConfigSource& source) {
   plan.sweeps =
       ReadSweeps(block.Required("sweeps", "add sweeps: a list of one sweep or more"), source);
   if (const auto noise = block.Optional("noise")) plan.noise = ReadNoise(*noise, source);
+  if (const auto model = block.Optional("model")) plan.form = ReadModelForm(*model, source);
   std::string error;
   if (!plan.IsValid(&error)) throw source.Error(document.path, document.mark, error);
   return plan;
 }
 
 }  // namespace
+
+ModelForm ReadModelForm(const ConfigValue& value, const ConfigSource& source) {
+  const StrictMap block(value, source, {"averaging"});
+  const ConfigValue averaging = block.Required(
+      "averaging", "give averaging: first_order (the chapter's model) or second_order");
+  ModelForm form;
+  AveragingFromName(
+      ReadOneOf(averaging, source, "averaging",
+                {AveragingName(Averaging::kFirstOrder), AveragingName(Averaging::kSecondOrder)}),
+      &form.averaging);
+  return form;
+}
 
 DwellPlan ParseDwellPlan(const std::string& yaml_text, const std::string& source) {
   return ReadPlan(ConfigSource::Parse(source, yaml_text));

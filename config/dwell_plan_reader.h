@@ -25,6 +25,8 @@
 //   noise:                  # optional; default none
 //     relative_sigma: 0.01  # a *= 1 + relative_sigma N(0, 1)
 //     seed: 7               # std::mt19937_64 seed, a non-negative integer
+//   model:                  # optional; the response model the dwells follow
+//     averaging: first_order   # (default) or second_order (model_form.h)
 //
 // Keys are strict, as in identify's config (config/strict_yaml.h): an
 // unknown, misplaced or repeated key is an error, as is a value that does not
@@ -35,9 +37,15 @@
 
 #include <string>
 
+#include "dwellfit/config/config_source.h"
+#include "dwellfit/config/strict_yaml.h"
 #include "dwellfit/estimator/simulation/dwell_simulator.h"
 
 namespace dwellfit {
+
+// The `model: {averaging: first_order | second_order}` block of a plan and of
+// identify's config; an unknown name is an error at its line listing both.
+ModelForm ReadModelForm(const ConfigValue& value, const ConfigSource& source);
 
 // Parses the YAML text of a plan; `source` names it in errors (a file path).
 // Throws InputError with source, line and field for any bad content.

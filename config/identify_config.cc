@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "dwellfit/config/config_source.h"
+#include "dwellfit/config/dwell_plan_reader.h"
 #include "dwellfit/config/strict_yaml.h"
 #include "dwellfit/estimator/data/sweep_csv.h"
 
@@ -565,6 +566,15 @@ void ReadTestQuantities(const StrictMap& top, const ConfigSource& source, Identi
   }
 }
 
+// `model: {averaging: first_order | second_order}`: the response model every
+// stage evaluates (model_form.h). Read after `residual:`, whose block it
+// joins.
+void ReadModel(const StrictMap& top, const ConfigSource& source, IdentifyConfig* config) {
+  if (const auto value = top.Optional("model")) {
+    config->identification.solve.residual.form = ReadModelForm(*value, source);
+  }
+}
+
 // `units:` and `plot:`: how figures and reports show the data.
 void ReadPresentation(const StrictMap& top, const ConfigSource& source, IdentifyConfig* config) {
   if (const auto value = top.Optional("units")) {
@@ -590,6 +600,7 @@ std::vector<std::string> TopLevelKeys() {
           "initial_guess",
           "fixed",
           "stages",
+          "model",
           "residual",
           "solver",
           "penalties",
@@ -670,6 +681,7 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
   }
 
   ReadTestQuantities(top, source, &config);
+  ReadModel(top, source, &config);
   ReadPresentation(top, source, &config);
   const ConfigValue output_dir =
       top.Required("output_dir", "give the directory for the results, e.g. output_dir: out");

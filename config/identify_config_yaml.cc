@@ -236,6 +236,13 @@ std::string ConfigToYaml(const IdentifyConfig& config, ConfigKeys keys) {
     out << YAML::EndMap;
   }
   EmitTestQuantities(out, config.test);
+  // Only the second order, so that a config without the key keeps its text.
+  const ModelForm form = config.identification.solve.residual.form;
+  if (form.second_order()) {
+    out << YAML::Key << "model" << YAML::Value << YAML::BeginMap;
+    Put(out, "averaging", AveragingName(form.averaging));
+    out << YAML::EndMap;
+  }
   if (!config.units.a.empty() || !config.units.a_base.empty()) {
     out << YAML::Key << "units" << YAML::Value << YAML::BeginMap;
     if (!config.units.a.empty()) Put(out, "a", config.units.a);

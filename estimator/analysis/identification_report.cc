@@ -497,6 +497,10 @@ std::string ReportToYaml(const IdentificationReport& report) {
   out << YAML::Key << "status_message" << YAML::Value << result.message;
   out << YAML::Key << "dwellfit_version" << YAML::Value << DwellfitVersion();
   out << YAML::Key << "config" << YAML::Value << report.config_path;
+  out << YAML::Key << "model" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "averaging" << YAML::Value
+      << AveragingName(report.options.solve.residual.form.averaging);
+  out << YAML::EndMap;
   EmitParameters(report, &out);
   EmitUncertainty(report, &out);
   EmitStarts(report, &out);
@@ -554,6 +558,11 @@ std::string ReportToPredictionsCsv(const IdentificationReport& report) {
 }
 
 void PrintReport(const IdentificationReport& report, std::ostream& out) {
+  // The chapter's model goes unsaid, so that its reports keep their text.
+  if (report.options.solve.residual.form.second_order()) {
+    out << "model: second-order averaging (harmonic balance on harmonics 1 and 3; "
+           "docs/model.md)\n";
+  }
   PrintStages(report.result, out);
   out << "\n";
   PrintParameters(report, out);

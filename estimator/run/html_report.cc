@@ -229,8 +229,12 @@ std::string ReportToHtml(const IdentificationReport& report, const std::vector<N
     (file.first.rfind(kOverviewFigureStem, 0) == 0 ? overview : others).push_back(file);
   }
   const std::string overview_html = InlineSvgFigures(overview);
-  std::string body = "<p>Config: <code>" + HtmlEscape(report.config_path) + "</code></p>\n" +
-                     StatusSection(report) + EstimatesSection(report, units);
+  std::string body = "<p>Config: <code>" + HtmlEscape(report.config_path) + "</code></p>\n";
+  // The chapter's model goes unsaid, so that its pages keep their text.
+  if (report.options.solve.residual.form.second_order()) {
+    body += "<p>Model: second-order averaging (harmonic balance on harmonics 1 and 3)</p>\n";
+  }
+  body += StatusSection(report) + EstimatesSection(report, units);
   if (!overview_html.empty()) body += "<h2>Where the sweeps jump</h2>\n" + overview_html;
   body += WarningsSection(report) + SweepsSection(report) +
           ValidationSection(report.validation_intervals) + "<h2>Figures</h2>\n";

@@ -204,6 +204,8 @@ std::unique_ptr<IdentifyOutcome> ComputeIdentify(const IdentifyConfig& config, s
   report.uncertainty = std::move(uncertainty);
   // An estimated phase offset is an error source the intervals do not hold.
   if (config.test.estimate_phase_offset) report.uncertainty.warnings.push_back(run.phase_note);
+  const std::string range = SecondOrderRangeProblem(run, result.parameters[kNaturalFrequency]);
+  if (!range.empty()) report.uncertainty.warnings.push_back("at the estimate, " + range);
   std::string predictions_csv;
   RunCurves curves;
   ComputeAfterFit(run, result, &report, &predictions_csv, &curves);

@@ -171,6 +171,26 @@ void CheckPhaseConvention(const IdentifyConfig& config, const std::vector<const 
 
 }  // namespace
 
+std::string SecondOrderRangeProblem(const ResolvedRun& run, double natural_frequency_rad_s) {
+  if (!run.options.solve.residual.form.second_order()) return "";
+  const double lowest = kSecondOrderMinFrequencyRatio * natural_frequency_rad_s;
+  for (const auto* sweeps : {&run.fitted, &run.validation}) {
+    for (const Sweep* sweep : *sweeps) {
+      for (const DwellPoint& point : sweep->points) {
+        if (point.drive_frequency_rad_s >= lowest) continue;
+        return StringPrintf(
+            "%s:%d: sweep '%s' has a dwell at %.6g Hz, below %.2g w = %.6g Hz, where the "
+            "second-order model's terms (1 / (9 Omega^2 - w^2), the superharmonic resonance at "
+            "w/3) are not valid; use model: {averaging: first_order} or leave these dwells out",
+            sweep->source_file.c_str(), point.source_line, sweep->Name().c_str(),
+            RadPerSecondToHz(point.drive_frequency_rad_s), kSecondOrderMinFrequencyRatio,
+            RadPerSecondToHz(lowest));
+      }
+    }
+  }
+  return "";
+}
+
 std::vector<const Sweep*> SelectSweeps(const std::vector<Sweep>& sweeps,
                                        const std::vector<SweepSelection>& selections,
                                        const std::string& config_path, const std::string& field) {
@@ -218,6 +238,10 @@ ResolvedRun ResolveRun(const IdentifyConfig& config, std::vector<Sweep> sweeps) 
                      "the starting point is not usable (" + invalid +
                          "); give the initial guesses in the config");
   }
+  // The second order is refused, before any fit, where a dwell lies below
+  // its range at the start's natural frequency.
+  const std::string range = SecondOrderRangeProblem(run, run.options.initial[kNaturalFrequency]);
+  if (!range.empty()) throw InputError(config.config_path, 0, "model.averaging", range);
   return run;
 }
 

@@ -67,6 +67,13 @@ std::vector<const Sweep*> SelectSweeps(const std::vector<Sweep>& sweeps,
 // Fits the run's fitted sweeps from its start (IdentifyMultiStart).
 MultiStartResult FitRun(const ResolvedRun& run);
 
+// With the second-order model (model_form.h): a message naming the first
+// fitted or validation dwell below kSecondOrderMinFrequencyRatio times
+// `natural_frequency_rad_s` (its file and line); empty when there is none or
+// the model is the first order. ResolveRun refuses such a run at its start;
+// identify warns when the estimate's w puts a dwell there.
+std::string SecondOrderRangeProblem(const ResolvedRun& run, double natural_frequency_rad_s);
+
 }  // namespace dwellfit
 
 #endif  // DWELLFIT_ESTIMATOR_RUN_RESOLVED_RUN_H_

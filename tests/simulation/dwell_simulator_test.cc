@@ -495,7 +495,7 @@ TEST(DwellPlanReader, UnknownKeysGetADidYouMean) {
        "from_hz, to_hz, step_hz"},
       {std::string(kTruth) + "sweep:\n  - id: F\n",
        "2 sweep: plan.yaml:2: field 'sweep': unknown key 'sweep' at the top level (did you mean "
-       "'sweeps'?); allowed: truth, sweeps, noise"},
+       "'sweeps'?); allowed: truth, sweeps, noise, model"},
       {sweep + "noise: {relative_sigma: 0.01, sed: 7}\n",
        "9 noise.sed: plan.yaml:9: field 'noise.sed': unknown key 'sed' in 'noise' (did you mean "
        "'seed'?); allowed: relative_sigma, seed"},
