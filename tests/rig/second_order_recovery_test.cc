@@ -12,6 +12,7 @@
 #include "dwellfit/config/dwell_plan_reader.h"
 #include "dwellfit/config/identify_config.h"
 #include "dwellfit/config/rig_config_reader.h"
+#include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/rig/rig_simulator.h"
 #include "dwellfit/estimator/run/resolved_run.h"
 #include "gtest/gtest.h"
@@ -79,6 +80,30 @@ TEST_F(SecondOrderRecovery, SecondOrderRecoversTheTruthWhereTheFirstOrderMissesA
   }
   std::cout << "alpha_e: second order " << 100.0 * error(AlphaE(second), AlphaE(kTruth))
             << " %, first order " << 100.0 * error(AlphaE(first), AlphaE(kTruth)) << " %\n";
+}
+
+// Below 0.5 w (here w = 100 Hz, the dwells at 38-46 Hz) the second order is
+// refused before any fit, naming the dwell; the first order is not.
+TEST_F(SecondOrderRecovery, SecondOrderIsRefusedWithADwellBelowHalfTheNaturalFrequency) {
+  for (const std::string averaging : {"first_order", "second_order"}) {
+    const std::vector<ConfigOverride> overrides = {
+        {"initial_guess.omega_hz", "100"}, {"validate", "[]"}, {"model.averaging", averaging}};
+    const IdentifyConfig config = LoadIdentifyConfig(kDataset + "/beam.yaml", overrides);
+    if (averaging == "first_order") {
+      EXPECT_NO_THROW(ResolveRun(config, *truth_));
+      continue;
+    }
+    try {
+      ResolveRun(config, *truth_);
+      ADD_FAILURE() << "no InputError";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), "model.averaging");
+      EXPECT_NE(std::string(e.what()).find("below 0.5 w = 50 Hz"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("sweep 'F0.01/up' has a dwell at 38 Hz"),
+                std::string::npos)
+          << e.what();
+    }
+  }
 }
 
 }  // namespace
