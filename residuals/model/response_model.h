@@ -70,6 +70,10 @@ struct ResponseCoefficients {
   // and G = P^2 + Q^2 is of degree ten.
   T k5 = T(0.0), k6 = T(0.0), k7 = T(0.0);
   bool higher_order = false;
+  // Whether k5..k7 are a correction to the first-order terms (the second-order
+  // form) rather than a model's own terms: a correction holds only where it is
+  // small (CorrectionLimit, stable_root.h).
+  bool correction = false;
 
   // `p` is the parameter block (ParameterIndex layout); `omega_drive` in rad/s.
   template <typename D>
@@ -100,6 +104,7 @@ struct ResponseCoefficients {
     k->k6 = (3.0 / 32.0) * g * g / eta_d;
     k->k7 = -0.45 * t.scaled_mu2 * omega_drive * g / eta_d;
     k->higher_order = true;
+    k->correction = true;
   }
 
   // The amplitude `a` is a T, or a double where it is a constant (a root

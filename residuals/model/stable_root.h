@@ -47,8 +47,22 @@ struct TurningPoints {
   double a_upper_end = 0.0;  // local minimum of G: the upper branch ends here
   // Where the upper branch ends going up: a third turning point (a local
   // maximum of G, only with terms beyond the chapter's), else infinity.
+  // Where G folds nowhere within a correction's limit (CorrectionLimit), the
+  // first turning point beyond it, if any: the single branch ends there.
   double a_upper_limit = std::numeric_limits<double>::infinity();
 };
+
+// The amplitude up to which terms that correct the first-order model (the
+// second-order form, ResponseCoefficients::correction) hold: with k4 k6 < 0,
+// Q / a = k3 + k4 a^2 + k6 a^4 shifts the backbone monotonically in a^2 only
+// up to a^2 = -k4 / (2 k6), where d(Q/a)/d(a^2) = k4 + 2 k6 a^2 = 0; beyond it
+// the correction would outweigh and reverse the first-order term it corrects
+// (on a softening cubic, a second fold pair that is no response of the
+// structure). Infinity for the chapter's member and the family's own terms.
+inline double CorrectionLimit(const ResponseCoefficients<double>& k) {
+  if (!k.correction || !(k.k4 * k.k6 < 0.0)) return std::numeric_limits<double>::infinity();
+  return std::sqrt(-k.k4 / (2.0 * k.k6));
+}
 
 namespace internal {
 
@@ -95,7 +109,13 @@ inline TurningPoints FindTurningPointsOfFamily(const ResponseCoefficients<double
     if (a > 0.0 && std::isfinite(a)) ends.push_back(a);
   }
   std::sort(ends.begin(), ends.end());
-  if (ends.size() < 2) return tp;
+  // The fold pair must lie within a correction's limit; the next turning
+  // point bounds its upper branch wherever it lies.
+  const double limit = CorrectionLimit(k);
+  if (ends.size() < 2 || ends[1] > limit) {
+    if (ends.size() >= 2) tp.a_upper_limit = ends[0];
+    return tp;
+  }
   tp.a_lower_end = ends[0];
   tp.a_upper_end = ends[1];
   if (ends.size() > 2) tp.a_upper_limit = ends[2];
@@ -178,7 +198,14 @@ inline StableRoot SolveStableRoot(const ResponseCoefficients<double>& k, double 
   const double guess = a_guess > 0.0 ? a_guess : std::numeric_limits<double>::quiet_NaN();
   const TurningPoints tp = FindTurningPoints(k, branch);
   if (!tp.exist) {
-    const double hi = upper_bracket_end(guess > 0.0 ? guess : std::sqrt(a_base));
+    // G rises up to a_upper_limit (a turning point beyond a correction's
+    // limit) or without end: the branch ends there if G stays below the level.
+    if (std::isfinite(tp.a_upper_limit) && !(k.G(tp.a_upper_limit) > target)) {
+      return {tp.a_upper_limit, RootStatus::kBranchEnd, Branch::kOnly};
+    }
+    const double hi = std::isfinite(tp.a_upper_limit)
+                          ? tp.a_upper_limit
+                          : upper_bracket_end(guess > 0.0 ? guess : std::sqrt(a_base));
     if (!std::isfinite(hi)) return root;
     root.a = BracketedNewton(residual, 0.0, hi, guess);
     root.status = std::isfinite(root.a) ? RootStatus::kOnBranch : RootStatus::kFailed;
@@ -311,6 +338,7 @@ ResponseCoefficients<double> ScalarCoefficients(const ResponseCoefficients<T>& k
   scalar.k6 = ScalarPart(k.k6);
   scalar.k7 = ScalarPart(k.k7);
   scalar.higher_order = k.higher_order;
+  scalar.correction = k.correction;
   return scalar;
 }
 

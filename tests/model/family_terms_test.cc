@@ -209,5 +209,56 @@ TEST(FamilyTerms, TheLiftedRootsDerivativeInTheNewTermsPassesTheGradientChecker)
   EXPECT_GT(std::abs(results.jacobians[0](0, 1)), 1e-3);
 }
 
+// The second-order form on a softening cubic (the truth of
+// datasets/softening-numerical): k4 < 0 < k6, so Q / a turns back at large a
+// and G folds a second time near 0.05-0.07 m, a fold of no structure (the
+// correction there outweighs the cubic term it corrects).
+ResponseCoefficients<double> SofteningSecondOrder(double hz) {
+  const ParameterVector truth = {50.0, 0.5, 100.0, 1e3, -4e8, HzToRadPerSecond(60.0)};
+  return ResponseCoefficients<double>::FromParameters(kSecondOrderForm, truth.data(),
+                                                      HzToRadPerSecond(hz));
+}
+
+TEST(FamilyTerms, ASecondOrderFoldBeyondTheCorrectionsLimitIsNoFold) {
+  // Where d(Q/a)/da changes sign: the limit, found on a grid.
+  const ResponseCoefficients<double> at60 = SofteningSecondOrder(60.0);
+  const std::vector<double> backbone_turn = GridRoots(
+      [&at60](double a) { return at60.k4 * a + 2.0 * at60.k6 * a * a * a; }, 1e-6, 0.1, 100000);
+  ASSERT_EQ(backbone_turn.size(), 1u);
+  EXPECT_NEAR(CorrectionLimit(at60), backbone_turn[0], 1e-12);
+  // At 60 Hz, above the softening fold's frequencies, G turns only beyond the
+  // limit: no fold, and the branch G rises on ends at the first turning point.
+  const std::vector<double> turning =
+      GridRoots([&at60](double a) { return at60.dG(a); }, 1e-6, 0.1, 100000);
+  ASSERT_EQ(turning.size(), 2u);
+  ASSERT_GT(turning[0], backbone_turn[0]);
+  const TurningPoints tp = FindTurningPoints(at60);
+  EXPECT_FALSE(tp.exist);
+  EXPECT_NEAR(tp.a_upper_limit, turning[0], 1e-12);
+  // A dwell labelled upper there gets the one root below the limit (the
+  // grid's first sign change of G - a_base^2), not a root past the second
+  // fold pair, and as a root, not a branch end.
+  const double a_base = std::sqrt(at60.G(4e-3));
+  const std::vector<double> roots =
+      GridRoots([&](double a) { return at60.G(a) - a_base * a_base; }, 1e-6, 0.1, 100000);
+  ASSERT_FALSE(roots.empty());
+  const StableRoot root = SolveStableRoot(at60, a_base, Branch::kUpper, 0.06);
+  EXPECT_EQ(root.status, RootStatus::kOnBranch);
+  EXPECT_NEAR(root.a, roots[0], 1e-12);
+  // At 59 Hz the softening fold lies within the limit: the fold pair is the
+  // grid's first two turning points, the third caps the upper branch.
+  const ResponseCoefficients<double> at59 = SofteningSecondOrder(59.0);
+  const std::vector<double> turning59 =
+      GridRoots([&at59](double a) { return at59.dG(a); }, 1e-6, 0.1, 100000);
+  ASSERT_EQ(turning59.size(), 4u);
+  const TurningPoints tp59 = FindTurningPoints(at59);
+  ASSERT_TRUE(tp59.exist);
+  EXPECT_NEAR(tp59.a_lower_end, turning59[0], 1e-12);
+  EXPECT_NEAR(tp59.a_upper_end, turning59[1], 1e-12);
+  EXPECT_NEAR(tp59.a_upper_limit, turning59[2], 1e-12);
+  EXPECT_LT(turning59[1], CorrectionLimit(at59));
+  EXPECT_GT(turning59[2], CorrectionLimit(at59));
+}
+
 }  // namespace
 }  // namespace dwellfit
