@@ -34,6 +34,8 @@ DEFINE_string(target, "0.01,0.005,0.0005,0.10",
               "bounds on the 95 % half-width relative to the estimate: alpha_e,eta_e,w,mu1");
 DEFINE_string(output_dir, ".", "folder for design_study.csv, design_study_fits.csv, the figure");
 DEFINE_bool(figures, true, "render the figure with gnuplot");
+DEFINE_string(averaging, "config",
+              "the fits' model: config (the config's model key), first_order or second_order");
 
 namespace {
 
@@ -55,6 +57,14 @@ dwellfit::DesignStudyOptions OptionsFromFlags() {
     throw dwellfit::InputError("--target", 0, t,
                                "give four relative bounds alpha_e,eta_e,w,mu1, e.g. "
                                "0.01,0.005,0.0005,0.1");
+  }
+  if (FLAGS_averaging != "config") {
+    dwellfit::Averaging averaging;
+    if (!dwellfit::AveragingFromName(FLAGS_averaging, &averaging)) {
+      throw dwellfit::InputError("--averaging", 0, FLAGS_averaging,
+                                 "give config, first_order or second_order");
+    }
+    options.averaging = averaging;
   }
   std::string error;
   if (!options.IsValid(&error)) throw dwellfit::InputError("design_study flags", 0, "", error);

@@ -457,11 +457,15 @@ DesignStudyResult RunDesignStudy(const DesignStudyCase& study, const DesignStudy
   if (!options.IsValid(&error)) throw InputError("design_study options: " + error);
   DesignStudyResult result;
   result.case_name = study.name;
+  DesignStudyCase fitted_as = study;
+  if (options.averaging) {
+    fitted_as.config.identification.solve.residual.form.averaging = *options.averaging;
+  }
   for (int i = 0; i < options.seeds; ++i) {
     const std::uint64_t seed = options.first_seed + i;
     for (bool closed : {false, true}) {
-      ArmRun arm =
-          closed ? RunClosedLoop(study, options, seed) : RunStandardProtocol(study, options, seed);
+      ArmRun arm = closed ? RunClosedLoop(fitted_as, options, seed)
+                          : RunStandardProtocol(fitted_as, options, seed);
       if (progress) {
         *progress << StringPrintf("%s seed %llu %-11s: %s at %.0f s, %zu dwells, %zu fits\n",
                                   study.name.c_str(), static_cast<unsigned long long>(seed),

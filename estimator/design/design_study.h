@@ -28,6 +28,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -73,6 +74,8 @@ struct DesignStudyOptions {
   // often ends on the other attractor); the best such candidate is taken.
   int hysteresis_steps = 2;           // >= 1
   int max_closed_loop_dwells = 2000;  // a guard besides the budget (>= 1)
+  // The fits' model (both arms, and next_dwell's); unset: the config's.
+  std::optional<Averaging> averaging;
   bool IsValid(std::string* error) const;
 };
 
