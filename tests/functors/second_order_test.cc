@@ -12,6 +12,7 @@
 #include "dwellfit/residuals/functors/vertical_error_residual.h"
 #include "dwellfit/residuals/model/fold_point.h"
 #include "gtest/gtest.h"
+#include "jacobian_check.h"
 
 namespace dwellfit {
 namespace {
@@ -75,30 +76,6 @@ TEST(SecondOrderModel, DerivativeInDriveFrequencyMatchesCentralDifferencesOfG) {
   }
 }
 
-// As in vertical_error_residual_test.cc: column j scaled by |p_j|, relative
-// to the largest scaled column, Ridders' steps from 1e-6 relative.
-void ExpectGradientMatchesFiniteDifferences(const ceres::CostFunction& cost, ParameterVector p,
-                                            double tolerance) {
-  ceres::NumericDiffOptions numeric;
-  numeric.ridders_relative_initial_step_size = 1e-6;
-  const std::vector<const ceres::Manifold*>* euclidean = nullptr;
-  ceres::GradientChecker checker(&cost, euclidean, numeric);
-  ceres::GradientChecker::ProbeResults results;
-  std::vector<double*> blocks = {p.data()};
-  checker.Probe(blocks.data(), 1e-6, &results);
-  ASSERT_TRUE(results.return_value);
-  const Eigen::MatrixXd& user = results.jacobians[0];
-  const Eigen::MatrixXd& numeric_jacobian = results.numeric_jacobians[0];
-  double largest = 0.0;
-  for (int j = 0; j < kNumParameters; ++j) largest = std::max(largest, std::abs(user(0, j) * p[j]));
-  ASSERT_GT(largest, 0.0);
-  for (int j = 0; j < kNumParameters; ++j) {
-    EXPECT_LE(std::abs(user(0, j) - numeric_jacobian(0, j)) * std::abs(p[j]), tolerance * largest)
-        << ParameterName(j) << ": autodiff " << user(0, j) << " finite differences "
-        << numeric_jacobian(0, j);
-  }
-}
-
 TEST(SecondOrderModel, VerticalErrorGradientCheckerPassesOnBothBranchesNearTheJumps) {
   struct Dwell {
     double hz, a_base;
@@ -124,7 +101,7 @@ TEST(SecondOrderModel, VerticalErrorGradientCheckerPassesOnBothBranchesNearTheJu
                    << d.hz << " Hz, a_base " << d.a_base << " " << BranchName(d.branch));
       const std::unique_ptr<ceres::CostFunction> cost(VerticalErrorResidual::Create(
           kSecondOrderForm, omega, d.a_base, root.a * (1.0 + d.offset), d.branch, error, 1.0));
-      ExpectGradientMatchesFiniteDifferences(*cost, kTruth, 1e-6);
+      ExpectJacobianMatchesFiniteDifferences(*cost, kTruth, 1e-6);
     }
   }
 }

@@ -6,6 +6,7 @@
 #include "ceres/gradient_checker.h"
 #include "dwellfit/residuals/functors/algebraic_residual.h"
 #include "gtest/gtest.h"
+#include "jacobian_check.h"
 
 namespace dwellfit {
 namespace {
@@ -32,36 +33,6 @@ double Evaluate(const ceres::CostFunction& cost, ParameterVector p) {
   double residual = 0.0;
   EXPECT_TRUE(cost.Evaluate(blocks, &residual, nullptr));
   return residual;
-}
-
-// Compares the autodiff Jacobian with ceres::GradientChecker's finite
-// differences in the solver's units: column j scaled by |p_j| (a relative
-// change of each parameter), relative to the largest scaled column. An entry
-// that is exactly zero (the branch end does not move with eta_e) is then
-// compared with the finite difference's round-off, not divided by it.
-void ExpectGradientMatchesFiniteDifferences(const ceres::CostFunction& cost, ParameterVector p) {
-  // GradientChecker differentiates by Ridders' extrapolation. Its default
-  // first step (a large fraction of each parameter) crosses folds and changes
-  // branches; the residual is a local function of the parameters near a
-  // jump, so start from steps of 1e-6 relative.
-  ceres::NumericDiffOptions numeric;
-  numeric.ridders_relative_initial_step_size = 1e-6;
-  const std::vector<const ceres::Manifold*>* euclidean = nullptr;
-  ceres::GradientChecker checker(&cost, euclidean, numeric);
-  ceres::GradientChecker::ProbeResults results;
-  std::vector<double*> blocks = {p.data()};
-  checker.Probe(blocks.data(), 1e-6, &results);
-  ASSERT_TRUE(results.return_value);
-  const Eigen::MatrixXd& user = results.jacobians[0];
-  const Eigen::MatrixXd& numeric_jacobian = results.numeric_jacobians[0];
-  double largest = 0.0;
-  for (int j = 0; j < kNumParameters; ++j) largest = std::max(largest, std::abs(user(0, j) * p[j]));
-  ASSERT_GT(largest, 0.0);
-  for (int j = 0; j < kNumParameters; ++j) {
-    EXPECT_LE(std::abs(user(0, j) - numeric_jacobian(0, j)) * std::abs(p[j]), 1e-6 * largest)
-        << ParameterName(j) << ": autodiff " << user(0, j) << " finite differences "
-        << numeric_jacobian(0, j);
-  }
 }
 
 TEST(VerticalErrorResidual, VanishesOnTheModelCurveAndMeasuresTheVerticalDistance) {
@@ -109,7 +80,7 @@ TEST(VerticalErrorResidual, GradientCheckerPassesOnBothBranchesNearTheJumps) {
                                       << BranchName(d.branch));
       std::unique_ptr<ceres::CostFunction> cost(VerticalErrorResidual::Create(
           kFirstOrderForm, d.omega, d.a_base, d.a, d.branch, error, 1.0));
-      ExpectGradientMatchesFiniteDifferences(*cost, Truth());
+      ExpectJacobianMatchesFiniteDifferences(*cost, Truth(), 1e-6);
     }
   }
 }
@@ -125,7 +96,7 @@ TEST(VerticalErrorResidual, BranchEndExtensionIsContinuousAndDifferentiable) {
   std::unique_ptr<ceres::CostFunction> cost(VerticalErrorResidual::Create(
       kFirstOrderForm, omega, 0.01, 4.8e-3, Branch::kUpper, ErrorMeasure::kAbsolute, 1.0));
   EXPECT_NEAR(Evaluate(*cost, Truth()), 4.8e-3 - tp.a_upper_end, 1e-15);
-  ExpectGradientMatchesFiniteDifferences(*cost, Truth());
+  ExpectJacobianMatchesFiniteDifferences(*cost, Truth(), 1e-6);
 
   // Continuity: as a_base rises through the branch end's level the residual
   // moves continuously from the turning point onto the branch.
@@ -193,7 +164,7 @@ TEST(AlgebraicResidual, VanishesAtTheTruthAndPassesTheGradientChecker) {
   std::unique_ptr<ceres::CostFunction> off(
       AlgebraicResidual::Create(kFirstOrderForm, d.omega, d.a_base, d.a * 1.02, 1.0));
   EXPECT_GT(std::abs(Evaluate(*off, Truth())), 1e-3);
-  ExpectGradientMatchesFiniteDifferences(*off, Truth());
+  ExpectJacobianMatchesFiniteDifferences(*off, Truth(), 1e-6);
 }
 
 TEST(VerticalErrorResidual, RejectsAnUndefinedEvaluation) {
