@@ -279,18 +279,64 @@ inline bool CertifiedOnBranch(const ResponseCoefficients<double>& k, double r, B
   return 2.0 * c2 + q_min > 0.0;
 }
 
+// The same certificate for a member with terms beyond the chapter's, from
+// h(a) = sum_m b_m a^m, b_m = (m + 2) c_(m+2), m = 0..8 (b_0 = 2 c2 >= 0):
+//   lower: h > 0 on (0, r]: b_0 + sum over m >= 1 of min(0, b_m) r^m > 0
+//     (each negative term is most negative at a = r); G rises on (0, r], so
+//     r lies below every turning point: the lower branch's root, wherever
+//     the fold pair lies (within CorrectionLimit or not).
+//   upper: h has at most two positive roots (Descartes: at most two sign
+//     changes among b_0..b_8), so G folds at most once, and h > 0 on
+//     [r, inf) (h's Taylor coefficients at r all >= 0, h(r) > 0): r lies past
+//     every turning point, on the upper branch; and r within
+//     CorrectionLimit, so that the fold pair below it is named.
+//   only: h has no positive root (no sign change): G rises everywhere and r
+//     is its one root.
+inline bool CertifiedOnBranchOfFamily(const ResponseCoefficients<double>& k, double r,
+                                      Branch branch) {
+  const std::array<double, 11> c = k.Coefficients();
+  std::array<double, 9> b;
+  for (int m = 0; m < 9; ++m) b[m] = (m + 2) * c[m + 2];
+  int sign_changes = 0;
+  double last = b[0];
+  for (int m = 1; m < 9; ++m) {
+    if (b[m] == 0.0) continue;
+    if ((b[m] < 0.0) != (last < 0.0)) ++sign_changes;
+    last = b[m];
+  }
+  if (branch == Branch::kOnly) return sign_changes == 0 && b[0] > 0.0;
+  if (branch == Branch::kLower) {
+    double bound = b[0], power = 1.0;
+    for (int m = 1; m < 9; ++m) {
+      power *= r;
+      bound += std::min(0.0, b[m]) * power;
+    }
+    return bound > 0.0;
+  }
+  if (sign_changes > 2 || r > CorrectionLimit(k)) return false;
+  // Taylor coefficients at r by repeated Horner steps: b_j becomes h^(j)(r) / j!.
+  for (int i = 0; i < 8; ++i) {
+    for (int j = 7; j >= i; --j) b[j] += r * b[j + 1];
+  }
+  if (!(b[0] > 0.0)) return false;
+  return std::all_of(b.begin(), b.end(), [](double x) { return x >= 0.0; });
+}
+
 }  // namespace internal
 
 // The same root as SolveStableRoot, faster where the measured amplitude is
 // near its branch: plain Newton from `a_guess`, accepted only with a
-// certificate that the root lies on `branch` (internal::CertifiedOnBranch);
-// anything else falls back to SolveStableRoot. The returned `branch` is the
+// certificate that the root lies on `branch` (internal::CertifiedOnBranch,
+// or CertifiedOnBranchOfFamily with terms beyond the chapter's, which also
+// certifies the one root of a G without fold for kOnly); anything else falls
+// back to SolveStableRoot. The returned `branch` is the
 // requested one even where G is monotone.
 inline StableRoot SolveStableRootNear(const ResponseCoefficients<double>& k, double a_base,
                                       Branch branch, double a_guess) {
-  // The certificate is the sextic's; a model with terms beyond the chapter's always
-  // brackets its branch between turning points.
-  if (branch != Branch::kOnly && a_guess > 0.0 && !k.higher_order) {
+  // The sextic's certificate, or the family's (which also certifies a
+  // single-valued G's one root); anything uncertified brackets its branch
+  // between turning points.
+  if (a_guess > 0.0 && (branch != Branch::kOnly || k.higher_order)) {
     const double target = a_base * a_base;
     double a = a_guess;
     for (int i = 0; i < 30; ++i) {
@@ -301,7 +347,9 @@ inline StableRoot SolveStableRootNear(const ResponseCoefficients<double>& k, dou
       a -= step;
       if (!(a > 0.0) || !std::isfinite(a)) break;
       if (std::abs(step) <= 4.0 * std::numeric_limits<double>::epsilon() * a) {
-        if (internal::CertifiedOnBranch(k, a, branch)) return {a, RootStatus::kOnBranch, branch};
+        const bool certified = k.higher_order ? internal::CertifiedOnBranchOfFamily(k, a, branch)
+                                              : internal::CertifiedOnBranch(k, a, branch);
+        if (certified) return {a, RootStatus::kOnBranch, branch};
         break;
       }
     }

@@ -260,5 +260,48 @@ TEST(FamilyTerms, ASecondOrderFoldBeyondTheCorrectionsLimitIsNoFold) {
   EXPECT_GT(turning59[2], CorrectionLimit(at59));
 }
 
+// The family's certificate (internal::CertifiedOnBranchOfFamily) lets the
+// warm-started Newton step stand only where it found the branch's root: on
+// the second order of both cases, over frequencies, levels, branches and
+// guesses, every certified root equals the bracketed solve's, and most
+// dwells are certified.
+TEST(FamilyTerms, CertifiedNewtonRootsAreTheBracketedSolvesRoots) {
+  const ParameterVector beam = {100.0, 0.2, 300.0, 1e4, 9e8, HzToRadPerSecond(40.0)};
+  const ParameterVector softening = {50.0, 0.5, 100.0, 1e3, -4e8, HzToRadPerSecond(60.0)};
+  int certified = 0, compared = 0;
+  for (const ParameterVector* p : {&beam, &softening}) {
+    const double f0 = (*p)[kNaturalFrequency] / kTwoPi;
+    for (double hz = 0.9 * f0; hz <= 1.1 * f0; hz += 0.005 * f0) {
+      const auto k = ResponseCoefficients<double>::FromParameters(kSecondOrderForm, p->data(),
+                                                                  HzToRadPerSecond(hz));
+      for (double a_base : {0.002, 0.01, 0.03, 0.05}) {
+        for (Branch branch : {Branch::kLower, Branch::kUpper, Branch::kOnly}) {
+          const StableRoot exact = SolveStableRoot(k, a_base, branch, 0.0);
+          if (exact.status != RootStatus::kOnBranch) continue;
+          for (double guess : {0.9 * exact.a, 1.1 * exact.a}) {
+            const StableRoot near = SolveStableRootNear(k, a_base, branch, guess);
+            ++compared;
+            ASSERT_EQ(near.status, RootStatus::kOnBranch);
+            EXPECT_NEAR(near.a, exact.a, 1e-12 * exact.a)
+                << hz << " Hz, a_base " << a_base << ", " << BranchName(branch);
+            certified += internal::CertifiedOnBranchOfFamily(k, near.a, branch) ? 1 : 0;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(compared, 500);
+  EXPECT_GT(certified, compared / 2);
+  // Where G folds twice the upper branch is never certified (h has four
+  // positive roots), the lower one below the first turning point is.
+  const ResponseCoefficients<double> k = TwoFoldPairs();
+  const TurningPoints tp = FindTurningPoints(k);
+  ASSERT_TRUE(tp.exist);
+  EXPECT_FALSE(internal::CertifiedOnBranchOfFamily(k, 0.5 * (tp.a_upper_end + tp.a_upper_limit),
+                                                   Branch::kUpper));
+  EXPECT_TRUE(internal::CertifiedOnBranchOfFamily(k, 0.5 * tp.a_lower_end, Branch::kLower));
+  EXPECT_FALSE(internal::CertifiedOnBranchOfFamily(k, 0.5 * tp.a_lower_end, Branch::kOnly));
+}
+
 }  // namespace
 }  // namespace dwellfit
