@@ -97,16 +97,22 @@ TEST(FamilyTerms, DerivativesAgreeWithCentralDifferences) {
   }
 }
 
+// The named turning points are the grid's first three sign changes of dG/da:
+// the fold pair, then the cap of the upper branch.
+void ExpectNamedTurningPoints(const TurningPoints& tp, const std::vector<double>& turning) {
+  ASSERT_GE(turning.size(), 3u);
+  ASSERT_TRUE(tp.exist);
+  EXPECT_NEAR(tp.a_lower_end, turning[0], 1e-12);
+  EXPECT_NEAR(tp.a_upper_end, turning[1], 1e-12);
+  EXPECT_NEAR(tp.a_upper_limit, turning[2], 1e-12);
+}
+
 TEST(FamilyTerms, TurningPointsAreTheFirstThreeSignChangesOfTheSlope) {
   const ResponseCoefficients<double> k = TwoFoldPairs();
   const std::vector<double> turning =
       GridRoots([&k](double a) { return k.dG(a); }, 1e-6, 3.0, 300000);
   ASSERT_EQ(turning.size(), 4u);
-  const TurningPoints tp = FindTurningPoints(k);
-  ASSERT_TRUE(tp.exist);
-  EXPECT_NEAR(tp.a_lower_end, turning[0], 1e-12);
-  EXPECT_NEAR(tp.a_upper_end, turning[1], 1e-12);
-  EXPECT_NEAR(tp.a_upper_limit, turning[2], 1e-12);
+  ExpectNamedTurningPoints(FindTurningPoints(k), turning);
 }
 
 TEST(FamilyTerms, FindsAllFiveFixedPointsAndTheStableRootsOfTheNamedBranches) {
@@ -251,11 +257,7 @@ TEST(FamilyTerms, ASecondOrderFoldBeyondTheCorrectionsLimitIsNoFold) {
   const std::vector<double> turning59 =
       GridRoots([&at59](double a) { return at59.dG(a); }, 1e-6, 0.1, 100000);
   ASSERT_EQ(turning59.size(), 4u);
-  const TurningPoints tp59 = FindTurningPoints(at59);
-  ASSERT_TRUE(tp59.exist);
-  EXPECT_NEAR(tp59.a_lower_end, turning59[0], 1e-12);
-  EXPECT_NEAR(tp59.a_upper_end, turning59[1], 1e-12);
-  EXPECT_NEAR(tp59.a_upper_limit, turning59[2], 1e-12);
+  ExpectNamedTurningPoints(FindTurningPoints(at59), turning59);
   EXPECT_LT(turning59[1], CorrectionLimit(at59));
   EXPECT_GT(turning59[2], CorrectionLimit(at59));
 }
