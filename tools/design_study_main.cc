@@ -32,6 +32,9 @@ DEFINE_int32(hysteresis_steps, 2,
 DEFINE_double(settle_time_constants, 5.0, "next_dwell's settling cost model k");
 DEFINE_string(target, "0.01,0.005,0.0005,0.10",
               "bounds on the 95 % half-width relative to the estimate: alpha_e,eta_e,w,mu1");
+DEFINE_bool(simultaneous, true,
+            "judge the target and the coverage on simultaneous 95 % intervals of the four "
+            "quantities (each at 0.95^(1/4)); false: each quantity's own 95 % interval");
 DEFINE_string(output_dir, ".", "folder for design_study.csv, design_study_fits.csv, the figure");
 DEFINE_bool(figures, true, "render the figure with gnuplot");
 DEFINE_string(averaging, "config",
@@ -50,6 +53,7 @@ dwellfit::DesignStudyOptions OptionsFromFlags() {
   options.level_step_max = FLAGS_level_step_max;
   options.settle_time_constants = FLAGS_settle_time_constants;
   options.hysteresis_steps = FLAGS_hysteresis_steps;
+  options.target.simultaneous = FLAGS_simultaneous;
   const std::string& t = FLAGS_target;
   double* b = options.target.relative_half_width.data();
   char tail = 0;

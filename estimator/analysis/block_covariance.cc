@@ -62,13 +62,6 @@ std::vector<double*> FreeBlocks(const FitDescription& fit) {
   return blocks;
 }
 
-// Student's t (s estimated) or the normal (s known) 0.975 quantile.
-double IntervalQuantile(bool noise_known, int degrees_of_freedom) {
-  if (noise_known) return boost::math::quantile(boost::math::normal_distribution<double>(), 0.975);
-  return boost::math::quantile(boost::math::students_t_distribution<double>(degrees_of_freedom),
-                               0.975);
-}
-
 BlockCovariance Unavailable(BlockCovariance c, const std::string& message) {
   c.available = false;
   c.message = message;
@@ -242,6 +235,18 @@ void SetIntervals(BlockCovariance* c) {
 }
 
 }  // namespace
+
+double IntervalQuantile(bool noise_known, int degrees_of_freedom, double confidence) {
+  const double p = 0.5 * (1.0 + confidence);
+  if (noise_known) return boost::math::quantile(boost::math::normal_distribution<double>(), p);
+  return boost::math::quantile(boost::math::students_t_distribution<double>(degrees_of_freedom), p);
+}
+
+double SimultaneousIntervalQuantile(bool noise_known, int degrees_of_freedom, int count,
+                                    double confidence) {
+  return IntervalQuantile(noise_known, degrees_of_freedom,
+                          std::pow(confidence, 1.0 / static_cast<double>(count)));
+}
 
 void IntervalsFromCovariance(BlockCovariance* c) {
   for (size_t i = 0; i < c->values.size(); ++i) c->ci95_low[i] = c->ci95_high[i] = c->values[i];

@@ -80,6 +80,20 @@ struct BlockCovariance {
   Eigen::VectorXd unit_scale;      // physical change per unit of each free normalised coordinate
 };
 
+// q of two-sided intervals p -/+ q se at `confidence` (0.95: the 0.975
+// quantile): Student's t with `degrees_of_freedom` (n - k, s estimated) or the
+// normal (s known). `degrees_of_freedom` >= 1 unless `noise_known`;
+// 0 < confidence < 1.
+double IntervalQuantile(bool noise_known, int degrees_of_freedom, double confidence = 0.95);
+
+// q of simultaneous intervals for `count` (>= 1) quantities: each at
+// confidence^(1/count) (Sidak), so that all `count` hold together with
+// probability at least `confidence` for jointly normal estimates, whatever
+// their correlation (Sidak's inequality; equality when independent). With
+// s estimated each is Student's t at that level.
+double SimultaneousIntervalQuantile(bool noise_known, int degrees_of_freedom, int count,
+                                    double confidence = 0.95);
+
 // Standard errors sqrt(C_jj) and intervals value -/+ q se of the free
 // entries from `covariance` and `interval_quantile`; fixed entries [value, value].
 void IntervalsFromCovariance(BlockCovariance* c);

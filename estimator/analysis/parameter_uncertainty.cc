@@ -196,6 +196,7 @@ void CopyCounts(const BlockCovariance& c, ParameterUncertainty* u) {
   u->num_points = c.num_points;
   u->num_free = c.num_free;
   u->degrees_of_freedom = c.degrees_of_freedom;
+  u->noise_known = c.all_standardised;
   u->noise_sigma = c.noise_sigma;
   u->reduced_chi_square = c.reduced_chi_square;
   u->collinearity = c.collinearity;

@@ -81,6 +81,7 @@ struct ParameterUncertainty {
   int num_points = 0;                // n
   int num_free = 0;                  // k
   int degrees_of_freedom = 0;        // n - k
+  bool noise_known = false;          // every dwell divided by its point sigma (s = 1)
   double interval_quantile = 0.0;    // q: t_{0.975, n-k}, or the normal's 1.95996
   ParameterVector standard_error{};  // 0 for fixed parameters
   // The reported 95 % intervals: the profile's (+/- infinity at an open end,

@@ -8,6 +8,7 @@
 
 #include "dwellfit/config/dwell_plan_reader.h"
 #include "dwellfit/config/rig_config_reader.h"
+#include "dwellfit/estimator/analysis/block_covariance.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/name_table.h"
 #include "dwellfit/estimator/common/string_printf.h"
@@ -51,9 +52,14 @@ std::vector<Sweep> ProcessedSweeps(const Measured& measured,
   return sweeps;
 }
 
-// The study's quantities' values and 95 % half-widths from a design basis.
-void Intervals(const DesignBasis& basis, StudyFit* fit) {
+// The study's quantities' values and 95 % half-widths from a design basis,
+// simultaneous for the four or each its own (PrecisionTarget::simultaneous).
+void Intervals(const DesignBasis& basis, bool simultaneous, StudyFit* fit) {
   const int parameter[kStudyQuantities] = {-1, kEtaE, kNaturalFrequency, kMu1};
+  fit->interval_quantile = simultaneous
+                               ? SimultaneousIntervalQuantile(
+                                     basis.noise_known, basis.degrees_of_freedom, kStudyQuantities)
+                               : basis.interval_quantile;
   for (int i = 0; i < kStudyQuantities; ++i) {
     ParameterGradient c;
     double value = 0.0;
@@ -65,7 +71,7 @@ void Intervals(const DesignBasis& basis, StudyFit* fit) {
     }
     fit->value[i] = value;
     fit->half_width[i] =
-        basis.interval_quantile * std::sqrt(std::max(c.dot(basis.covariance * c), 0.0));
+        fit->interval_quantile * std::sqrt(std::max(c.dot(basis.covariance * c), 0.0));
   }
 }
 
@@ -134,7 +140,7 @@ StudyFit FitDwells(const DesignStudyCase& study, const Measured& measured,
   }
   *estimate = result.parameters;
   fit.has_intervals = true;
-  Intervals(*basis, &fit);
+  Intervals(*basis, target.simultaneous, &fit);
   fit.worst_ratio = WorstRatio(fit, target, nullptr);
   fit.met = fit.worst_ratio <= 1.0;
   return fit;
@@ -241,7 +247,7 @@ std::array<double, kStudyQuantities> StudyTruth(const DesignStudyCase& study) {
   basis.omega_ref_rad_s =
       study.config.omega_ref_rad_s.value_or(study.plan.truth[kNaturalFrequency]);
   StudyFit fit;
-  Intervals(basis, &fit);
+  Intervals(basis, false, &fit);  // the values only
   return fit.value;
 }
 

@@ -65,7 +65,8 @@ std::string HalfWidths(const ArmRun& arm) {
 
 void PrintDesignStudy(const DesignStudyResult& result, const DesignStudyOptions& options,
                       std::ostream& out) {
-  out << StringPrintf("\n%s: target 95 %% half-widths", result.case_name.c_str());
+  out << StringPrintf("\n%s: target half-widths of %s 95 %% intervals", result.case_name.c_str(),
+                      options.target.simultaneous ? "simultaneous" : "each quantity's");
   for (int i = 0; i < kStudyQuantities; ++i) {
     out << StringPrintf(" %s %g %%", StudyQuantityName(i),
                         100.0 * options.target.relative_half_width[i]);

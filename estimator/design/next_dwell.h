@@ -125,7 +125,11 @@ struct DesignBasis {
   ParameterMatrix covariance = ParameterMatrix::Zero();
   double noise_sigma = 0.0;         // s, the residual's unit
   double interval_quantile = 1.96;  // of the reported 95 % intervals
-  ResidualOptions residual;         // error measure and floor of the dwells' residual
+  // n - k of the fit behind it, and whether s is known (every dwell divided
+  // by its point sigma): what other intervals' quantiles need.
+  int degrees_of_freedom = 0;
+  bool noise_known = false;
+  ResidualOptions residual;  // error measure and floor of the dwells' residual
   // kappa: the relative standard deviation of one new dwell's measured level
   // (0: exact). A candidate's residuals then carry, besides s^2, the level's
   // kappa^2 h h^T (h_i = dr_i / d ln a_b): shared by a frequency segment's

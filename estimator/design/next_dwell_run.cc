@@ -195,6 +195,8 @@ bool DesignBasisFromFit(const std::vector<const Sweep*>& fitted,
   basis->covariance = u.covariance;
   basis->noise_sigma = u.noise_sigma;
   basis->interval_quantile = u.interval_quantile;
+  basis->degrees_of_freedom = u.degrees_of_freedom;
+  basis->noise_known = u.noise_known;
   basis->residual = options.solve.residual;
   basis->omega_ref_rad_s = u.omega_ref_rad_s;
   basis->level_relative_sigma = SingleDwellLevelSigma(fitted);

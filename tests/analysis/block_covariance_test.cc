@@ -3,7 +3,8 @@
 // fails on the unscaled problem, narrower for eta_e when two datasets share
 // it, and narrower still where the caller adds a prior. The Jacobian
 // streamed in chunks into its R factor gives what the whole dense Jacobian
-// gives, for any chunk size.
+// gives, for any chunk size. The intervals' quantiles, marginal and
+// simultaneous, are Student's t and the normal's.
 #include "dwellfit/estimator/analysis/block_covariance.h"
 
 #include <array>
@@ -209,6 +210,20 @@ TEST(BlockCovariance, ChunkOfNoRowsIsReportedInWords) {
       EstimateBlockCovariance(blocks.Describe(Pointers(sweeps), true), ResidualOptions{}, options);
   EXPECT_FALSE(c.available);
   EXPECT_THAT(c.message, HasSubstr("chunk_rows is 0: it must be at least 1"));
+}
+
+// The quantiles against scipy.stats (norm.ppf, t.ppf at (1 + 0.95^(1/m)) / 2),
+// and the simultaneous one against its definition: for m independent normal
+// estimates all m intervals hold with probability (2 Phi(q) - 1)^m = 0.95.
+TEST(IntervalQuantile, MarginalAndSimultaneousQuantilesAreStudentsAndNormals) {
+  EXPECT_NEAR(IntervalQuantile(true, 0), 1.959963984540054, 1e-12);
+  EXPECT_NEAR(IntervalQuantile(false, 31), 2.0395134463964077, 1e-12);
+  EXPECT_NEAR(IntervalQuantile(true, 0, 0.99), 2.5758293035489004, 1e-12);
+  EXPECT_NEAR(SimultaneousIntervalQuantile(true, 0, 4), 2.4909151310191397, 1e-12);
+  EXPECT_NEAR(SimultaneousIntervalQuantile(false, 31, 4), 2.6439464799762593, 1e-12);
+  EXPECT_DOUBLE_EQ(SimultaneousIntervalQuantile(false, 31, 1), IntervalQuantile(false, 31));
+  const double q = SimultaneousIntervalQuantile(true, 0, 4);
+  EXPECT_NEAR(std::pow(std::erf(q / std::sqrt(2.0)), 4), 0.95, 1e-12);
 }
 
 // Three blocks mapped as the identity give the one block's covariance.

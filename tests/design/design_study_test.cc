@@ -1,12 +1,14 @@
 // design_study: the standard arm dwells where the plan says, the closed
-// loop's test time is the rig's own settling and recording time, and the
-// same seed gives the same study.
+// loop's test time is the rig's own settling and recording time, simultaneous
+// intervals widen every half-width by their quantile, and the same seed gives
+// the same study.
 #include "dwellfit/estimator/design/design_study.h"
 
 #include <cmath>
 #include <string>
 #include <vector>
 
+#include "dwellfit/estimator/analysis/block_covariance.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "gtest/gtest.h"
 
@@ -99,6 +101,39 @@ TEST(DesignStudy, ClosedLoopTimeIsTheRigsSettlingAndRecordingTime) {
   for (std::size_t k = 1; k < arm.fits.size(); ++k) {
     EXPECT_EQ(arm.fits[k].dwells, arm.fits[k - 1].dwells + 1);
   }
+}
+
+// Simultaneous intervals: the same loop (a target never met, so that the
+// path cannot depend on the intervals' width), every half-width wider by
+// t_{(1 + 0.95^(1/4))/2, n-6} / t_{0.975, n-6}, n the fit's dwells and six
+// parameters free.
+TEST(DesignStudy, SimultaneousIntervalsWidenEveryHalfWidthByTheirQuantile) {
+  const DesignStudyCase study = VirtualBeam();
+  DesignStudyOptions options;
+  options.time_budget_seconds = 760.0;
+  options.target.relative_half_width = {1e-9, 1e-9, 1e-9, 1e-9};
+  options.target.simultaneous = false;
+  const ArmRun each = RunClosedLoop(study, options, 2);
+  options.target.simultaneous = true;
+  const ArmRun joint = RunClosedLoop(study, options, 2);
+  ASSERT_EQ(each.fits.size(), joint.fits.size());
+  int compared = 0;
+  for (std::size_t k = 0; k < each.fits.size(); ++k) {
+    const StudyFit& e = each.fits[k];
+    const StudyFit& j = joint.fits[k];
+    ASSERT_EQ(e.has_intervals, j.has_intervals);
+    if (!e.has_intervals) continue;
+    const int dof = e.dwells - kNumParameters;
+    EXPECT_DOUBLE_EQ(e.interval_quantile, IntervalQuantile(false, dof));
+    EXPECT_DOUBLE_EQ(j.interval_quantile, SimultaneousIntervalQuantile(false, dof, 4));
+    for (int i = 0; i < kStudyQuantities; ++i) {
+      EXPECT_DOUBLE_EQ(e.value[i], j.value[i]);
+      EXPECT_NEAR(j.half_width[i] / e.half_width[i], j.interval_quantile / e.interval_quantile,
+                  1e-12);
+    }
+    ++compared;
+  }
+  EXPECT_GE(compared, 2);
 }
 
 TEST(DesignStudy, SameSeedSameStudyAnotherSeedAnother) {
