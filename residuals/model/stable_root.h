@@ -87,6 +87,14 @@ double ExpandUntil(double hi, const Predicate& positive) {
 // returned; where the terms are a second-order correction (docs/model.md),
 // that pair lies beyond the correction's validity (a softening cubic with the
 // quintic k6 > 0 that the correction adds folds back at large amplitude).
+// h(a) = (dG/da) / a = sum_m b_m a^m of G's coefficients `c`:
+// b_m = (m + 2) c_(m+2), m = 0..8.
+inline std::array<double, 9> SlopeCoefficients(const std::array<double, 11>& c) {
+  std::array<double, 9> b;
+  for (int m = 0; m < 9; ++m) b[m] = (m + 2) * c[m + 2];
+  return b;
+}
+
 inline TurningPoints FindTurningPointsOfFamily(const ResponseCoefficients<double>& k) {
   TurningPoints tp;
   const std::array<double, 11> c = k.Coefficients();
@@ -94,9 +102,10 @@ inline TurningPoints FindTurningPointsOfFamily(const ResponseCoefficients<double
   while (top > 2 && c[top] == 0.0) --top;
   if (top <= 3 || !(c[2] > 0.0)) return tp;  // G = c2 a^2 + c3 a^3 rises on a > 0
   const double scale = std::pow(c[2] / std::abs(c[top]), 1.0 / (top - 2));
-  // h(a) = sum_n n c_n a^(n-2), in x = a / scale, divided by 2 c2.
+  // h in x = a / scale, divided by 2 c2.
+  const std::array<double, 9> h = SlopeCoefficients(c);
   Eigen::VectorXd b = Eigen::VectorXd::Zero(top - 1);
-  for (int n = 2; n <= top; ++n) b[n - 2] = n * c[n] * std::pow(scale, n - 2) / (2.0 * c[2]);
+  for (int m = 0; m <= top - 2; ++m) b[m] = h[m] * std::pow(scale, m) / (2.0 * c[2]);
   std::vector<double> ends;
   for (const std::complex<double>& z : ScaledPolynomialRoots(b, scale)) {
     if (!(z.real() > 0.0) || !IsRealRoot(z)) continue;
@@ -294,9 +303,7 @@ inline bool CertifiedOnBranch(const ResponseCoefficients<double>& k, double r, B
 //     is its one root.
 inline bool CertifiedOnBranchOfFamily(const ResponseCoefficients<double>& k, double r,
                                       Branch branch) {
-  const std::array<double, 11> c = k.Coefficients();
-  std::array<double, 9> b;
-  for (int m = 0; m < 9; ++m) b[m] = (m + 2) * c[m + 2];
+  std::array<double, 9> b = SlopeCoefficients(k.Coefficients());
   int sign_changes = 0;
   double last = b[0];
   for (int m = 1; m < 9; ++m) {

@@ -215,13 +215,16 @@ TEST(FamilyTerms, TheLiftedRootsDerivativeInTheNewTermsPassesTheGradientChecker)
   EXPECT_GT(std::abs(results.jacobians[0](0, 1)), 1e-3);
 }
 
-// The second-order form on a softening cubic (the truth of
-// datasets/softening-numerical): k4 < 0 < k6, so Q / a turns back at large a
-// and G folds a second time near 0.05-0.07 m, a fold of no structure (the
-// correction there outweighs the cubic term it corrects).
+// The truths of datasets/virtual-beam (Table 3.1) and datasets/softening-numerical.
+const ParameterVector kBeamTruth = {100.0, 0.2, 300.0, 1e4, 9e8, HzToRadPerSecond(40.0)};
+const ParameterVector kSofteningTruth = {50.0, 0.5, 100.0, 1e3, -4e8, HzToRadPerSecond(60.0)};
+
+// The second-order form on a softening cubic (kSofteningTruth): k4 < 0 < k6,
+// so Q / a turns back at large a and G folds a second time near 0.05-0.07 m,
+// a fold of no structure (the correction there outweighs the cubic term it
+// corrects).
 ResponseCoefficients<double> SofteningSecondOrder(double hz) {
-  const ParameterVector truth = {50.0, 0.5, 100.0, 1e3, -4e8, HzToRadPerSecond(60.0)};
-  return ResponseCoefficients<double>::FromParameters(kSecondOrderForm, truth.data(),
+  return ResponseCoefficients<double>::FromParameters(kSecondOrderForm, kSofteningTruth.data(),
                                                       HzToRadPerSecond(hz));
 }
 
@@ -268,10 +271,8 @@ TEST(FamilyTerms, ASecondOrderFoldBeyondTheCorrectionsLimitIsNoFold) {
 // guesses, every certified root equals the bracketed solve's, and most
 // dwells are certified.
 TEST(FamilyTerms, CertifiedNewtonRootsAreTheBracketedSolvesRoots) {
-  const ParameterVector beam = {100.0, 0.2, 300.0, 1e4, 9e8, HzToRadPerSecond(40.0)};
-  const ParameterVector softening = {50.0, 0.5, 100.0, 1e3, -4e8, HzToRadPerSecond(60.0)};
   int certified = 0, compared = 0;
-  for (const ParameterVector* p : {&beam, &softening}) {
+  for (const ParameterVector* p : {&kBeamTruth, &kSofteningTruth}) {
     const double f0 = (*p)[kNaturalFrequency] / kTwoPi;
     for (double hz = 0.9 * f0; hz <= 1.1 * f0; hz += 0.005 * f0) {
       const auto k = ResponseCoefficients<double>::FromParameters(kSecondOrderForm, p->data(),
