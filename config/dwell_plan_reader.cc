@@ -43,17 +43,23 @@ std::vector<ConfigValue> ReadNonEmptyList(const ConfigValue& value, const Config
   return ReadList(value, source);
 }
 
-// The `truth` block: all six parameters, omega given in Hz.
-ParameterVector ReadTruth(const ConfigValue& value, const ConfigSource& source) {
-  const StrictMap block(value, source, {"eta_e", "mu1", "mu2", "delta", "alpha", "omega_hz"});
+// The `truth` block: all six parameters of `form`'s member, omega given in Hz.
+ParameterVector ReadTruth(const ConfigValue& value, const ConfigSource& source, ModelForm form) {
+  const auto names = ParameterNames(form);
+  const StrictMap block(value, source,
+                        {"eta_e", "mu1", names[kMu2], names[kDelta], "alpha", "omega_hz"});
   auto get = [&](const PlanKey& key) {
     return block.Required(key.name, std::string("add the true ") + key.meaning);
   };
   ParameterVector truth{};
   truth[kEtaE] = ReadPositive(get({"eta_e", "forcing effectiveness (> 0)"}), source);
   truth[kMu1] = ReadNonNegative(get({"mu1", "linear damping [1/s] (>= 0)"}), source);
-  truth[kMu2] = ReadNonNegative(get({"mu2", "quadratic damping (>= 0)"}), source);
-  truth[kDelta] = ReadFiniteDouble(get({"delta", "nonlinear inertia"}), source);
+  truth[kMu2] = ReadNonNegative(form.cubic_damping() ? get({"mu3", "cubic damping (>= 0)"})
+                                                     : get({"mu2", "quadratic damping (>= 0)"}),
+                                source);
+  truth[kDelta] = ReadFiniteDouble(form.quintic_stiffness() ? get({"alpha5", "quintic stiffness"})
+                                                            : get({"delta", "nonlinear inertia"}),
+                                   source);
   truth[kAlpha] = ReadFiniteDouble(get({"alpha", "cubic stiffness"}), source);
   truth[kNaturalFrequency] = HzToRadPerSecond(
       ReadPositive(get({"omega_hz", "linear natural frequency [Hz] (> 0)"}), source));
@@ -189,13 +195,13 @@ DwellPlan ReadPlan(const ConfigSource& source) {
   const ConfigValue document = DocumentValue(source);
   const StrictMap block(document, source, {"truth", "sweeps", "noise", "model"});
   DwellPlan plan;
+  if (const auto model = block.Optional("model")) plan.form = ReadModelForm(*model, source);
   plan.truth = ReadTruth(
-      block.Required("truth", "add truth: with eta_e, mu1, mu2, delta, alpha and omega_hz"),
-      source);
+      block.Required("truth", "add truth: with eta_e, mu1, mu2, delta, alpha and omega_hz"), source,
+      plan.form);
   plan.sweeps =
       ReadSweeps(block.Required("sweeps", "add sweeps: a list of one sweep or more"), source);
   if (const auto noise = block.Optional("noise")) plan.noise = ReadNoise(*noise, source);
-  if (const auto model = block.Optional("model")) plan.form = ReadModelForm(*model, source);
   std::string error;
   if (!plan.IsValid(&error)) throw source.Error(document.path, document.mark, error);
   return plan;
@@ -204,14 +210,39 @@ DwellPlan ReadPlan(const ConfigSource& source) {
 }  // namespace
 
 ModelForm ReadModelForm(const ConfigValue& value, const ConfigSource& source) {
-  const StrictMap block(value, source, {"averaging"});
-  const ConfigValue averaging = block.Required(
-      "averaging", "give averaging: first_order (the chapter's model) or second_order");
+  const StrictMap block(value, source, {"averaging", "damping", "backbone"});
   ModelForm form;
-  AveragingFromName(
-      ReadOneOf(averaging, source, "averaging",
-                {AveragingName(Averaging::kFirstOrder), AveragingName(Averaging::kSecondOrder)}),
-      &form.averaging);
+  if (const auto averaging = block.Optional("averaging")) {
+    AveragingFromName(
+        ReadOneOf(*averaging, source, "averaging",
+                  {AveragingName(Averaging::kFirstOrder), AveragingName(Averaging::kSecondOrder)}),
+        &form.averaging);
+  }
+  if (const auto damping = block.Optional("damping")) {
+    const std::string cubic = DampingTermName(DampingTerm::kCubic);
+    if (ReadOneOf(*damping, source, "damping", {DampingTermName(DampingTerm::kQuadratic), cubic}) ==
+        cubic) {
+      form.damping = DampingTerm::kCubic;
+    }
+  }
+  if (const auto backbone = block.Optional("backbone")) {
+    const std::string quintic = BackboneTermName(BackboneTerm::kQuintic);
+    if (ReadOneOf(*backbone, source, "backbone",
+                  {BackboneTermName(BackboneTerm::kInertia), quintic}) == quintic) {
+      form.backbone = BackboneTerm::kQuintic;
+    }
+  }
+  if (form.second_order() && form.family_terms()) {
+    throw source.Error(value.path, value.mark,
+                       "averaging: second_order is derived for the chapter's terms only; give "
+                       "averaging: first_order with damping: cubic or backbone: quintic, or drop "
+                       "those keys for the second order");
+  }
+  if (!block.Optional("averaging") && !block.Optional("damping") && !block.Optional("backbone")) {
+    throw source.Error(value.path, value.mark,
+                       "names no model; give averaging: first_order | second_order, damping: "
+                       "quadratic | cubic or backbone: inertia | quintic");
+  }
   return form;
 }
 

@@ -43,8 +43,10 @@
 
 namespace dwellfit {
 
-// The `model: {averaging: first_order | second_order}` block of a plan and of
-// identify's config; an unknown name is an error at its line listing both.
+// The `model: {averaging: first_order | second_order, damping: quadratic |
+// cubic, backbone: inertia | quintic}` block of a plan and of identify's
+// config (ModelForm); an unknown name is an error at its line listing the
+// choices, and the second order with a family term is refused.
 ModelForm ReadModelForm(const ConfigValue& value, const ConfigSource& source);
 
 // Parses the YAML text of a plan; `source` names it in errors (a file path).

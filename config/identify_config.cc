@@ -143,10 +143,12 @@ void CheckNoSweepFittedAndValidated(const std::vector<PlacedSelection>& fit,
 
 // The initial_guess block: `auto`, or per parameter a number (physical
 // units, omega in Hz) or `auto`; a parameter left out is `auto`.
-KnownParameters ReadInitialGuess(const ConfigValue& value, const ConfigSource& source) {
+KnownParameters ReadInitialGuess(const ConfigValue& value, const ConfigSource& source,
+                                 ModelForm form) {
   KnownParameters known;
   if (value.node.IsScalar() && value.node.Scalar() == "auto") return known;
-  std::vector<std::string> names(kParameterNames.begin(), kParameterNames.end());
+  const auto member_names = ParameterNames(form);
+  std::vector<std::string> names(member_names.begin(), member_names.end());
   names[kNaturalFrequency] = "omega_hz";
   const StrictMap block(value, source, names);
   for (int index = 0; index < kNumParameters; ++index) {
@@ -235,13 +237,14 @@ InputError EntryError(const ConfigValue& entry, const ConfigSource& source,
 // so it must have one in `known` (initial_guess): the automatic value is a
 // rough start, not a value to hold.
 std::array<bool, kNumParameters> ReadFixed(const ConfigValue& value, const ConfigSource& source,
-                                           const KnownParameters& known) {
-  const std::vector<std::string> allowed(kParameterNames.begin(), kParameterNames.end());
+                                           const KnownParameters& known, ModelForm form) {
+  const auto names = ParameterNames(form);
+  const std::vector<std::string> allowed(names.begin(), names.end());
   std::array<bool, kNumParameters> fixed{};
   for (const ConfigValue& entry : ReadList(value, source)) {
     const std::string name = ReadNonEmptyString(entry, source);
     ParameterIndex index;
-    if (!ParameterIndexFromName(name, &index)) {
+    if (!ParameterIndexFromName(form, name, &index)) {
       const std::string hint =
           name == "omega_hz" ? " (the parameter is called 'omega')" : DidYouMean(name, allowed);
       throw EntryError(entry, source,
@@ -566,13 +569,11 @@ void ReadTestQuantities(const StrictMap& top, const ConfigSource& source, Identi
   }
 }
 
-// `model: {averaging: first_order | second_order}`: the response model every
-// stage evaluates (model_form.h). Read after `residual:`, whose block it
-// joins.
-void ReadModel(const StrictMap& top, const ConfigSource& source, IdentifyConfig* config) {
-  if (const auto value = top.Optional("model")) {
-    config->identification.solve.residual.form = ReadModelForm(*value, source);
-  }
+// `model: {averaging: ..., damping: ..., backbone: ...}`: the response model
+// every stage evaluates (model_form.h); the chapter's where the key is absent.
+ModelForm ReadModel(const StrictMap& top, const ConfigSource& source) {
+  if (const auto value = top.Optional("model")) return ReadModelForm(*value, source);
+  return ModelForm{};
 }
 
 // `units:` and `plot:`: how figures and reports show the data.
@@ -640,12 +641,14 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
   config.validate_sweeps = Selections(validate);
 
   IdentificationOptions& identification = config.identification;
+  // The model names the parameters the keys below hold.
+  const ModelForm form = ReadModel(top, source);
   if (const auto value = top.Optional("initial_guess")) {
-    config.initial_guess = ReadInitialGuess(*value, source);
+    config.initial_guess = ReadInitialGuess(*value, source, form);
   }
   identification.initial = WithPlaceholders(config.initial_guess);
   if (const auto value = top.Optional("fixed")) {
-    identification.fixed = ReadFixed(*value, source, config.initial_guess);
+    identification.fixed = ReadFixed(*value, source, config.initial_guess, form);
   }
   if (const auto value = top.Optional("stages"))
     identification.solve.stages = ReadStages(*value, source);
@@ -658,6 +661,11 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
   }
 
   if (const auto value = top.Optional("model_selection")) {
+    if (form.family_terms()) {
+      throw source.Error(value->path, value->mark,
+                         "model_selection compares the chapter's variants (delta, mu2); remove it, "
+                         "or remove damping: and backbone: from model:");
+    }
     config.model_selection = ReadModelSelectionConfig(*value, source, config.initial_guess);
   }
   if (top.Optional("forcing_calibration")) {
@@ -681,7 +689,7 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
   }
 
   ReadTestQuantities(top, source, &config);
-  ReadModel(top, source, &config);
+  identification.solve.residual.form = form;  // after `residual:`, whose block it joins
   ReadPresentation(top, source, &config);
   const ConfigValue output_dir =
       top.Required("output_dir", "give the directory for the results, e.g. output_dir: out");

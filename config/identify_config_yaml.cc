@@ -93,16 +93,16 @@ void EmitJumpOverrides(YAML::Emitter& out, const std::vector<JumpOverride>& jump
 
 void EmitInitialGuess(YAML::Emitter& out, const IdentifyConfig& config) {
   const ParameterVector& initial = config.identification.initial;
+  const auto names = ParameterNames(config.identification.solve.residual.form);
   out << YAML::Key << "initial_guess" << YAML::Value << YAML::BeginMap;
   for (int i = 0; i < kNumParameters; ++i) {
     if (!config.initial_guess[i]) {
-      out << YAML::Key << (i == kNaturalFrequency ? "omega_hz" : ParameterName(i)) << YAML::Value
-          << "auto";
+      out << YAML::Key << (i == kNaturalFrequency ? "omega_hz" : names[i]) << YAML::Value << "auto";
     } else if (i == kNaturalFrequency) {
       out << YAML::Key << "omega_hz" << YAML::Value << ConvertedNumber(RadPerSecondToHz(initial[i]))
           << YAML::Comment(FormatRoundTrip(initial[i]) + " rad/s");
     } else {
-      Put(out, ParameterName(i), initial[i]);
+      Put(out, names[i], initial[i]);
     }
   }
   out << YAML::EndMap;
@@ -113,7 +113,7 @@ void EmitFitSettings(YAML::Emitter& out, const IdentificationOptions& identifica
                      ConfigKeys keys) {
   out << YAML::Key << "fixed" << YAML::Value << YAML::Flow << YAML::BeginSeq;
   for (int i = 0; i < kNumParameters; ++i) {
-    if (identification.fixed[i]) out << ParameterName(i);
+    if (identification.fixed[i]) out << ParameterName(identification.solve.residual.form, i);
   }
   out << YAML::EndSeq;
   PutList(out, "stages", identification.solve.stages, ResidualKindName);
@@ -236,11 +236,14 @@ std::string ConfigToYaml(const IdentifyConfig& config, ConfigKeys keys) {
     out << YAML::EndMap;
   }
   EmitTestQuantities(out, config.test);
-  // Only the second order, so that a config without the key keeps its text.
+  // Only what differs from the chapter's model, so that a config without the
+  // key keeps its text.
   const ModelForm form = config.identification.solve.residual.form;
-  if (form.second_order()) {
+  if (form != ModelForm{}) {
     out << YAML::Key << "model" << YAML::Value << YAML::BeginMap;
-    Put(out, "averaging", AveragingName(form.averaging));
+    if (form.second_order()) Put(out, "averaging", AveragingName(form.averaging));
+    if (form.cubic_damping()) Put(out, "damping", DampingTermName(form.damping));
+    if (form.quintic_stiffness()) Put(out, "backbone", BackboneTermName(form.backbone));
     out << YAML::EndMap;
   }
   if (!config.units.a.empty() || !config.units.a_base.empty()) {

@@ -44,9 +44,10 @@ std::vector<ConfigOverride> ToOverrides(const Overrides& pairs) {
   return overrides;
 }
 
-py::dict ByParameter(const ParameterVector& values) {
+// Keyed by the names of `form`'s member (model_form.h).
+py::dict ByParameter(const ParameterVector& values, ModelForm form = ModelForm{}) {
   py::dict out;
-  for (int i = 0; i < kNumParameters; ++i) out[ParameterName(i)] = values[i];
+  for (int i = 0; i < kNumParameters; ++i) out[ParameterName(form, i)] = values[i];
   return out;
 }
 
@@ -125,9 +126,9 @@ py::dict UncertaintyDict(const ParameterUncertainty& u) {
   out["available"] = u.available;
   out["message"] = u.message;
   out["interval_kind"] = u.interval_kind;
-  out["standard_error"] = ByParameter(u.standard_error);
-  out["ci95_low"] = ByParameter(u.ci95_low);
-  out["ci95_high"] = ByParameter(u.ci95_high);
+  out["standard_error"] = ByParameter(u.standard_error, u.form);
+  out["ci95_low"] = ByParameter(u.ci95_low, u.form);
+  out["ci95_high"] = ByParameter(u.ci95_high, u.form);
   out["warnings"] = u.warnings;
   out["effective_nonlinearity"] = u.effective_nonlinearity;
   out["effective_nonlinearity_ci95"] =
@@ -142,7 +143,7 @@ py::dict OutcomeDict(const IdentifyOutcome& outcome, const std::string& printed)
   py::dict out;
   out["status"] = FitStatusName(report.result.status);
   out["message"] = report.result.message;
-  out["parameters"] = ByParameter(report.result.parameters);
+  out["parameters"] = ByParameter(report.result.parameters, report.options.solve.residual.form);
   out["fixed"] = std::vector<bool>(report.options.fixed.begin(), report.options.fixed.end());
   out["final_cost"] = report.result.final_cost;
   out["uncertainty"] = UncertaintyDict(report.uncertainty);

@@ -21,9 +21,9 @@ inline const ParameterVector kThesisTruth = {100.0, 0.2, 300.0, 1e4, 9e8, HzToRa
 // `truth`: a frequency sweep at a_base 0.01 from f0 - 2 to f0 + 6 Hz and an
 // amplitude sweep at f0 + 1.5 Hz, each up and down. With noise the branches
 // are labelled by DetectJumps, as for measured data; without, the
-// simulator's own labels stand.
+// simulator's own labels stand. `form` names the member `truth` is of.
 inline std::vector<Sweep> SimulateDataset(const ParameterVector& truth, double relative_sigma,
-                                          std::uint64_t seed) {
+                                          std::uint64_t seed, ModelForm form = ModelForm{}) {
   const double f0 = RadPerSecondToHz(truth[kNaturalFrequency]);
   SweepPlan frequency;
   frequency.id = "F";
@@ -41,6 +41,7 @@ inline std::vector<Sweep> SimulateDataset(const ParameterVector& truth, double r
   amplitude.step = 0.001;
   DwellPlan plan;
   plan.truth = truth;
+  plan.form = form;
   plan.sweeps = {frequency, amplitude};
   plan.noise = {relative_sigma, seed};
   std::vector<Sweep> sweeps = SimulateDwells(plan);
@@ -71,7 +72,9 @@ struct ThreeBlocks {
   double rest[3];
 
   explicit ThreeBlocks(const ParameterVector& p)
-      : eta_e{p[kEtaE]}, damping{p[kMu1], p[kMu2]}, rest{p[kDelta], p[kAlpha], p[kNaturalFrequency]} {}
+      : eta_e{p[kEtaE]},
+        damping{p[kMu1], p[kMu2]},
+        rest{p[kDelta], p[kAlpha], p[kNaturalFrequency]} {}
 
   ParameterVector Values() const {
     return {eta_e[0], damping[0], damping[1], rest[0], rest[1], rest[2]};
@@ -96,7 +99,9 @@ struct SharedModel {
   double w_b[1];
 
   SharedModel(const ParameterVector& a, double w_b_rad_s)
-      : shared{a[kEtaE], a[kMu1], a[kMu2], a[kDelta], a[kAlpha]}, w_a{a[kNaturalFrequency]}, w_b{w_b_rad_s} {}
+      : shared{a[kEtaE], a[kMu1], a[kMu2], a[kDelta], a[kAlpha]},
+        w_a{a[kNaturalFrequency]},
+        w_b{w_b_rad_s} {}
 
   ParameterMap MapOf(double* w) {
     return {{{shared, 0}, {shared, 1}, {shared, 2}, {shared, 3}, {shared, 4}, {w, 0}}};

@@ -67,11 +67,12 @@ void EmitInterval(const ParameterUncertainty& u, int i, YAML::Emitter* out) {
 
 // parameters, the natural frequency in Hz and alpha_e with its interval.
 void EmitParameters(const IdentificationReport& report, YAML::Emitter* out) {
+  const ModelForm form = report.options.solve.residual.form;
   const ParameterVector& p = report.result.parameters;
   const ParameterUncertainty& u = report.uncertainty;
   *out << YAML::Key << "parameters" << YAML::Value << YAML::BeginMap;
   for (int i = 0; i < kNumParameters; ++i) {
-    *out << YAML::Key << ParameterName(i) << YAML::Value << YAML::BeginMap;
+    *out << YAML::Key << ParameterName(form, i) << YAML::Value << YAML::BeginMap;
     *out << YAML::Key << "value" << YAML::Value << p[i];
     *out << YAML::Key << "initial" << YAML::Value << report.options.initial[i];
     *out << YAML::Key << "fixed" << YAML::Value << report.options.fixed[i];
@@ -86,8 +87,10 @@ void EmitParameters(const IdentificationReport& report, YAML::Emitter* out) {
   *out << YAML::Key << "natural_frequency_hz" << YAML::Value
        << RadPerSecondToHz(p[kNaturalFrequency]);
   *out << YAML::Key << "effective_nonlinearity" << YAML::Value << YAML::BeginMap;
-  *out << YAML::Key << "definition" << YAML::Value << "-(1/3)(2 delta Omega_ref^2 - 3 alpha)";
-  *out << YAML::Key << "value" << YAML::Value << EffectiveNonlinearity(p, report.omega_ref_rad_s);
+  *out << YAML::Key << "definition" << YAML::Value
+       << (form.has_inertia() ? "-(1/3)(2 delta Omega_ref^2 - 3 alpha)" : "alpha");
+  *out << YAML::Key << "value" << YAML::Value
+       << EffectiveNonlinearity(form, p, report.omega_ref_rad_s);
   *out << YAML::Key << "omega_ref_rad_s" << YAML::Value << report.omega_ref_rad_s;
   if (u.available) {
     *out << YAML::Key << "standard_error" << YAML::Value << u.effective_nonlinearity_standard_error;
@@ -97,6 +100,7 @@ void EmitParameters(const IdentificationReport& report, YAML::Emitter* out) {
 }
 
 void EmitUncertainty(const IdentificationReport& report, YAML::Emitter* out) {
+  const ModelForm form = report.options.solve.residual.form;
   const ParameterUncertainty& u = report.uncertainty;
   *out << YAML::Key << "uncertainty" << YAML::Value << YAML::BeginMap;
   *out << YAML::Key << "available" << YAML::Value << u.available;
@@ -113,7 +117,7 @@ void EmitUncertainty(const IdentificationReport& report, YAML::Emitter* out) {
     *out << YAML::Key << "correlation" << YAML::Value << YAML::BeginMap;
     for (int i = 0; i < kNumParameters; ++i) {
       if (report.options.fixed[i]) continue;
-      *out << YAML::Key << ParameterName(i) << YAML::Value << YAML::Flow << YAML::BeginSeq;
+      *out << YAML::Key << ParameterName(form, i) << YAML::Value << YAML::Flow << YAML::BeginSeq;
       for (int j = 0; j < kNumParameters; ++j) {
         if (!report.options.fixed[j]) *out << u.correlation(i, j);
       }
@@ -137,7 +141,7 @@ void EmitStarts(const IdentificationReport& report, YAML::Emitter* out) {
   }
 }
 
-void EmitStage(const StageSummary& stage, YAML::Emitter* out) {
+void EmitStage(ModelForm form, const StageSummary& stage, YAML::Emitter* out) {
   *out << YAML::BeginMap;
   *out << YAML::Key << "residual" << YAML::Value << ResidualKindName(stage.residual);
   if (stage.fold_stage) *out << YAML::Key << "fold_conditions" << YAML::Value << true;
@@ -153,7 +157,7 @@ void EmitStage(const StageSummary& stage, YAML::Emitter* out) {
   *out << YAML::Key << "iterations" << YAML::Value << stage.iterations;
   *out << YAML::Key << "solves" << YAML::Value << stage.solves;
   *out << YAML::Key << "held_at_bound" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (int index : stage.held_at_bound) *out << ParameterName(index);
+  for (int index : stage.held_at_bound) *out << ParameterName(form, index);
   *out << YAML::EndSeq;
   *out << YAML::Key << "converged" << YAML::Value << stage.converged;
   if (stage.penalty_unit > 0.0) {
@@ -256,7 +260,7 @@ void EmitValidationIntervals(const ValidationIntervals& v, YAML::Emitter* out) {
 }
 
 // leave_one_level_out: the refits and their spread (omega in rad/s).
-void EmitLevelRefits(const LevelRefits& r, YAML::Emitter* out) {
+void EmitLevelRefits(ModelForm form, const LevelRefits& r, YAML::Emitter* out) {
   *out << YAML::Key << "leave_one_level_out" << YAML::Value << YAML::BeginMap;
   *out << YAML::Key << "computed" << YAML::Value << r.computed;
   *out << YAML::Key << "message" << YAML::Value << r.message;
@@ -271,7 +275,7 @@ void EmitLevelRefits(const LevelRefits& r, YAML::Emitter* out) {
       *out << YAML::Key << "usable" << YAML::Value << refit.usable;
       *out << YAML::Key << "final_cost" << YAML::Value << refit.final_cost;
       for (int i = 0; i < kNumParameters; ++i) {
-        *out << YAML::Key << ParameterName(i) << YAML::Value << refit.parameters[i];
+        *out << YAML::Key << ParameterName(form, i) << YAML::Value << refit.parameters[i];
       }
       *out << YAML::Key << "alpha_e" << YAML::Value << refit.effective_nonlinearity;
       *out << YAML::EndMap;
@@ -308,7 +312,7 @@ void AppendBlockMapping(const char* key, const std::string& mapping, std::string
   }
 }
 
-void PrintStages(const IdentificationResult& result, std::ostream& out) {
+void PrintStages(ModelForm form, const IdentificationResult& result, std::ostream& out) {
   for (const StageSummary& stage : result.stages) {
     out << ResidualKindName(stage.residual) << (stage.fold_stage ? " + fold conditions" : "")
         << (stage.start_stage ? " (start stage)" : "");
@@ -317,7 +321,7 @@ void PrintStages(const IdentificationResult& result, std::ostream& out) {
         << ", " << stage.iterations << " iterations";
     if (stage.solves > 1) out << " in " << stage.solves << " solves";
     for (size_t i = 0; i < stage.held_at_bound.size(); ++i) {
-      out << (i == 0 ? ", held at bound: " : ", ") << ParameterName(stage.held_at_bound[i]);
+      out << (i == 0 ? ", held at bound: " : ", ") << ParameterName(form, stage.held_at_bound[i]);
     }
     out << "\n";
     if (!stage.note.empty()) out << "  " << stage.note << "\n";
@@ -326,6 +330,7 @@ void PrintStages(const IdentificationResult& result, std::ostream& out) {
 }
 
 void PrintParameters(const IdentificationReport& report, std::ostream& out) {
+  const ModelForm form = report.options.solve.residual.form;
   const IdentificationResult& result = report.result;
   const ParameterUncertainty& u = report.uncertainty;
   const bool profile = u.interval_kind == "profile_likelihood";
@@ -338,14 +343,15 @@ void PrintParameters(const IdentificationReport& report, std::ostream& out) {
     const std::string se = interval ? StringPrintf("%.3g", u.standard_error[i]) : "-";
     const std::string ci =
         interval ? StringPrintf("[%.6g, %.6g]", u.ci95_low[i], u.ci95_high[i]) : "-";
-    out << StringPrintf("%-8s %-18.10g %-12s %-34s %-14.6g %s\n", ParameterName(i),
+    out << StringPrintf("%-8s %-18.10g %-12s %-34s %-14.6g %s\n", ParameterName(form, i),
                         result.parameters[i], se.c_str(), ci.c_str(), report.options.initial[i],
                         report.options.fixed[i] ? "yes" : "no");
   }
   out << StringPrintf(
       "natural frequency %.8g Hz; effective nonlinearity %.8g at Omega_ref %.6g rad/s\n",
       RadPerSecondToHz(result.parameters[kNaturalFrequency]),
-      EffectiveNonlinearity(result.parameters, report.omega_ref_rad_s), report.omega_ref_rad_s);
+      EffectiveNonlinearity(form, result.parameters, report.omega_ref_rad_s),
+      report.omega_ref_rad_s);
   if (u.available) {
     out << StringPrintf("  effective nonlinearity std.error %.3g, 95%% interval [%.6g, %.6g]\n",
                         u.effective_nonlinearity_standard_error, u.effective_nonlinearity_ci95_low,
@@ -509,7 +515,8 @@ std::string ReportToYaml(const IdentificationReport& report) {
   out << YAML::Key << "converged" << YAML::Value << result.converged;
   out << YAML::Key << "fitted_points" << YAML::Value << result.residual_blocks;
   out << YAML::Key << "stages" << YAML::Value << YAML::BeginSeq;
-  for (const StageSummary& stage : result.stages) EmitStage(stage, &out);
+  for (const StageSummary& stage : result.stages)
+    EmitStage(report.options.solve.residual.form, stage, &out);
   out << YAML::EndSeq;
   out << YAML::Key << "sweeps" << YAML::Value << YAML::BeginSeq;
   for (const SweepPrediction& prediction : report.predictions) EmitSweep(prediction, &out);
@@ -517,7 +524,9 @@ std::string ReportToYaml(const IdentificationReport& report) {
   if (!report.validation_intervals.levels.empty()) {
     EmitValidationIntervals(report.validation_intervals, &out);
   }
-  if (!report.level_refits.message.empty()) EmitLevelRefits(report.level_refits, &out);
+  if (!report.level_refits.message.empty()) {
+    EmitLevelRefits(report.options.solve.residual.form, report.level_refits, &out);
+  }
   if (!report.modal.points.empty()) EmitModalProperties(report.modal, &out);
   out << YAML::EndMap;
   std::string yaml = std::string(out.c_str()) + "\n";
@@ -563,7 +572,7 @@ void PrintReport(const IdentificationReport& report, std::ostream& out) {
     out << "model: second-order averaging (harmonic balance on harmonics 1 and 3; "
            "docs/model.md)\n";
   }
-  PrintStages(report.result, out);
+  PrintStages(report.options.solve.residual.form, report.result, out);
   out << "\n";
   PrintParameters(report, out);
   out << "\n";

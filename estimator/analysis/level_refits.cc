@@ -25,17 +25,19 @@ LevelRefit Refit(const std::vector<const Sweep*>& fitted, const IdentificationOp
   refit.message = result.message;
   refit.final_cost = result.final_cost;
   refit.parameters = result.parameters;
-  refit.effective_nonlinearity = EffectiveNonlinearity(result.parameters, omega_ref_rad_s);
+  refit.effective_nonlinearity =
+      EffectiveNonlinearity(options.solve.residual.form, result.parameters, omega_ref_rad_s);
   refit.usable =
       result.IsSolutionUsable() && std::all_of(result.parameters.begin(), result.parameters.end(),
                                                [](double v) { return std::isfinite(v); });
   return refit;
 }
 
-RefitSpread SpreadOf(int index, double estimate, const std::vector<double>& values) {
+RefitSpread SpreadOf(ModelForm form, int index, double estimate,
+                     const std::vector<double>& values) {
   RefitSpread spread;
   spread.index = index;
-  spread.name = index < kNumParameters ? ParameterName(index) : "alpha_e";
+  spread.name = index < kNumParameters ? ParameterName(form, index) : "alpha_e";
   spread.estimate = estimate;
   spread.min = *std::min_element(values.begin(), values.end());
   spread.max = *std::max_element(values.begin(), values.end());
@@ -82,7 +84,8 @@ std::vector<std::string> FittedLevels(const std::vector<const Sweep*>& fitted) {
 
 std::vector<RefitSpread> SpreadOverRefits(const std::vector<LevelRefit>& refits,
                                           const std::array<bool, kNumParameters>& fixed,
-                                          const ParameterVector& estimate, double omega_ref_rad_s) {
+                                          const ParameterVector& estimate, double omega_ref_rad_s,
+                                          ModelForm form) {
   std::vector<RefitSpread> spread;
   std::vector<const LevelRefit*> usable;
   for (const LevelRefit& refit : refits) {
@@ -91,13 +94,14 @@ std::vector<RefitSpread> SpreadOverRefits(const std::vector<LevelRefit>& refits,
   if (usable.size() < 2) return spread;
   for (int j = 0; j <= kNumParameters; ++j) {  // kNumParameters: alpha_e
     const bool parameter = j < kNumParameters;
-    if (parameter ? fixed[j] : fixed[kAlpha] && fixed[kDelta]) continue;
+    if (parameter ? fixed[j] : fixed[kAlpha] && (fixed[kDelta] || !form.has_inertia())) continue;
     std::vector<double> values;
     for (const LevelRefit* refit : usable) {
       values.push_back(parameter ? refit->parameters[j] : refit->effective_nonlinearity);
     }
     spread.push_back(SpreadOf(
-        j, parameter ? estimate[j] : EffectiveNonlinearity(estimate, omega_ref_rad_s), values));
+        form, j, parameter ? estimate[j] : EffectiveNonlinearity(form, estimate, omega_ref_rad_s),
+        values));
   }
   return spread;
 }
@@ -126,7 +130,8 @@ LevelRefits RefitLeavingOneLevelOut(const std::vector<const Sweep*>& fitted,
     });
   });
   for (const LevelRefit& refit : result.refits) result.usable += refit.usable;
-  result.spread = SpreadOverRefits(result.refits, options.fixed, estimate, omega_ref_rad_s);
+  result.spread = SpreadOverRefits(result.refits, options.fixed, estimate, omega_ref_rad_s,
+                                   options.solve.residual.form);
   result.computed = true;
   result.warnings = Warnings(result);
   result.message = StringPrintf(

@@ -70,7 +70,8 @@ LevelRefits RefitLeavingOneLevelOut(const std::vector<const Sweep*>& fitted,
 // (none with fewer than two); exposed for tests.
 std::vector<RefitSpread> SpreadOverRefits(const std::vector<LevelRefit>& refits,
                                           const std::array<bool, kNumParameters>& fixed,
-                                          const ParameterVector& estimate, double omega_ref_rad_s);
+                                          const ParameterVector& estimate, double omega_ref_rad_s,
+                                          ModelForm form = ModelForm{});
 
 }  // namespace dwellfit
 

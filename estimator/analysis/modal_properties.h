@@ -14,6 +14,10 @@
 // by fixed-point iteration from the first order's, and zeta(a) takes
 // mu1 + 4 mu2 a / (3 pi) - 3 mu2 g a^3 / (5 pi D) at Omega = omega(a).
 //
+// A member of the family (model_form.h) has delta = 0 where entry kDelta
+// holds alpha5, whose k6 a^5 adds 2.5 alpha5 a^4 to the numerator of
+// omega(a)^2, and mu1 + mu3 a^2 / 4 for the damping where entry kMu2 holds mu3.
+//
 // The 95 % bands are linearised: q +/- 1.95996 sqrt(g^T C g), g = dq/dp by
 // central differences (relative step 1e-6), C the fit's covariance.
 #ifndef DWELLFIT_ESTIMATOR_ANALYSIS_MODAL_PROPERTIES_H_

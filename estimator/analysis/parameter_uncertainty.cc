@@ -19,11 +19,11 @@
 namespace dwellfit {
 namespace {
 
-std::string JoinNames(const std::vector<int>& parameters) {
+std::string JoinNames(ModelForm form, const std::vector<int>& parameters) {
   std::string joined;
   for (size_t i = 0; i < parameters.size(); ++i) {
     if (i > 0) joined += i + 1 == parameters.size() ? " and " : ", ";
-    joined += ParameterName(parameters[i]);
+    joined += ParameterName(form, parameters[i]);
   }
   return joined;
 }
@@ -32,9 +32,14 @@ bool IsPair(int a, int b, int first, int second) {
   return (a == first && b == second) || (a == second && b == first);
 }
 
+// Whether a and b are delta and alpha, the pair only alpha_e of separates.
+bool IsInertiaPair(ModelForm form, int a, int b) {
+  return form.has_inertia() && IsPair(a, b, kDelta, kAlpha);
+}
+
 // What to do about two free parameters the sweeps hardly separate.
-std::string PairAdvice(int a, int b) {
-  if (IsPair(a, b, kDelta, kAlpha)) {
+std::string PairAdvice(ModelForm form, int a, int b) {
+  if (IsInertiaPair(form, a, b)) {
     return "fix delta (fixed: [delta]) or add a sweep far from this frequency band";
   }
   if (IsPair(a, b, kMu1, kMu2)) {
@@ -47,8 +52,9 @@ std::string PairAdvice(int a, int b) {
 // What the sweeps cannot see, in plain words. A parameter is implicated when
 // its row of `null_space` has a norm of at least kNullDirectionShare
 // (independent of the basis the SVD returned).
-std::string DescribeNullSpace(const Eigen::MatrixXd& null_space, const Eigen::VectorXd& unit_scale,
-                              const std::vector<int>& free, const Eigen::MatrixXd& column_cosines) {
+std::string DescribeNullSpace(ModelForm form, const Eigen::MatrixXd& null_space,
+                              const Eigen::VectorXd& unit_scale, const std::vector<int>& free,
+                              const Eigen::MatrixXd& column_cosines) {
   std::vector<int> involved;
   std::vector<int> tangent;
   for (int j = 0; j < null_space.rows(); ++j) {
@@ -58,7 +64,7 @@ std::string DescribeNullSpace(const Eigen::MatrixXd& null_space, const Eigen::Ve
     }
   }
   const int rank_loss = static_cast<int>(null_space.cols());
-  std::string text = JoinNames(involved) + " cannot be told apart by these sweeps";
+  std::string text = JoinNames(form, involved) + " cannot be told apart by these sweeps";
   if (rank_loss != 1 || involved.size() != 2) {
     return text + StringPrintf(
                       ": %d combination(s) of them are not determined; fix %d of them or add "
@@ -73,7 +79,7 @@ std::string DescribeNullSpace(const Eigen::MatrixXd& null_space, const Eigen::Ve
   text += StringPrintf(
       " (a change of one is undone by a change of the other: their correlation is %+.3f)",
       sign * cosine);
-  if (IsPair(involved[0], involved[1], kDelta, kAlpha)) {
+  if (IsInertiaPair(form, involved[0], involved[1])) {
     // Along the null direction alpha - (2/3) delta Omega^2 stays constant:
     // d alpha = (2/3) Omega^2 d delta, which gives the Omega the data fix.
     const int d = involved[0] == kDelta ? tangent[0] : tangent[1];
@@ -86,7 +92,7 @@ std::string DescribeNullSpace(const Eigen::MatrixXd& null_space, const Eigen::Ve
                        RadPerSecondToHz(std::sqrt(omega_squared)));
     }
   }
-  return text + "; " + PairAdvice(involved[0], involved[1]);
+  return text + "; " + PairAdvice(form, involved[0], involved[1]);
 }
 
 // Counts the fitted dwells past the end of their branch at `estimate`
@@ -220,10 +226,12 @@ void CopyIntervals(const BlockCovariance& c, ParameterUncertainty* u) {
   }
 }
 
-// g = d alpha_e / dp, alpha_e = alpha - (2/3) delta Omega_ref^2.
-Eigen::Matrix<double, kNumParameters, 1> EffectiveNonlinearityGradient(double omega_ref_rad_s) {
+// g = d alpha_e / dp, alpha_e = alpha - (2/3) delta Omega_ref^2 (alpha for
+// a member without delta).
+Eigen::Matrix<double, kNumParameters, 1> EffectiveNonlinearityGradient(ModelForm form,
+                                                                       double omega_ref_rad_s) {
   Eigen::Matrix<double, kNumParameters, 1> g = Eigen::Matrix<double, kNumParameters, 1>::Zero();
-  g[kDelta] = -(2.0 / 3.0) * omega_ref_rad_s * omega_ref_rad_s;
+  if (form.has_inertia()) g[kDelta] = -(2.0 / 3.0) * omega_ref_rad_s * omega_ref_rad_s;
   g[kAlpha] = 1.0;
   return g;
 }
@@ -231,7 +239,7 @@ Eigen::Matrix<double, kNumParameters, 1> EffectiveNonlinearityGradient(double om
 // alpha_e's variance g^T C g.
 void SetEffectiveNonlinearity(ParameterUncertainty* u) {
   const Eigen::Matrix<double, kNumParameters, 1> gradient =
-      EffectiveNonlinearityGradient(u->omega_ref_rad_s);
+      EffectiveNonlinearityGradient(u->form, u->omega_ref_rad_s);
   u->effective_nonlinearity_standard_error =
       std::sqrt(std::max(gradient.dot(u->covariance * gradient), 0.0));
   u->effective_nonlinearity_ci95_low =
@@ -276,7 +284,7 @@ void WidenProfileByLevel(const LevelNoise& level, const ParameterVector& estimat
             &u->ci95_high[j]);
   }
   const Eigen::Matrix<double, kNumParameters, 1> g =
-      EffectiveNonlinearityGradient(u->omega_ref_rad_s);
+      EffectiveNonlinearityGradient(u->form, u->omega_ref_rad_s);
   WidenBy(u->effective_nonlinearity, g.dot(level.added * g), u->interval_quantile,
           &u->effective_nonlinearity_ci95_low, &u->effective_nonlinearity_ci95_high);
 }
@@ -290,20 +298,21 @@ void AddPairAndBoundWarnings(const std::vector<int>& free, const ParameterVector
       const double rho = u->correlation(a, b);
       if (std::abs(rho) <= kCorrelationWarning) continue;
       std::string warning =
-          StringPrintf("%s and %s correlate at %+.3f: ", ParameterName(a), ParameterName(b), rho);
-      if (IsPair(a, b, kDelta, kAlpha)) {
+          StringPrintf("%s and %s correlate at %+.3f: ", ParameterName(u->form, a),
+                       ParameterName(u->form, b), rho);
+      if (IsInertiaPair(u->form, a, b)) {
         warning += StringPrintf(
             "delta and alpha are weakly separated by these sweeps, while alpha - (2/3) delta "
             "Omega_ref^2 = %.4g +/- %.2g is well determined; ",
             u->effective_nonlinearity, u->effective_nonlinearity_standard_error);
       }
-      u->warnings.push_back(warning + PairAdvice(a, b));
+      u->warnings.push_back(warning + PairAdvice(u->form, a, b));
     }
   }
   for (int i : free) {
     const bool bounded = i == kEtaE || i == kMu1 || i == kMu2;
     if (bounded && estimate[i] <= 0.0) {
-      u->warnings.push_back(std::string(ParameterName(i)) +
+      u->warnings.push_back(std::string(ParameterName(u->form, i)) +
                             " sits on its bound 0: the data pull it below zero, and its interval "
                             "ignores the bound");
     }
@@ -318,7 +327,8 @@ BlockCovariance PenalisedCovariance(const std::vector<const Sweep*>& fitted,
                                     const ParameterVector& estimate, double noise_variance,
                                     const std::vector<PenaltyCurvature>& terms) {
   ParameterVector parameters = estimate;  // the block the problem reads
-  FitDescription fit = SingleBlockFit(fitted, options.fixed, &parameters);
+  FitDescription fit =
+      SingleBlockFit(fitted, options.fixed, &parameters, options.solve.residual.form);
   if (!terms.empty()) {
     fit.add_residuals = [&terms, &parameters, noise_variance](ceres::Problem* problem) {
       for (const PenaltyCurvature& term : terms) {
@@ -403,12 +413,14 @@ void UseProfile(const ProfileLikelihood& profile, ParameterUncertainty* u) {
   u->interval_kind = "profile_likelihood";
   for (int q = 0; q <= kNumParameters; ++q) {
     const bool effective = q == kNumParameters;
-    const ProfileInterval& interval =
-        effective ? profile.effective_nonlinearity : profile.parameters[q];
+    // Without the inertia delta, alpha_e is alpha, and so is its profile.
+    const ProfileInterval& interval = !effective              ? profile.parameters[q]
+                                      : u->form.has_inertia() ? profile.effective_nonlinearity
+                                                              : profile.parameters[kAlpha];
     if (!interval.computed) continue;
     double& low = effective ? u->effective_nonlinearity_ci95_low : u->ci95_low[q];
     double& high = effective ? u->effective_nonlinearity_ci95_high : u->ci95_high[q];
-    const char* name = effective ? "alpha_e" : ParameterName(q);
+    const char* name = effective ? "alpha_e" : ParameterName(u->form, q);
     const double ratio = (high - low) / (interval.high - interval.low);
     if (interval.low_end == ProfileEnd::kOpen || interval.high_end == ProfileEnd::kOpen) {
       u->warnings.push_back(StringPrintf(
@@ -486,9 +498,10 @@ ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted
                                          const FitSummary* summary, IntervalMethod method,
                                          int threads) {
   ParameterUncertainty u;
+  u.form = options.solve.residual.form;
   if (!(omega_ref_rad_s > 0.0)) omega_ref_rad_s = estimate[kNaturalFrequency];
   u.omega_ref_rad_s = omega_ref_rad_s;
-  u.effective_nonlinearity = EffectiveNonlinearity(estimate, omega_ref_rad_s);
+  u.effective_nonlinearity = EffectiveNonlinearity(u.form, estimate, omega_ref_rad_s);
   if (!std::isfinite(u.effective_nonlinearity)) u.effective_nonlinearity = 0.0;
 
   const BlockCovariance data_only = PenalisedCovariance(fitted, options, estimate, 1.0, {});
@@ -504,11 +517,11 @@ ParameterUncertainty EstimateUncertainty(const std::vector<const Sweep*>& fitted
     WarnAboutDwellsPastTheirBranchEnd(fitted, options.solve.residual.form, estimate, &u);
   if (!c.available) {
     // Entries the data cannot tell apart are named in the model's terms.
-    u.message = c.null_space.cols() == 0
-                    ? c.message
-                    : DescribeNullSpace(c.null_space, c.unit_scale, c.free, c.column_cosines) +
-                          StringPrintf(" (collinearity %.3g, limit %.3g)", c.collinearity,
-                                       kMaxCollinearity);
+    u.message = c.null_space.cols() == 0 ? c.message
+                                         : DescribeNullSpace(u.form, c.null_space, c.unit_scale,
+                                                             c.free, c.column_cosines) +
+                                               StringPrintf(" (collinearity %.3g, limit %.3g)",
+                                                            c.collinearity, kMaxCollinearity);
     return u;
   }
   CopyIntervals(c, &u);

@@ -73,6 +73,7 @@ struct ParameterUncertainty {
   std::string message;
   // "profile_likelihood", "gauss_newton" or "linearised_with_penalty".
   std::string interval_kind = "gauss_newton";
+  ModelForm form;         // the member whose parameters these are (model_form.h)
   int penalty_terms = 0;  // enforced jumps whose curvature entered C
   // s, in the residual's unit (data length unit, or ln a for the relative
   // error); 1 when every residual is standardised by its point's sigma.

@@ -99,7 +99,7 @@ double AlphaETie(const ProfileProblem& problem) {
 // Returns the final cost, infinity when it cannot be evaluated.
 double MinimiseHeld(const ProfileProblem& problem, const std::array<bool, kNumParameters>& held,
                     bool tie, double function_tolerance, ParameterVector* p) {
-  const FitDescription fit = SingleBlockFit(problem.fitted, held, p);
+  const FitDescription fit = SingleBlockFit(problem.fitted, held, p, problem.residual.form);
   std::string error;
   if (!fit.IsValid(&error)) return kInfinity;
   StageSetup setup;
@@ -160,12 +160,16 @@ double ConstrainedMinimum(const ProfileProblem& problem, int quantity, double va
 }
 
 double ValueOf(const ProfileProblem& problem, int quantity, const ParameterVector& p) {
-  return quantity == kEffective ? EffectiveNonlinearity(p, problem.omega_ref_rad_s) : p[quantity];
+  return quantity == kEffective
+             ? EffectiveNonlinearity(problem.residual.form, p, problem.omega_ref_rad_s)
+             : p[quantity];
 }
 
 bool IsProfiled(const ProfileProblem& problem, int quantity) {
   if (quantity == kEffective) {
-    return !(problem.fixed[kAlpha] && problem.fixed[kDelta]) && problem.omega_ref_rad_s > 0.0;
+    // A member without the inertia delta has alpha_e = alpha (profiled as alpha).
+    return problem.residual.form.has_inertia() &&
+           !(problem.fixed[kAlpha] && problem.fixed[kDelta]) && problem.omega_ref_rad_s > 0.0;
   }
   return !problem.fixed[quantity];
 }
@@ -401,7 +405,8 @@ ProfileLikelihood ProfileCost(const ProfileProblem& problem, const ParameterVect
       profile.lower_cost = side->lower_cost;
       profile.lower_point = side->lower->p;
       profile.lower_while = StringPrintf(
-          "profiling %s at %.6g", q == kEffective ? "alpha_e" : ParameterName(q), side->lower->t);
+          "profiling %s at %.6g",
+          q == kEffective ? "alpha_e" : ParameterName(problem.residual.form, q), side->lower->t);
     }
   }
   return profile;

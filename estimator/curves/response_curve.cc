@@ -23,12 +23,20 @@ struct FrequencyQuadratic {
   double backbone_x = kNaN;  // B / C
 };
 
-FrequencyQuadratic MakeQuadratic(const ParameterVector& p, double a_base, double a) {
+// A member of the family (model_form.h) keeps the quadratic: mu3 enters D as
+// mu3 a^2 / 4, alpha5 enters B as (5/2) alpha5 a^4, and delta is then 0.
+FrequencyQuadratic MakeQuadratic(ModelForm form, const ParameterVector& p, double a_base,
+                                 double a) {
   const double eta_e = p[kEtaE];
   const double w = p[kNaturalFrequency];
-  const double d = (p[kMu1] + 4.0 * p[kMu2] * a / (3.0 * kPi)) * a / eta_e;
-  const double b = a * (4.0 * w * w + 3.0 * p[kAlpha] * a * a) / (8.0 * eta_e);
-  const double c = a * (4.0 + 2.0 * p[kDelta] * a * a) / (8.0 * eta_e);
+  const double damping = form.cubic_damping() ? p[kMu1] + 0.25 * p[kMu3] * a * a
+                                              : p[kMu1] + 4.0 * p[kMu2] * a / (3.0 * kPi);
+  const double d = damping * a / eta_e;
+  double stiffness = 4.0 * w * w + 3.0 * p[kAlpha] * a * a;
+  if (form.quintic_stiffness()) stiffness += 2.5 * p[kAlpha5] * a * a * a * a;
+  const double b = a * stiffness / (8.0 * eta_e);
+  const double delta = form.has_inertia() ? p[kDelta] : 0.0;
+  const double c = a * (4.0 + 2.0 * delta * a * a) / (8.0 * eta_e);
   FrequencyQuadratic q;
   q.c2 = c * c;
   q.c1 = d * d - 2.0 * b * c;
@@ -41,8 +49,8 @@ FrequencyQuadratic MakeQuadratic(const ParameterVector& p, double a_base, double
 // Omega [rad/s] on `side` (0: left root x-, 1: right root x+ >= x-) at
 // amplitude a; NaN where that root is not a positive x. A discriminant
 // rounded just below 0 at a piece's end counts as 0.
-double SideFrequency(const ParameterVector& p, double a_base, double a, int side) {
-  const FrequencyQuadratic q = MakeQuadratic(p, a_base, a);
+double SideFrequency(ModelForm form, const ParameterVector& p, double a_base, double a, int side) {
+  const FrequencyQuadratic q = MakeQuadratic(form, p, a_base, a);
   if (std::isnan(q.disc) || !(q.c2 > 0.0)) return kNaN;
   const double s = std::sqrt(std::max(q.disc, 0.0));
   const double big = -0.5 * (q.c1 + std::copysign(s, q.c1));
@@ -88,7 +96,7 @@ double SliceG(const ParameterVector& p, double omega, double a) {
 
 SecondOrderSlice MakeSecondOrderSlice(const ParameterVector& p, double a_base, double a) {
   SecondOrderSlice slice;
-  const double x = MakeQuadratic(p, a_base, a).backbone_x;
+  const double x = MakeQuadratic(kSecondOrderForm, p, a_base, a).backbone_x;
   const double w = p[kNaturalFrequency];
   const double centre = x > 0.0 ? std::sqrt(x) : w;
   const double lo = std::max(0.6 * centre, 0.45 * w);
@@ -146,9 +154,15 @@ CurvePoint MakePoint(ModelForm form, const ParameterVector& p, double omega, dou
 }
 
 // An upper bound of the frequency response's amplitude over the range:
-// P = Omega D(a) <= a_base with Omega >= control_low.
-double FrequencyAmplitudeBound(const ParameterVector& p, const CurveSpec& spec) {
+// P = Omega D(a) <= a_base with Omega >= control_low; with mu3 (model_form.h)
+// both mu1 a and mu3 a^3 / 4 are at most eta_e a_base / Omega.
+double FrequencyAmplitudeBound(ModelForm form, const ParameterVector& p, const CurveSpec& spec) {
   const double rhs = spec.a_base * p[kEtaE] / spec.control_low;
+  if (form.cubic_damping()) {
+    const double by_mu3 = p[kMu3] > 0.0 ? std::cbrt(4.0 * rhs / p[kMu3]) : kNaN;
+    const double by_mu1 = p[kMu1] > 0.0 ? rhs / p[kMu1] : kNaN;
+    return std::fmin(by_mu1, by_mu3);  // the finite one where one is NaN
+  }
   const double k = 4.0 * p[kMu2] / (3.0 * kPi);
   if (k > 0.0) return (-p[kMu1] + std::sqrt(p[kMu1] * p[kMu1] + 4.0 * k * rhs)) / (2.0 * k);
   return rhs / p[kMu1];
@@ -177,7 +191,7 @@ std::vector<std::pair<double, double>> RealPieces(ModelForm form, const Paramete
   constexpr int kScan = 4000;
   auto disc = [&](double a) {
     return form.second_order() ? MakeSecondOrderSlice(p, a_base, a).excess
-                               : MakeQuadratic(p, a_base, a).disc;
+                               : MakeQuadratic(form, p, a_base, a).disc;
   };
   std::vector<std::pair<double, double>> pieces;
   double previous = lo;
@@ -208,7 +222,7 @@ double SideControl(ModelForm form, const ParameterVector& p, const CurveSpec& sp
                    int side) {
   if (spec.kind == SweepKind::kFrequency) {
     return form.second_order() ? SecondOrderSideFrequency(p, spec.a_base, a, side % 2)
-                               : SideFrequency(p, spec.a_base, a, side % 2);
+                               : SideFrequency(form, p, spec.a_base, a, side % 2);
   }
   const auto k = ResponseCoefficients<double>::FromParameters(form, p.data(), spec.omega_rad_s);
   return std::sqrt(k.G(a));
@@ -273,7 +287,7 @@ std::vector<RawPoint> FrequencyTrace(ModelForm form, const ParameterVector& p,
   const double a_start = 0.25 * spec.a_base / std::sqrt(std::max(k_lo.c2(), k_hi.c2()));
   // The bound is the first order's; P's k7 a^4 may lower P, so the second
   // order searches further.
-  const double a_bound = (form.second_order() ? 1.5 : 1.0) * FrequencyAmplitudeBound(p, spec);
+  const double a_bound = (form.second_order() ? 1.5 : 1.0) * FrequencyAmplitudeBound(form, p, spec);
   std::vector<RawPoint> trace;
   if (!(a_start > 0.0) || !(a_bound > a_start)) return trace;
   const auto pieces = RealPieces(form, p, spec.a_base, a_start, a_bound);
@@ -351,7 +365,7 @@ double BackboneAmplitudeSquared(const ResponseCoefficients<double>& k) {
 // The backbone's Omega [rad/s] at amplitude a: the first order's sqrt(B / C),
 // the second order's the root of Q(a; Omega) = 0 within 20 % of it.
 double BackboneFrequency(ModelForm form, const ParameterVector& p, double a_base, double a) {
-  const double x = MakeQuadratic(p, a_base, a).backbone_x;
+  const double x = MakeQuadratic(form, p, a_base, a).backbone_x;
   if (!(x > 0.0)) return kNaN;
   if (!form.second_order()) return std::sqrt(x);
   auto q = [&](double omega) {
@@ -405,9 +419,10 @@ ResponseCurve TraceResponseCurve(ModelForm form, const ParameterVector& p, const
   std::string why;
   if (!spec.IsValid(&why)) throw InputError(spec.name, 0, "curve", why);
   if (!(p[kEtaE] > 0.0) || !(p[kMu1] >= 0.0) || !(p[kMu2] >= 0.0) || !(p[kMu1] + p[kMu2] > 0.0)) {
+    const std::string mu = ParameterName(form, kMu2);
     throw InputError(spec.name, 0, "curve",
-                     "the parameters make no response curve: it needs eta_e > 0, mu1 >= 0, "
-                     "mu2 >= 0 and some damping (mu1 + mu2 > 0); give physical parameters");
+                     "the parameters make no response curve: it needs eta_e > 0, mu1 >= 0, " + mu +
+                         " >= 0 and some damping (mu1 + " + mu + " > 0); give physical parameters");
   }
   const std::vector<RawPoint> trace = spec.kind == SweepKind::kFrequency
                                           ? FrequencyTrace(form, p, spec)

@@ -215,10 +215,11 @@ int FitDescription::NumDwells() const {
 
 FitDescription SingleBlockFit(const std::vector<const Sweep*>& sweeps,
                               const std::array<bool, kNumParameters>& fixed,
-                              ParameterVector* parameters) {
+                              ParameterVector* parameters, ModelForm form) {
   FitDescription fit;
   fit.blocks = {{parameters->data(), kNumParameters, "parameters"}};
-  fit.blocks[0].entry_names.assign(kParameterNames.begin(), kParameterNames.end());
+  const auto names = ParameterNames(form);
+  fit.blocks[0].entry_names.assign(names.begin(), names.end());
   fit.blocks[0].fixed.assign(fixed.begin(), fixed.end());
   fit.datasets = {{"fit", sweeps, IdentityMap(parameters->data())}};
   return fit;

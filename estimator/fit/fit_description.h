@@ -31,6 +31,7 @@
 
 #include "ceres/problem.h"
 #include "dwellfit/estimator/data/sweep.h"
+#include "dwellfit/residuals/model/model_form.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 
 namespace dwellfit {
@@ -93,10 +94,11 @@ struct FitDescription {
   int NumDwells() const;
 };
 
-// The single-dataset fit: one 6-double block `parameters` with `fixed`.
+// The single-dataset fit: one 6-double block `parameters` with `fixed`, its
+// entries named after `form`'s member.
 FitDescription SingleBlockFit(const std::vector<const Sweep*>& sweeps,
                               const std::array<bool, kNumParameters>& fixed,
-                              ParameterVector* parameters);
+                              ParameterVector* parameters, ModelForm form = ModelForm{});
 
 // The distinct blocks a dataset's six parameters live in, in order of first
 // use, and the position and entry of each parameter among them.

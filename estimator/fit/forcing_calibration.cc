@@ -99,7 +99,8 @@ CalibratedIdentification IdentifyWithForcingCalibration(
   const ParameterIndex index = CalibratedIndex(calibration.parameter);
   const std::string name = ParameterName(index);
   std::vector<double> etas(size, options.initial[index]);
-  FitDescription fit = SingleBlockFit(fitted, options.fixed, &out.fit.parameters);
+  FitDescription fit =
+      SingleBlockFit(fitted, options.fixed, &out.fit.parameters, options.solve.residual.form);
   fit.blocks.push_back({etas.data(), size, name + " per sweep"});
   fit.datasets.clear();
   for (int k = 0; k < size; ++k) {

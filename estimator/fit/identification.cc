@@ -17,7 +17,8 @@ IdentificationResult Identify(const std::vector<const Sweep*>& fitted,
     result.message = error;
     return result;
   }
-  const FitDescription fit = SingleBlockFit(fitted, options.fixed, &result.parameters);
+  const FitDescription fit =
+      SingleBlockFit(fitted, options.fixed, &result.parameters, options.solve.residual.form);
   static_cast<FitSummary&>(result) = SolveStaged(fit, options.solve);
   return result;
 }

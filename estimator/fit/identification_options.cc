@@ -108,7 +108,7 @@ bool StagedSolveOptions::IsValid(std::string* error) const {
 
 bool IdentificationOptions::InitialIsValid(std::string* error) const {
   for (int i = 0; i < kNumParameters; ++i) {
-    const std::string field = std::string("initial.") + ParameterName(i);
+    const std::string field = std::string("initial.") + ParameterName(solve.residual.form, i);
     if (!std::isfinite(initial[i])) {
       *error = field + " must be a finite number, got " + StringPrintf("%g", initial[i]);
       return false;

@@ -496,4 +496,28 @@ InitialGuessReport AutomaticInitialGuess(const std::vector<const Sweep*>& sweeps
   return report;
 }
 
+InitialGuessReport AutomaticInitialGuess(const std::vector<const Sweep*>& sweeps,
+                                         const KnownParameters& known, ModelForm form) {
+  if (!form.family_terms()) return AutomaticInitialGuess(sweeps, known);
+  std::vector<int> own;  // the entries that hold the member's own terms
+  if (form.cubic_damping()) own.push_back(kMu3);
+  if (form.quintic_stiffness()) own.push_back(kAlpha5);
+  KnownParameters chapter = known;
+  for (int index : own) chapter[index] = 0.0;
+  InitialGuessReport report = AutomaticInitialGuess(sweeps, chapter);
+  for (int index : own) {
+    const std::string chapter_step = std::string(ParameterName(index)) + " = ";
+    auto& steps = report.steps;
+    steps.erase(
+        std::remove_if(steps.begin(), steps.end(),
+                       [&](const std::string& step) { return step.rfind(chapter_step, 0) == 0; }),
+        steps.end());
+    report.guess[index] = known[index].value_or(0.0);
+    steps.push_back(StringPrintf(
+        "%s = %.6g: %s", ParameterName(form, index), report.guess[index],
+        known[index] ? "given" : "the member's own term starts at 0 and the fit frees it"));
+  }
+  return report;
+}
+
 }  // namespace dwellfit

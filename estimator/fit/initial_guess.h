@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "dwellfit/estimator/data/sweep.h"
+#include "dwellfit/residuals/model/model_form.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 
 namespace dwellfit {
@@ -63,6 +64,11 @@ struct InitialGuessReport {
 // no amplitude sweep reaching the upper branch) or no dwell off resonance.
 InitialGuessReport AutomaticInitialGuess(const std::vector<const Sweep*>& sweeps,
                                          const KnownParameters& known);
+// The same for `form`'s member: the chapter's estimate with its terms that
+// the member replaces (mu2, delta) held at 0; the member's own terms (mu3,
+// alpha5, model_form.h) start where given, else at 0, and the fit frees them.
+InitialGuessReport AutomaticInitialGuess(const std::vector<const Sweep*>& sweeps,
+                                         const KnownParameters& known, ModelForm form);
 
 }  // namespace dwellfit
 

@@ -309,10 +309,15 @@ bool RunStage(const SolveContext& context, ResidualKind kind, const PenaltyOptio
 // A step unit for a parameter that starts at 0, independent of the units of
 // a and time (docs/model.md, "Units"): delta like |alpha| / w^2, alpha like
 // w^2 / a_max^2 / 10 (a tenth of the linear stiffness at the largest
-// amplitude), mu2 like mu1 / a_max, mu1 like w / 1000.
-double NaturalScale(int parameter, const ParameterVector& p, double a_max) {
+// amplitude), mu2 like mu1 / a_max, mu1 like w / 1000; a member's own terms
+// (model_form.h) alike: mu3 like mu1 / a_max^2, alpha5 like alpha / a_max^2.
+double NaturalScale(int parameter, const ParameterVector& p, double a_max, ModelForm form) {
   const double w = std::abs(p[kNaturalFrequency]);
   const double mu1 = p[kMu1] != 0.0 ? std::abs(p[kMu1]) : 1e-3 * w;
+  if (parameter == kMu3 && form.cubic_damping()) return mu1 / (a_max * a_max);
+  if (parameter == kAlpha5 && form.quintic_stiffness()) {
+    return NaturalScale(kAlpha, p, a_max, form) / (a_max * a_max);
+  }
   switch (parameter) {
     case kDelta:
       return p[kAlpha] != 0.0 ? std::abs(p[kAlpha]) / (w * w) : 0.1 / (a_max * a_max);
@@ -329,7 +334,7 @@ double NaturalScale(int parameter, const ParameterVector& p, double a_max) {
 
 // The step unit of every entry: its scale when given, else |value at the
 // start|, for 0 its NaturalScale in the first dataset that maps it (else 1).
-std::vector<double> StartScale(const FitDescription& fit) {
+std::vector<double> StartScale(const FitDescription& fit, ModelForm form) {
   std::vector<double> scale = fit.Values();
   for (double& value : scale) value = std::abs(value);
   for (const FitDataset& dataset : fit.datasets) {
@@ -341,7 +346,7 @@ std::vector<double> StartScale(const FitDescription& fit) {
     for (int i = 0; i < kNumParameters; ++i) {
       const int entry = fit.AmbientIndex(dataset.parameters[i]);
       if (entry < 0 || scale[entry] != 0.0) continue;
-      const double natural = a_max > 0.0 ? NaturalScale(i, p, a_max) : 1.0;
+      const double natural = a_max > 0.0 ? NaturalScale(i, p, a_max, form) : 1.0;
       scale[entry] = std::isfinite(natural) && natural > 0.0 ? natural : 1.0;
     }
   }
@@ -656,7 +661,7 @@ FitSummary SolveStaged(const FitDescription& fit, const StagedSolveOptions& opti
     summary.message = error;
     return summary;
   }
-  const SolveContext context{fit, options, StartScale(fit),
+  const SolveContext context{fit, options, StartScale(fit, options.residual.form),
                              ResolveThreadCount(options.solver.num_threads)};
   std::vector<double> previous_start;
   bool fold_stage_ran = false;

@@ -35,6 +35,7 @@ struct RigEquation {
   double base_pole;   // 2 pi f_c [rad/s], 0: no filter
   double response_pole;
   const StrainGauge* gauge;
+  ModelForm form;  // the member: entries kMu2 and kDelta may hold mu3 and alpha5
 
   void operator()(const State& x, State& dxdt, double t) const {
     const double theta = omega * t + phase0;
@@ -42,9 +43,15 @@ struct RigEquation {
     const double v = omega * scale * x[1];
     const double w = p[kNaturalFrequency];
     const double drive = a_base * std::cos(theta);
-    const double restoring = w * w * u + p[kDelta] * u * v * v + p[kAlpha] * u * u * u;
-    const double damping = 2.0 * p[kMu1] * v + (p[kMu2] / omega) * v * std::abs(v);
-    const double acc = (2.0 * p[kEtaE] * drive - restoring - damping) / (1.0 + p[kDelta] * u * u);
+    // (1 + delta u^2) u'' + delta u u'^2 + w^2 u + alpha u^3 [+ alpha5 u^5]
+    //   + 2 mu1 u' + (mu2 / Omega) u'|u'| [or 2 mu3 u^2 u'] = 2 eta_e a_base cos(theta)
+    const double delta = form.has_inertia() ? p[kDelta] : 0.0;
+    double restoring = w * w * u + delta * u * v * v + p[kAlpha] * u * u * u;
+    if (form.quintic_stiffness()) restoring += p[kAlpha5] * u * u * u * u * u;
+    double damping = 2.0 * p[kMu1] * v;
+    damping +=
+        form.cubic_damping() ? 2.0 * p[kMu3] * u * u * v : (p[kMu2] / omega) * v * std::abs(v);
+    const double acc = (2.0 * p[kEtaE] * drive - restoring - damping) / (1.0 + delta * u * u);
     dxdt[0] = omega * x[1];
     dxdt[1] = acc / (omega * scale);
     dxdt[2] = base_pole > 0.0 ? base_pole * (drive / a_base - x[2]) : 0.0;
@@ -61,8 +68,8 @@ using Stepper = odeint::controlled_runge_kutta<odeint::runge_kutta_dopri5<State>
 // One dwell: settle, then record. Updates `state`.
 class DwellRun {
  public:
-  DwellRun(const ParameterVector& p, const RigOptions& options, const StrainGauge& gauge,
-           double omega, double a_base, RigMotion* state)
+  DwellRun(const ParameterVector& p, ModelForm form, const RigOptions& options,
+           const StrainGauge& gauge, double omega, double a_base, RigMotion* state)
       : options_(options), state_(state), period_(kTwoPi / omega) {
     const double w = p[kNaturalFrequency];
     const double linear =
@@ -72,7 +79,7 @@ class DwellRun {
     const auto pole = [](double cutoff_hz) { return cutoff_hz > 0.0 ? kTwoPi * cutoff_hz : 0.0; };
     equation_ = RigEquation({p, omega, a_base, state->phase, scale, volt_scale,
                              pole(options.channels.base_filter_cutoff_hz),
-                             pole(options.channels.response_filter_cutoff_hz), &gauge});
+                             pole(options.channels.response_filter_cutoff_hz), &gauge, form});
     x_ = State({state->u / scale, state->v / (omega * scale), state->y_base / a_base,
                 state->y_response / volt_scale, 0.0, 0.0});
     stepper_ = odeint::make_controlled(options.integration_tolerance, options.integration_tolerance,
@@ -298,8 +305,12 @@ bool RigOptions::IsValid(std::string* error) const {
   return true;
 }
 
-VirtualRig::VirtualRig(const ParameterVector& truth, const RigOptions& options)
-    : truth_(truth), options_(options), gauge_(options.gauge), random_(options.noise_seed) {
+VirtualRig::VirtualRig(const ParameterVector& truth, const RigOptions& options, ModelForm form)
+    : truth_(truth),
+      form_(form),
+      options_(options),
+      gauge_(options.gauge),
+      random_(options.noise_seed) {
   std::string error;
   if (!options.IsValid(&error)) throw InputError("rig: " + error);
 }
@@ -309,7 +320,7 @@ RigDwell VirtualRig::Dwell(double f_hz, double a_base, const std::string& sweep_
   CheckSampleRate(options_, f_hz, "the dwell's drive frequency");
   const double omega = HzToRadPerSecond(f_hz);
   RigDwell out;
-  DwellRun dwell(truth_, options_, gauge_, omega, a_base, &motion_);
+  DwellRun dwell(truth_, form_, options_, gauge_, omega, a_base, &motion_);
   out.truth = dwell.Settle();
   out.trace =
       DwellTrace{sweep_id, direction, SweepKind::kFrequency, omega, options_.sample_rate_hz};
@@ -324,7 +335,7 @@ RigDwell VirtualRig::Dwell(double f_hz, double a_base, const std::string& sweep_
 
 RigRun SimulateRig(const DwellPlan& plan, const RigOptions& options, const RigProgress& progress) {
   CheckPlan(plan, options);
-  VirtualRig rig(plan.truth, options);
+  VirtualRig rig(plan.truth, options, plan.form);
   int total = 0;
   for (const SweepPlan& sweep : plan.sweeps) {
     total += (sweep.NumSteps() + 1) * static_cast<int>(sweep.directions.size());

@@ -111,8 +111,10 @@ struct RigDwell {
 // over all dwells, seeded by the options.
 class VirtualRig {
  public:
-  // Throws InputError when the options are not valid.
-  VirtualRig(const ParameterVector& truth, const RigOptions& options);
+  // `form` names the member whose terms entries kMu2 and kDelta of `truth`
+  // hold (its averaging does not matter: the rig integrates the equation of
+  // motion). Throws InputError when the options are not valid.
+  VirtualRig(const ParameterVector& truth, const RigOptions& options, ModelForm form = ModelForm{});
 
   // Settles and records one dwell at f_hz and base level a_base; the trace
   // carries `sweep_id` and `direction`. Throws InputError when the sample
@@ -127,6 +129,7 @@ class VirtualRig {
 
  private:
   ParameterVector truth_;
+  ModelForm form_;
   RigOptions options_;
   StrainGauge gauge_;
   std::mt19937_64 random_;

@@ -42,6 +42,7 @@ std::string StatusSection(const IdentificationReport& report) {
 // The estimates with their intervals and units; omega also in Hz.
 std::string EstimatesSection(const IdentificationReport& report, const DataUnits& units) {
   const ParameterUncertainty& u = report.uncertainty;
+  const ModelForm form = report.options.solve.residual.form;
   std::string html = "<h2>Estimates</h2>\n<p>95 % intervals: " +
                      HtmlEscape(u.available ? u.interval_kind : "none") + ". " +
                      HtmlEscape(u.message) + "</p>\n<table id=\"estimates\">\n" +
@@ -56,7 +57,7 @@ std::string EstimatesSection(const IdentificationReport& report, const DataUnits
     if (std::find(held.begin(), held.end(), i) != held.end()) note = "held at its bound";
     const bool interval = u.available && note.empty();
     html +=
-        "<tr>" + Cell(ParameterName(i)) + Cell(ParameterUnit(i, units)) +
+        "<tr>" + Cell(ParameterName(form, i)) + Cell(ParameterUnit(form, i, units)) +
         Cell(StringPrintf("%.10g", value), true) +
         Cell(interval ? StringPrintf("[%.6g, %.6g]", u.ci95_low[i], u.ci95_high[i]) : "-", true) +
         Cell(interval ? StringPrintf("%.3g", u.standard_error[i]) : "-", true) + Cell(note) +
@@ -203,9 +204,11 @@ std::string InlineSvgFigures(const std::vector<NamedFile>& files, const std::str
   return html;
 }
 
-std::string ParameterUnit(int index, const DataUnits& units) {
+std::string ParameterUnit(ModelForm form, int index, const DataUnits& units) {
   const std::string a = units.a.empty() ? "[A]" : units.a;
   const std::string b = units.a_base.empty() ? "[B]" : units.a_base;
+  if (index == kMu3 && form.cubic_damping()) return "1/(" + a + "^2 s)";
+  if (index == kAlpha5 && form.quintic_stiffness()) return "1/(" + a + "^4 s^2)";
   switch (index) {
     case kEtaE:
       return a + "/(" + b + " s^2)";

@@ -26,7 +26,7 @@ std::string ReportToHtml(const IdentificationReport& report, const std::vector<N
 
 // The unit of parameter `index` (docs/model.md, Units) in the data's units
 // ("[A]" and "[B]" where unstated): eta_e "mm/(g s^2)", mu2 "1/(mm s)".
-std::string ParameterUnit(int index, const DataUnits& units);
+std::string ParameterUnit(ModelForm form, int index, const DataUnits& units);
 
 // `text` with &, <, >, " and ' written as HTML entities.
 std::string HtmlEscape(const std::string& text);

@@ -66,9 +66,10 @@ void CheckSettings(const IdentifyConfig& config) {
   }
   for (int i = 0; i < kNumParameters; ++i) {
     if (!config.identification.fixed[i] || config.initial_guess[i]) continue;
-    const std::string key = i == kNaturalFrequency ? "omega_hz" : ParameterName(i);
+    const char* name = ParameterName(config.identification.solve.residual.form, i);
+    const std::string key = i == kNaturalFrequency ? "omega_hz" : name;
     throw InputError(config.config_path, 0, "fixed",
-                     std::string(ParameterName(i)) +
+                     std::string(name) +
                          " is held fixed but its initial guess is left to the data (auto); give "
                          "initial_guess." +
                          key + ", or remove it from 'fixed'");
@@ -84,7 +85,7 @@ void FillGuessesFromData(const IdentifyConfig& config, ResolvedRun* run) {
   if (!run->guessed_from_data) return;
   InitialGuessReport guess;
   try {
-    guess = AutomaticInitialGuess(run->fitted, given);
+    guess = AutomaticInitialGuess(run->fitted, given, config.identification.solve.residual.form);
   } catch (const InputError& error) {
     throw InputError(config.config_path, 0, "initial_guess",
                      std::string("cannot find a starting point from the data: ") + error.what() +
@@ -104,7 +105,8 @@ void FindAutomaticStart(const IdentifyConfig& config, ResolvedRun* run) {
     if (config.identification.fixed[i]) fixed[i] = config.initial_guess[i];
   }
   try {
-    InitialGuessReport guess = AutomaticInitialGuess(run->fitted, fixed);
+    InitialGuessReport guess =
+        AutomaticInitialGuess(run->fitted, fixed, config.identification.solve.residual.form);
     run->automatic_start = guess.guess;
     run->automatic_start_steps = std::move(guess.steps);
   } catch (const InputError& error) {

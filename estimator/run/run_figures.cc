@@ -151,8 +151,9 @@ std::vector<std::string> EstimateLines(const IdentificationReport& report) {
   for (int i = 0; i < kNumParameters; ++i) {
     const bool omega = i == kNaturalFrequency;
     const double scale = omega ? 1.0 / kTwoPi : 1.0;
-    std::string line = StringPrintf("%s = %.6g", omega ? "omega_hz" : ParameterName(i),
-                                    report.result.parameters[i] * scale);
+    std::string line = StringPrintf(
+        "%s = %.6g", omega ? "omega_hz" : ParameterName(report.options.solve.residual.form, i),
+        report.result.parameters[i] * scale);
     if (report.options.fixed[i]) {
       line += " (fixed)";
     } else if (std::find(held.begin(), held.end(), i) != held.end()) {

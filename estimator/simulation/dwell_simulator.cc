@@ -124,7 +124,7 @@ bool DwellPlan::IsValid(std::string* error) const {
   };
   for (int i = 0; i < kNumParameters; ++i) {
     if (!std::isfinite(truth[i])) {
-      return fail(std::string("truth parameter ") + ParameterName(i) + " is not finite");
+      return fail(std::string("truth parameter ") + ParameterName(form, i) + " is not finite");
     }
   }
   if (!(truth[kEtaE] > 0.0)) return fail("truth eta_e must be positive, got " + G12(truth[kEtaE]));
@@ -132,7 +132,8 @@ bool DwellPlan::IsValid(std::string* error) const {
     return fail("truth omega must be positive, got " + G12(truth[kNaturalFrequency]) + " rad/s");
   }
   if (truth[kMu1] < 0.0 || truth[kMu2] < 0.0) {
-    return fail("truth damping mu1 and mu2 must not be negative");
+    return fail(std::string("truth damping mu1 and ") + ParameterName(form, kMu2) +
+                " must not be negative");
   }
   if (sweeps.empty()) return fail("the plan has no sweeps");
   std::set<std::string> ids;
@@ -283,10 +284,11 @@ std::vector<Sweep> SimulateDwells(const DwellPlan& plan) {
 void DescribeSimulation(const DwellPlan& plan, const std::vector<Sweep>& sweeps,
                         std::ostream* out) {
   const ParameterVector& p = plan.truth;
-  *out << "truth: eta_e " << G12(p[kEtaE]) << ", mu1 " << G12(p[kMu1]) << " 1/s, mu2 "
-       << G12(p[kMu2]) << ", delta " << G12(p[kDelta]) << ", alpha " << G12(p[kAlpha]) << ", w "
-       << G12(p[kNaturalFrequency]) << " rad/s (" << G12(RadPerSecondToHz(p[kNaturalFrequency]))
-       << " Hz)\n";
+  const auto names = ParameterNames(plan.form);
+  *out << "truth: eta_e " << G12(p[kEtaE]) << ", mu1 " << G12(p[kMu1]) << " 1/s, " << names[kMu2]
+       << " " << G12(p[kMu2]) << ", " << names[kDelta] << " " << G12(p[kDelta]) << ", alpha "
+       << G12(p[kAlpha]) << ", w " << G12(p[kNaturalFrequency]) << " rad/s ("
+       << G12(RadPerSecondToHz(p[kNaturalFrequency])) << " Hz)\n";
   if (plan.noise.relative_sigma > 0.0) {
     *out << "noise: relative_sigma " << G12(plan.noise.relative_sigma) << ", seed "
          << plan.noise.seed << "\n";

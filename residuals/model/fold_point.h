@@ -38,11 +38,22 @@ namespace dwellfit {
 // dg/dOmega = -4 delta Omega, dD/dOmega = 18 Omega:
 //   dk6/dOmega = 3 (2 g g' D - g^2 D') / (32 eta_e D^2)
 //   dk7/dOmega = -(3 mu2 / (5 pi)) ((g + Omega g') D - Omega g D') / (eta_e D^2).
+// A member of the family (form.family_terms(), first order) adds
+// dk5/dOmega = k5/Omega and dk6/dOmega = 0.
 // `k` are the coefficients at `omega_drive_rad_s` in the same `form`.
 template <typename T>
 T DerivativeOfGInDriveFrequency(ModelForm form, const T* p, double omega_drive_rad_s,
                                 const ResponseCoefficients<T>& k, const T& a) {
   const double omega = omega_drive_rad_s;
+  if (form.family_terms()) {
+    // A member's own terms: k5 = Omega mu3 / (4 eta_e) grows with Omega as k1
+    // and k2 do, k6 = 5 alpha5 / (16 eta_e) does not; dk4/dOmega is the
+    // inertia's, 0 where entry kDelta is alpha5.
+    const T dp = k.PPerA(a) * a / omega;
+    const T delta = form.has_inertia() ? p[kDelta] : T(0.0);
+    const T dq = (-omega / p[kEtaE] - delta * omega / (2.0 * p[kEtaE]) * a * a) * a;
+    return 2.0 * (k.P(a) * dp + k.Q(a) * dq);
+  }
   const T dp = (k.k1 + k.k2 * a) * a / omega;
   const T dq = (-omega / p[kEtaE] - p[kDelta] * omega / (2.0 * p[kEtaE]) * a * a) * a;
   if (!form.second_order()) return 2.0 * (k.P(a) * dp + k.Q(a) * dq);

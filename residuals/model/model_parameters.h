@@ -8,6 +8,8 @@
 //   3      delta   nonlinear inertia [1/A^2]
 //   4      alpha   cubic stiffness [1/(A^2 s^2)]
 //   5      omega   linear natural frequency w [rad/s]
+// A member of the family (ModelForm) holds mu3 [1/(A^2 s)] in entry 2 or
+// alpha5 [1/(A^4 s^2)] in entry 3 instead.
 #ifndef DWELLFIT_RESIDUALS_MODEL_MODEL_PARAMETERS_H_
 #define DWELLFIT_RESIDUALS_MODEL_MODEL_PARAMETERS_H_
 
@@ -25,6 +27,10 @@ enum ParameterIndex : int {
   kAlpha = 4,
   kNaturalFrequency = 5,
   kNumParameters = 6,
+  // The family's terms, in the entries of the chapter's terms they replace
+  // (ModelForm, model_form.h).
+  kMu3 = kMu2,
+  kAlpha5 = kDelta,
 };
 
 // Values in the order of ParameterIndex; omega in rad/s.

@@ -14,7 +14,9 @@
 // Stability: a fixed point is stable iff dG/da > 0; folds (jumps) have dG/da = 0.
 // Models beyond the chapter's add k5 a^3 and k7 a^4 to P and k6 a^5 to Q
 // (ResponseCoefficients::higher_order; docs/model.md, "Terms beyond the chapter's").
-// The second-order form (ModelForm, model_form.h) sets, with
+// A member of the family (ModelForm) sets k5 = Omega mu3 / (4 eta_e) (cubic
+// damping 2 mu3 u^2 u') and k6 = 5 alpha5 / (16 eta_e) (quintic stiffness
+// alpha5 u^5). The second-order form (ModelForm, model_form.h) sets, with
 //   g = alpha - 2 delta Omega^2,  D = 9 Omega^2 - w^2:
 //   k6 = 3 g^2 / (32 eta_e D),   k7 = -3 mu2 Omega g / (5 pi eta_e D),   k5 = 0.
 #ifndef DWELLFIT_RESIDUALS_MODEL_RESPONSE_MODEL_H_
@@ -38,26 +40,34 @@ template <typename T>
 struct ParameterTerms {
   // `form` chooses the terms FromTerms adds; `p` is the parameter block
   // (ParameterIndex layout).
+  // A member's own terms (form.family_terms()) take entries kMu2 and kDelta
+  // in place of mu2 and delta, which are then 0.
   ParameterTerms(ModelForm form, const T* p)
       : second_order(form.second_order()),
+        family(form.family_terms()),
         eta_e(p[kEtaE]),
         two_eta_e(2.0 * p[kEtaE]),
         eight_eta_e(8.0 * p[kEtaE]),
         mu1(p[kMu1]),
-        scaled_mu2((4.0 / (3.0 * kPi)) * p[kMu2]),
+        scaled_mu2(form.cubic_damping() ? T(0.0) : T((4.0 / (3.0 * kPi)) * p[kMu2])),
         w_squared(p[kNaturalFrequency] * p[kNaturalFrequency]),
         three_alpha(3.0 * p[kAlpha]),
-        two_delta(2.0 * p[kDelta]) {
+        two_delta(form.quintic_stiffness() ? T(0.0) : T(2.0 * p[kDelta])) {
     if (second_order) alpha = p[kAlpha];
+    if (form.cubic_damping()) quarter_mu3 = 0.25 * p[kMu3];
+    if (form.quintic_stiffness()) scaled_alpha5 = (5.0 / 16.0) * p[kAlpha5];
   }
 
   bool second_order;
+  bool family;  // k5, k6 from the member's own terms
   T eta_e, two_eta_e, eight_eta_e;
   T mu1;
   T scaled_mu2;  // 4 mu2 / (3 pi)
   T w_squared;   // w^2 [rad^2/s^2]
   T three_alpha, two_delta;
-  T alpha = T(0.0);  // read by the second order only
+  T alpha = T(0.0);          // read by the second order only
+  T quarter_mu3 = T(0.0);    // mu3 / 4 [1/(A^2 s)]
+  T scaled_alpha5 = T(0.0);  // 5 alpha5 / 16 [1/(A^4 s^2)]
 };
 
 template <typename T>
@@ -90,6 +100,13 @@ struct ResponseCoefficients {
     k.k3 = -(omega_drive * omega_drive - t.w_squared) / t.two_eta_e;
     k.k4 = (t.three_alpha - t.two_delta * omega_drive * omega_drive) / t.eight_eta_e;
     if (t.second_order) AddSecondOrderTerms(t, omega_drive, &k);
+    if (t.family) {
+      // k5 = Omega mu3 / (4 eta_e), k6 = 5 alpha5 / (16 eta_e) (docs/model.md,
+      // "Terms beyond the chapter's").
+      k.k5 = omega_drive * t.quarter_mu3 / t.eta_e;
+      k.k6 = t.scaled_alpha5 / t.eta_e;
+      k.higher_order = true;
+    }
     return k;
   }
   // k6 = 3 g^2 / (32 eta_e D), k7 = -3 mu2 Omega g / (5 pi eta_e D), with

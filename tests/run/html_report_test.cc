@@ -21,13 +21,21 @@ using ::testing::Not;
 // docs/model.md, Units: each parameter's unit from those of a and a_base.
 TEST(HtmlReport, ParameterUnitsFollowTheDataUnits) {
   const DataUnits units{"mm", "g"};
-  EXPECT_EQ(ParameterUnit(kEtaE, units), "mm/(g s^2)");
-  EXPECT_EQ(ParameterUnit(kMu1, units), "1/s");
-  EXPECT_EQ(ParameterUnit(kMu2, units), "1/(mm s)");
-  EXPECT_EQ(ParameterUnit(kDelta, units), "1/mm^2");
-  EXPECT_EQ(ParameterUnit(kAlpha, units), "1/(mm^2 s^2)");
-  EXPECT_EQ(ParameterUnit(kNaturalFrequency, units), "rad/s");
-  EXPECT_EQ(ParameterUnit(kMu2, DataUnits{}), "1/([A] s)");
+  EXPECT_EQ(ParameterUnit(ModelForm{}, kEtaE, units), "mm/(g s^2)");
+  EXPECT_EQ(ParameterUnit(ModelForm{}, kMu1, units), "1/s");
+  EXPECT_EQ(ParameterUnit(ModelForm{}, kMu2, units), "1/(mm s)");
+  EXPECT_EQ(ParameterUnit(ModelForm{}, kDelta, units), "1/mm^2");
+  EXPECT_EQ(ParameterUnit(ModelForm{}, kAlpha, units), "1/(mm^2 s^2)");
+  EXPECT_EQ(ParameterUnit(ModelForm{}, kNaturalFrequency, units), "rad/s");
+  EXPECT_EQ(ParameterUnit(ModelForm{}, kMu2, DataUnits{}), "1/([A] s)");
+  // The family's terms (docs/model.md, "Terms beyond the chapter's"):
+  // 2 mu3 u^2 u' and alpha5 u^5 are accelerations, as mu1 u' and w^2 u are.
+  ModelForm family;
+  family.damping = DampingTerm::kCubic;
+  family.backbone = BackboneTerm::kQuintic;
+  EXPECT_EQ(ParameterUnit(family, kMu3, units), "1/(mm^2 s)");
+  EXPECT_EQ(ParameterUnit(family, kAlpha5, units), "1/(mm^4 s^2)");
+  EXPECT_EQ(ParameterUnit(family, kAlpha, units), "1/(mm^2 s^2)");
 }
 
 TEST(HtmlReport, EscapesEveryMarkupCharacter) {
