@@ -661,11 +661,6 @@ IdentifyConfig ReadIdentifyConfig(const ConfigSource& source, const fs::path& co
   }
 
   if (const auto value = top.Optional("model_selection")) {
-    if (form.family_terms()) {
-      throw source.Error(value->path, value->mark,
-                         "model_selection compares the chapter's variants (delta, mu2); remove it, "
-                         "or remove damping: and backbone: from model:");
-    }
     config.model_selection = ReadModelSelectionConfig(*value, source, config.initial_guess);
   }
   if (top.Optional("forcing_calibration")) {

@@ -13,6 +13,31 @@ namespace {
 constexpr const char* kSchemeNames[] = {"none", "leave_one_level_out"};
 constexpr const char* kTrainingNames[] = {"config", "all"};
 
+// A non-empty list of a member's terms, each once (`name` gives the
+// config's spelling of a term).
+template <typename Term>
+std::vector<Term> ReadTerms(const ConfigValue& value, const ConfigSource& source, const char* what,
+                            const std::vector<Term>& all, const char* (*name)(Term)) {
+  std::vector<std::string> allowed;
+  for (Term term : all) allowed.push_back(name(term));
+  std::vector<Term> terms;
+  for (const ConfigValue& entry : ReadList(value, source)) {
+    const std::string text = ReadOneOf(entry, source, what, allowed);
+    const Term term = all[std::find(allowed.begin(), allowed.end(), text) - allowed.begin()];
+    if (std::find(terms.begin(), terms.end(), term) != terms.end()) {
+      throw source.Error(entry.path, entry.mark,
+                         std::string(what) + " lists '" + text + "' twice; keep one");
+    }
+    terms.push_back(term);
+  }
+  if (terms.empty()) {
+    throw source.Error(value.path, value.mark,
+                       std::string(what) + " lists no term; give one or more of " +
+                           allowed.front() + ", " + allowed.back());
+  }
+  return terms;
+}
+
 // One list of choices: entries `free`, `initial` (the config's initial
 // guess, which must be given) or a number (omega in Hz).
 std::vector<ParameterChoice> ReadChoices(const ConfigValue& value, const ConfigSource& source,
@@ -134,10 +159,18 @@ bool ModelSelectionConfig::IsValid(std::string* error) const {
 
 ModelSelectionConfig ReadModelSelectionConfig(const ConfigValue& value, const ConfigSource& source,
                                               const KnownParameters& initial_guess) {
-  const StrictMap block(
-      value, source,
-      {"delta", "mu2", "omega_hz", "cross_validation", "training", "pool", "threads"});
+  const StrictMap block(value, source,
+                        {"backbone", "damping", "delta", "mu2", "omega_hz", "cross_validation",
+                         "training", "pool", "threads"});
   ModelSelectionConfig config;
+  if (const auto v = block.Optional("backbone")) {
+    config.backbone = ReadTerms<BackboneTerm>(
+        *v, source, "backbone", {BackboneTerm::kInertia, BackboneTerm::kQuintic}, BackboneTermName);
+  }
+  if (const auto v = block.Optional("damping")) {
+    config.damping = ReadTerms<DampingTerm>(
+        *v, source, "damping", {DampingTerm::kQuadratic, DampingTerm::kCubic}, DampingTermName);
+  }
   if (const auto v = block.Optional("delta")) {
     config.delta = ReadChoices(*v, source, kDelta, initial_guess);
   }

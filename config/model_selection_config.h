@@ -12,6 +12,7 @@
 #include "dwellfit/config/strict_yaml.h"
 #include "dwellfit/config/sweep_selection.h"
 #include "dwellfit/estimator/fit/initial_guess.h"
+#include "dwellfit/residuals/model/model_form.h"
 #include "dwellfit/residuals/model/model_parameters.h"
 
 namespace dwellfit {
@@ -44,8 +45,14 @@ enum class CrossValidationTraining {
 const char* CrossValidationTrainingName(CrossValidationTraining training);
 
 struct ModelSelectionConfig {
-  // The variants are every combination of these choices (delta, then mu2,
-  // then omega); each list non-empty, no choice twice.
+  // The members of the family compared (model_form.h): every combination of
+  // these terms, backbone slowest; the chapter's alone by default.
+  std::vector<BackboneTerm> backbone = {BackboneTerm::kInertia};
+  std::vector<DampingTerm> damping = {DampingTerm::kQuadratic};
+  // The variants of each member are every combination of these choices
+  // (delta, then mu2, then omega); each list non-empty, no choice twice.
+  // delta's and mu2's apply to the members that have them; a member's own
+  // term (alpha5, mu3) is free.
   std::vector<ParameterChoice> delta = {{std::nullopt, "free"}, {0.0, "0"}};
   std::vector<ParameterChoice> mu2 = {{std::nullopt, "free"}, {0.0, "0"}};
   std::vector<ParameterChoice> omega = {{std::nullopt, "free"}};

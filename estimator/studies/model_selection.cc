@@ -40,13 +40,22 @@ IdentifyConfig VariantConfig(const IdentifyConfig& config, const ModelVariant& v
   return copy;
 }
 
-// Every combination of the block's choices, delta slowest, omega fastest.
-std::vector<ModelVariant> ModelVariants(const ModelSelectionConfig& selection) {
+// Every combination of the block's members and choices: backbone slowest,
+// then damping, delta, mu2 and omega. A member's own term replaces the
+// chapter's choices of its entry by one: free.
+std::vector<ModelVariant> ModelVariants(const ModelSelectionConfig& selection,
+                                        Averaging averaging) {
+  const std::vector<ParameterChoice> free = {{std::nullopt, "free"}};
   std::vector<ModelVariant> variants;
-  for (const ParameterChoice& delta : selection.delta) {
-    for (const ParameterChoice& mu2 : selection.mu2) {
-      for (const ParameterChoice& omega : selection.omega) {
-        variants.push_back(ModelVariant{delta, mu2, omega});
+  for (BackboneTerm backbone : selection.backbone) {
+    for (DampingTerm damping : selection.damping) {
+      const ModelForm form{averaging, damping, backbone};
+      for (const ParameterChoice& delta : form.quintic_stiffness() ? free : selection.delta) {
+        for (const ParameterChoice& mu2 : form.cubic_damping() ? free : selection.mu2) {
+          for (const ParameterChoice& omega : selection.omega) {
+            variants.push_back(ModelVariant{delta, mu2, omega, form});
+          }
+        }
       }
     }
   }
@@ -300,7 +309,7 @@ ParameterSpread SpreadOf(const std::string& name, ParameterIndex index,
 
 // Every free parameter's spread over the usable fits (w in Hz), alpha_e's
 // when alpha is free.
-std::vector<ParameterSpread> Spreads(const IdentifyConfig& config,
+std::vector<ParameterSpread> Spreads(const IdentifyConfig& config, ModelForm form,
                                      const std::array<bool, kNumParameters>& fixed,
                                      const std::vector<const VariantFit*>& usable) {
   std::vector<ParameterSpread> spreads;
@@ -311,11 +320,11 @@ std::vector<ParameterSpread> Spreads(const IdentifyConfig& config,
     if (fixed[j]) continue;
     const bool frequency = j == kNaturalFrequency;
     spreads.push_back(SpreadOf(
-        frequency ? "w [Hz]" : ParameterName(j), static_cast<ParameterIndex>(j), usable,
+        frequency ? "w [Hz]" : ParameterName(form, j), static_cast<ParameterIndex>(j), usable,
         [&](const ParameterVector& p) { return frequency ? RadPerSecondToHz(p[j]) : p[j]; }));
     if (j != kAlpha) continue;
     spreads.push_back(SpreadOf("alpha_e", kAlpha, usable, [&](const ParameterVector& p) {
-      return EffectiveNonlinearity(p, omega_ref);
+      return EffectiveNonlinearity(form, p, omega_ref);
     }));
   }
   return spreads;
@@ -331,8 +340,8 @@ void Stability(const IdentifyConfig& config, VariantResult* result) {
     }
   }
   if (usable.size() < 2) return;
-  result->spread =
-      Spreads(config, WithVariant(config, result->variant).identification.fixed, usable);
+  result->spread = Spreads(config, result->variant.form,
+                           WithVariant(config, result->variant).identification.fixed, usable);
   for (const ParameterSpread& spread : result->spread) {
     const bool frequency = spread.index == kNaturalFrequency;
     const bool scale = spread.name == "eta_e" || spread.name == "mu1" || spread.name == "alpha_e";
@@ -551,6 +560,15 @@ void RecommendVariant(ModelSelectionReport* report) {
 
 IdentifyConfig WithVariant(const IdentifyConfig& config, const ModelVariant& variant) {
   IdentifyConfig copy = config;
+  copy.identification.solve.residual.form = variant.form;
+  // A member's own terms start at 0 (the chapter's guess of the entry is in
+  // another unit).
+  const bool own[] = {variant.form.cubic_damping(), variant.form.quintic_stiffness()};
+  for (int index : {kMu3, kAlpha5}) {
+    if (!own[index == kMu3 ? 0 : 1]) continue;
+    copy.initial_guess[index] = 0.0;
+    copy.identification.initial[index] = 0.0;
+  }
   ApplyChoice(variant.delta, kDelta, &copy);
   ApplyChoice(variant.mu2, kMu2, &copy);
   ApplyChoice(variant.omega, kNaturalFrequency, &copy);
@@ -558,7 +576,8 @@ IdentifyConfig WithVariant(const IdentifyConfig& config, const ModelVariant& var
 }
 
 std::string ModelVariant::Name() const {
-  return "delta " + delta.text + ", mu2 " + mu2.text + ", w " +
+  return std::string(ParameterName(form, kDelta)) + " " + delta.text + ", " +
+         ParameterName(form, kMu2) + " " + mu2.text + ", w " +
          (omega.value ? omega.text + " Hz" : omega.text);
 }
 
@@ -604,7 +623,15 @@ ModelSelectionReport RunModelSelection(const IdentifyConfig& config, int threads
   const ResolvedRun base = ResolveRun(config);
   const Plan plan = MakePlan(config, report.selection, base.sweeps);
   report.pool_levels = plan.levels;
-  const std::vector<ModelVariant> variants = ModelVariants(report.selection);
+  const Averaging averaging = config.identification.solve.residual.form.averaging;
+  if (averaging == Averaging::kSecondOrder &&
+      (report.selection.backbone != std::vector<BackboneTerm>{BackboneTerm::kInertia} ||
+       report.selection.damping != std::vector<DampingTerm>{DampingTerm::kQuadratic})) {
+    throw InputError(config.config_path, 0, "model_selection",
+                     "the family's terms (backbone: quintic, damping: cubic) are first order "
+                     "only; remove them, or model: {averaging: second_order}");
+  }
+  const std::vector<ModelVariant> variants = ModelVariants(report.selection, averaging);
   const std::vector<TaskResult> tasks =
       RunTasks(config, variants, base.sweeps, plan, report.selection.threads);
   const int sets = static_cast<int>(plan.training.size());

@@ -47,8 +47,12 @@ inline constexpr double kAmplitudeToleranceFloorPercent = 1.0;
 inline constexpr double kMuchWorseFactor = 2.0;
 
 struct ModelVariant {
+  // Entries kDelta and kMu2: the chapter's delta and mu2, or (a member of the
+  // family, `form`) alpha5 and mu3, which are always free.
   ParameterChoice delta, mu2, omega;
-  std::string Name() const;  // "delta free, mu2 0, w free"
+  ModelForm form;
+  // "delta free, mu2 0, w free"; a member's "alpha5 free, mu3 free, w free".
+  std::string Name() const;
   int FreeParameters(const IdentifyConfig& config) const;
 };
 

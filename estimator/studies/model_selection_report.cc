@@ -135,10 +135,19 @@ void SpreadTable(const ModelSelectionReport& report, std::ostream& out) {
   }
 }
 
+// Whether the study compares members of the family (model_form.h).
+bool ComparesMembers(const ModelSelectionReport& report) {
+  return std::any_of(report.variants.begin(), report.variants.end(),
+                     [](const VariantResult& v) { return v.variant.form.family_terms(); });
+}
+
 // Every fit with its status, so that none that failed passes unseen.
 void FitTable(const ModelSelectionReport& report, std::ostream& out) {
+  const bool members = ComparesMembers(report);
   out << "\n## Every fit\n\n| variant | fitted sweeps | status | cost | iterations | eta_e | mu1 "
-         "| mu2 | delta | alpha | w [Hz] | message "
+         "| "
+      << (members ? "mu2 or mu3 | delta or alpha5" : "mu2 | delta")
+      << " | alpha | w [Hz] | message "
          "|\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const VariantResult& v : report.variants) {
     for (const VariantFit& fit : v.fits) {
@@ -164,7 +173,12 @@ std::string ModelSelectionCsv(const ModelSelectionReport& report) {
          "fits_not_converged,fits_failed,eligible,recommended,jump_down_median_hz,"
          "jump_up_median_hz,upper_branch_median_pct,unstable,near_best,"
          "jump_down_interval_inside,jump_down_interval_total,jump_down_interval_median_half_"
-         "width_hz\n";
+         "width_hz";
+  // A study over the family's members names each variant's terms; the
+  // columns delta, mu2, mu2_fitted and delta_fitted then hold alpha5 and mu3
+  // where these say so.
+  const bool members = ComparesMembers(report);
+  out << (members ? ",backbone,damping\n" : "\n");
   for (std::size_t i = 0; i < report.variants.size(); ++i) {
     const VariantResult& v = report.variants[i];
     const VariantFit& fit = v.fits[0];
@@ -187,10 +201,15 @@ std::string ModelSelectionCsv(const ModelSelectionReport& report) {
         << StringPrintf(",%zu,%d,%d,%s,%s", v.fits.size(), v.fits_not_converged, v.fits_failed,
                         v.eligible ? "true" : "false",
                         static_cast<int>(i) == report.recommended ? "true" : "false")
-        << StringPrintf(",%.6g,%.6g,%.6g,%s,%d,%d,%d,%.6g\n", v.jump_down_hz, v.jump_up_hz,
+        << StringPrintf(",%.6g,%.6g,%.6g,%s,%d,%d,%d,%.6g", v.jump_down_hz, v.jump_up_hz,
                         v.upper_branch_percent, v.unstable ? "true" : "false", v.near_best,
                         v.jump_down_coverage.inside, v.jump_down_coverage.total,
                         v.jump_down_coverage.median_half_width);
+    if (members) {
+      out << "," << BackboneTermName(v.variant.form.backbone) << ","
+          << DampingTermName(v.variant.form.damping);
+    }
+    out << "\n";
   }
   return out.str();
 }
