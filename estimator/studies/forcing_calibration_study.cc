@@ -78,6 +78,7 @@ ForcingCalibrationComparison CompareForcingCalibration(
   const ResolvedRun run = ResolveRun(config);
   ForcingCalibrationComparison c;
   c.config = config.config_path;
+  c.form = config.identification.solve.residual.form;
   c.prior_sigma = calibration.prior_sigma;
   c.held_out_dwells = calibration.held_out_dwells;
   c.parameter = calibration.parameter;
@@ -128,7 +129,7 @@ std::string ForcingCalibrationMarkdown(const ForcingCalibrationComparison& c) {
              FitStatusName(c.with.fit.status), c.with.fit.final_cost, c.with.data_sigma);
   out << "| parameter | without | with |\n|---|---|---|\n";
   for (int i = 0; i < kNumParameters; ++i) {
-    out << StringPrintf("| %s | %.6g | %.6g |\n", ParameterName(i), c.without.parameters[i],
+    out << StringPrintf("| %s | %.6g | %.6g |\n", ParameterName(c.form, i), c.without.parameters[i],
                         c.with.fit.parameters[i]);
   }
   out << "\nFitted sweeps' scales s_k:";

@@ -30,6 +30,7 @@ struct ForcingCalibrationComparison {
   double prior_sigma = 0.0;
   HeldOutDwells held_out_dwells = HeldOutDwells::kBeforeJump;
   CalibratedParameter parameter = CalibratedParameter::kForcing;
+  ModelForm form;  // the config's member, whose names the parameters take
   IdentificationResult without;
   CalibratedIdentification with;
   std::vector<std::string> fitted;  // the fitted sweeps' names, as `with.scales`
