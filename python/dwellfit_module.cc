@@ -200,13 +200,28 @@ py::dict PyCurve(const std::map<std::string, double>& parameters, const std::str
     throw InputError("averaging", 0, "averaging",
                      "give 'first_order' or 'second_order', not '" + averaging + "'");
   }
+  // The member follows from the names (model_form.h): mu3 for mu2, alpha5
+  // for delta.
+  if (parameters.count("mu3")) form.damping = DampingTerm::kCubic;
+  if (parameters.count("alpha5")) form.backbone = BackboneTerm::kQuintic;
+  if (form.second_order() && form.family_terms()) {
+    throw InputError("averaging", 0, "averaging",
+                     "the second order is derived for the chapter's terms only; give "
+                     "'first_order' with mu3 or alpha5");
+  }
   ParameterVector p{};
   for (int i = 0; i < kNumParameters; ++i) {
-    const auto it = parameters.find(ParameterName(i));
+    const std::string name = ParameterName(form, i);
+    const auto it = parameters.find(name);
     if (it == parameters.end()) {
-      throw InputError("parameters", 0, ParameterName(i), "give every parameter");
+      throw InputError("parameters", 0, name,
+                       "give every parameter (mu2 or mu3, delta or alpha5, and the others)");
     }
     p[i] = it->second;
+  }
+  if (parameters.size() != static_cast<std::size_t>(kNumParameters)) {
+    throw InputError("parameters", 0, "parameters",
+                     "give six parameters: mu2 and mu3 (or delta and alpha5) are alternatives");
   }
   CurveSpec spec;
   spec.name = "curve";

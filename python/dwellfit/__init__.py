@@ -91,7 +91,8 @@ def next_dwell(config, state, *, limits=None, target="d_optimal", noise_sigma=0.
 
 def curve(parameters, kind, held, low, high, points_per_side=400, averaging="first_order"):
     """The model's response curve at `parameters` (a dict of eta_e, mu1, mu2,
-    delta, alpha, omega; omega in rad/s): kind="frequency" at base level
+    delta, alpha, omega; omega in rad/s; mu3 for mu2 or alpha5 for delta choose
+    a member of the family, docs/model.md): kind="frequency" at base level
     `held` from `low` to `high` Hz, or kind="amplitude" at `held` Hz from
     base level `low` to `high`. `averaging`: "first_order" (the chapter's
     model) or "second_order" (docs/model.md). Columns: freq_hz, a_base, a,

@@ -131,6 +131,29 @@ def test_the_curve_solves_the_frequency_response_equation():
     assert all(len(curve[name]) == len(curve["a"]) for name in ("freq_hz", "a_base", "phase_rad"))
 
 
+def test_a_members_curve_solves_its_frequency_response_equation():
+    """mu3 and alpha5 choose the member (docs/model.md, "Terms beyond the chapter's"):
+    P = k1 a + k5 a^3, Q = k3 a + k4 a^3 + k6 a^5, k5 = Omega mu3 / (4 eta_e),
+    k6 = 5 alpha5 / (16 eta_e)."""
+    member = {"eta_e": 100.0, "mu1": 0.2, "mu3": 1e5, "alpha5": 2e13, "alpha": 9e8,
+              "omega": 2 * math.pi * 40}
+    a_base = 0.01
+    curve = dwellfit.curve(member, "frequency", a_base, 38.0, 60.0)
+    p = member
+    for f, a in zip(curve["freq_hz"], curve["a"]):
+        omega = 2 * math.pi * f
+        k1 = omega * p["mu1"] / p["eta_e"]
+        k5 = omega * p["mu3"] / (4 * p["eta_e"])
+        k3 = -(omega ** 2 - p["omega"] ** 2) / (2 * p["eta_e"])
+        k4 = 3 * p["alpha"] / (8 * p["eta_e"])
+        k6 = 5 * p["alpha5"] / (16 * p["eta_e"])
+        g = (k1 * a + k5 * a ** 3) ** 2 + (k3 * a + k4 * a ** 3 + k6 * a ** 5) ** 2
+        assert g == pytest.approx(a_base ** 2, rel=1e-8)
+    assert len(set(np.round(curve["freq_hz"][curve["fold"]], 9))) == 2
+    with pytest.raises(dwellfit.InputError, match="alternatives"):
+        dwellfit.curve(dict(member, mu2=300.0), "frequency", a_base, 38.0, 46.0)
+
+
 def test_simulate_makes_the_plans_dwells():
     plan = os.path.join(SOURCE, "datasets", "thesis-numerical", "plan.yaml")
     sweeps = dwellfit.simulate(plan)
