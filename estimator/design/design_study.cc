@@ -233,6 +233,13 @@ DesignStudyCase LoadDesignStudyCase(const std::string& name, const std::string& 
   study.processing = rig.processing;
   std::string error;
   if (!study.plan.IsValid(&error)) throw InputError(plan_path, 0, "", error);
+  // next_dwell's ranking and the study's quantities are the chapter's terms'.
+  if (study.plan.form.family_terms() ||
+      study.config.identification.solve.residual.form.family_terms()) {
+    throw InputError(study.plan.form.family_terms() ? plan_path : config_path, 0, "model",
+                     "the design study ranks dwells for the chapter's terms (mu2, delta) only; "
+                     "remove damping: and backbone: from model:");
+  }
   if (study.plan.noise.relative_sigma != 0.0) {
     throw InputError(plan_path, 0, "noise",
                      "the rig adds its own noise (the rig config's noise.relative_sigma); set "

@@ -334,6 +334,13 @@ NextDwellOutcome ComputeNextDwell(const IdentifyConfig& config, const NextDwellR
   NextDwellOutcome outcome;
   std::string error;
   if (!request.options.IsValid(&error)) throw InputError("next_dwell options: " + error);
+  // The ranking's decay rate and intervals are the chapter's terms'
+  // (next_dwell.cc).
+  if (config.identification.solve.residual.form.family_terms()) {
+    throw InputError(config.config_path, 0, "model",
+                     "next_dwell ranks dwells for the chapter's terms (mu2, delta) only; remove "
+                     "damping: and backbone: from model:");
+  }
   const ResolvedRun run = ResolveRun(config);
   outcome.limits = OverrideLimits(LimitsFromSweeps(run.fitted), request.limits_text, "--limits");
   outcome.fit = FitRun(run).best;

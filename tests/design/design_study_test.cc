@@ -5,6 +5,8 @@
 #include "dwellfit/estimator/design/design_study.h"
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -30,6 +32,25 @@ TEST(DesignStudy, TruthOfTheVirtualBeamIsTable31s) {
   EXPECT_DOUBLE_EQ(truth[kStudyEtaE], 100.0);
   EXPECT_DOUBLE_EQ(truth[kStudyOmega], 2 * M_PI * 40.0);
   EXPECT_DOUBLE_EQ(truth[kStudyMu1], 0.2);
+}
+
+// A member of the family (model_form.h) is refused: next_dwell's ranking and
+// the study's quantities are the chapter's terms'.
+TEST(DesignStudy, AFamilyMembersPlanIsRefusedNamingTheModelKey) {
+  std::ifstream in(kVirtualBeam + "/plan.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string plan = text.str();
+  plan.replace(plan.find("  mu2: 300"), 10, "  mu3: 1.0e5");
+  const std::string path = ::testing::TempDir() + "/member_plan.yaml";
+  std::ofstream(path) << plan << "model: {damping: cubic}\n";
+  try {
+    LoadDesignStudyCase("member", kVirtualBeam + "/beam.yaml", path, kVirtualBeam + "/rig.yaml");
+    FAIL() << "a member's plan was taken";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.file(), path);
+    EXPECT_NE(std::string(error.what()).find("chapter's terms"), std::string::npos) << error.what();
+  }
 }
 
 TEST(DesignStudy, StandardArmDwellsAtThePlansFrequenciesAndLevels) {

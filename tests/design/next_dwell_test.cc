@@ -7,9 +7,12 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "Eigen/Dense"
+#include "dwellfit/config/identify_config.h"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/design/next_dwell_run.h"
 #include "dwellfit/residuals/functors/vertical_error_residual.h"
@@ -413,6 +416,23 @@ TEST(NextDwellRun, StateAndLimitsAreParsedAndBadOnesNamed) {
     EXPECT_NE(std::string(error.what()).find("f_stepmax_hz"), std::string::npos);
   }
   EXPECT_THROW(OverrideLimits(Limits(), "level_min=0.06", "--limits"), InputError);
+}
+
+// The ranking's decay rate and intervals are the chapter's terms': a member
+// of the family (model_form.h) is refused before any fit, naming the key.
+TEST(NextDwellRun, AFamilyMemberIsRefusedNamingTheModelKey) {
+  IdentifyConfig config =
+      LoadIdentifyConfig(std::string(DWELLFIT_SOURCE_DIR) + "/datasets/thesis-numerical/beam.yaml");
+  config.identification.solve.residual.form.backbone = BackboneTerm::kQuintic;
+  std::ostringstream out;
+  try {
+    ComputeNextDwell(config, NextDwellRequest{}, out);
+    FAIL() << "a member's config was taken";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.field(), "model");
+    EXPECT_NE(std::string(error.what()).find("chapter's terms"), std::string::npos);
+  }
+  EXPECT_TRUE(out.str().empty());
 }
 
 }  // namespace
