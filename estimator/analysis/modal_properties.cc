@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "dwellfit/estimator/common/string_printf.h"
+#include "dwellfit/residuals/model/equivalent_oscillator.h"
 #include "dwellfit/residuals/model/response_model.h"
 
 namespace dwellfit {
@@ -35,11 +36,9 @@ void Band(const ParameterVector& p, const ParameterMatrix& covariance, Quantity 
 
 double ModalFrequency(ModelForm form, const ParameterVector& p, double a) {
   const double w = p[kNaturalFrequency];
-  const double delta = form.has_inertia() ? p[kDelta] : 0.0;
-  const double mass = 4.0 + 2.0 * delta * a * a;
-  double stiffness = 4.0 * w * w + 3.0 * p[kAlpha] * a * a;
-  // Q = 0 with k6 = 5 alpha5 / (16 eta_e): 8 eta_e k6 a^4 = 2.5 alpha5 a^4.
-  if (form.quintic_stiffness()) stiffness += 2.5 * p[kAlpha5] * a * a * a * a;
+  const EquivalentOscillator o = EquivalentOscillatorAt(form, p, a);
+  const double mass = o.mass;
+  const double stiffness = o.stiffness;
   double squared = stiffness / mass;
   // The second order's fixed point: its correction is of order a^4, small
   // beside the first order's, so a few steps settle it.
@@ -56,16 +55,16 @@ double ModalFrequency(ModelForm form, const ParameterVector& p, double a) {
 
 double ModalDampingRatio(ModelForm form, const ParameterVector& p, double a) {
   // P / (a Omega / eta_e): mu1 + 4 mu2 a / (3 pi), or mu1 + mu3 a^2 / 4.
-  double damping = form.cubic_damping() ? p[kMu1] + 0.25 * p[kMu3] * a * a
-                                        : p[kMu1] + 4.0 * p[kMu2] * a / (3.0 * kPi);
+  const EquivalentOscillator o = EquivalentOscillatorAt(form, p, a);
+  double damping = o.damping;
   const double omega = ModalFrequency(form, p, a);
   if (form.second_order()) {
     const double w = p[kNaturalFrequency];
     const double g = p[kAlpha] - 2.0 * p[kDelta] * omega * omega;
     damping -= 3.0 * p[kMu2] * g * a * a * a / (5.0 * kPi * (9.0 * omega * omega - w * w));
   }
-  const double delta = form.has_inertia() ? p[kDelta] : 0.0;
-  return damping / ((1.0 + 0.5 * delta * a * a) * omega);
+  // 1 + delta a^2 / 2 = mass / 4 (exactly: scaling by 1/4 rounds alike).
+  return damping / ((0.25 * o.mass) * omega);
 }
 
 ModalProperties ComputeModalProperties(ModelForm form, const ParameterVector& parameters,

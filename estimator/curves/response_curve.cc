@@ -9,6 +9,7 @@
 #include "boost/math/tools/toms748_solve.hpp"
 #include "dwellfit/estimator/common/input_error.h"
 #include "dwellfit/estimator/common/string_printf.h"
+#include "dwellfit/residuals/model/equivalent_oscillator.h"
 #include "dwellfit/residuals/model/fold_point.h"
 #include "dwellfit/residuals/model/response_model.h"
 
@@ -28,15 +29,10 @@ struct FrequencyQuadratic {
 FrequencyQuadratic MakeQuadratic(ModelForm form, const ParameterVector& p, double a_base,
                                  double a) {
   const double eta_e = p[kEtaE];
-  const double w = p[kNaturalFrequency];
-  const double damping = form.cubic_damping() ? p[kMu1] + 0.25 * p[kMu3] * a * a
-                                              : p[kMu1] + 4.0 * p[kMu2] * a / (3.0 * kPi);
-  const double d = damping * a / eta_e;
-  double stiffness = 4.0 * w * w + 3.0 * p[kAlpha] * a * a;
-  if (form.quintic_stiffness()) stiffness += 2.5 * p[kAlpha5] * a * a * a * a;
-  const double b = a * stiffness / (8.0 * eta_e);
-  const double delta = form.has_inertia() ? p[kDelta] : 0.0;
-  const double c = a * (4.0 + 2.0 * delta * a * a) / (8.0 * eta_e);
+  const EquivalentOscillator o = EquivalentOscillatorAt(form, p, a);
+  const double d = o.damping * a / eta_e;
+  const double b = a * o.stiffness / (8.0 * eta_e);
+  const double c = a * o.mass / (8.0 * eta_e);
   FrequencyQuadratic q;
   q.c2 = c * c;
   q.c1 = d * d - 2.0 * b * c;
